@@ -1,0 +1,47 @@
+"""Exact solutions used to verify the schemes (REFERENCE formulas, restated here)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def ritter(x: np.ndarray, t: float, h0: float, x0: float = 0.0,
+           g: float = 9.81) -> tuple[np.ndarray, np.ndarray]:
+    """Ritter's frictionless dam break onto a dry bed.
+
+    Reservoir of depth h0 [m] for x < x0 at t = 0, c0 = sqrt(g h0). For
+    x0 - c0 t <= x <= x0 + 2 c0 t: h = (2 c0 - (x - x0)/t)^2 / (9 g),
+    u = 2/3 ((x - x0)/t + c0); h = h0, u = 0 upstream and h = 0 downstream.
+    Returns (h [m], u [m/s]) at the points x [m].
+    """
+    return mangeney(x, t, h0, x0=x0, g=g, theta_deg=0.0, delta_deg=0.0)
+
+
+def mangeney(x: np.ndarray, t: float, h0: float, x0: float = 0.0, g: float = 9.81,
+             theta_deg: float = 0.0, delta_deg: float = 0.0
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """Mangeney, Heinrich & Roche (2000): dam break on a slope theta with Coulomb
+    friction angle delta <= theta (h normal to the bed, x down-slope).
+
+    m = g cos(theta)(tan(theta) - tan(delta)), c0 = sqrt(g cos(theta) h0);
+    rear x_A = x0 - c0 t + m t^2/2, front x_B = x0 + 2 c0 t + m t^2/2.
+    x <= x_A: h = h0, u = m t; x_A < x <= x_B: h = (2 c0 - (x - x0)/t + m t/2)^2 /
+    (9 g cos theta), u = 2/3 ((x - x0)/t + c0 + m t); beyond x_B: h = 0.
+    """
+    th = math.radians(theta_deg)
+    gz = g * math.cos(th)
+    m = gz * (math.tan(th) - math.tan(math.radians(delta_deg)))
+    c0 = math.sqrt(gz * h0)
+    x = np.asarray(x, dtype=float)
+    if t <= 0:
+        return np.where(x < x0, h0, 0.0), np.zeros_like(x)
+    xa = x0 - c0 * t + 0.5 * m * t * t
+    xb = x0 + 2 * c0 * t + 0.5 * m * t * t
+    xi = (x - x0) / t
+    h_fan = (2 * c0 - xi + 0.5 * m * t) ** 2 / (9 * gz)
+    u_fan = 2.0 / 3.0 * (xi + c0 + m * t)
+    h = np.where(x <= xa, h0, np.where(x <= xb, h_fan, 0.0))
+    u = np.where(x <= xa, m * t, np.where(x <= xb, u_fan, 0.0))
+    return h, u

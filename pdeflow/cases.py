@@ -1,0 +1,354 @@
+"""Case files: TOML schema, validation, and the built-in initial shapes.
+
+A case file is data, never code: it is parsed with ``tomllib`` and every key is
+checked against the schema below; an unknown key or a wrong type is an error that
+names the key and the file. Sections (all optional except ``[initial]``)::
+
+    [case]        name, description, t_end [s], models = ["two_layer", "single_layer"]
+    [grid]        length [m], dx [m] (or cells), x_start [m]
+    [boundaries]  left, right = "wall" | "open"
+    [initial]     shape = "column" | "dam_break" | "heap" | "file" and its keys
+    [numerics]    solver = "fv-split" | any py-pde solver name, cfl, dt (py-pde solvers)
+    [two_layer]   any field of TwoLayerParameters
+    [single_layer] any field of SingleLayerParameters
+    [output]      snapshot_times [s], front_threshold [m]
+
+Initial shapes (x measured from the left end of the domain):
+
+* ``column``: a column of length L0 [m] and height H0 [m] against the left end. For
+  two layers the lower layer is the wedge h2 = min(H0, (L0 - x) tan(alpha)) under the
+  upper layer h1 = H0 - h2, alpha = ``wedge_angle_deg`` (default 45 + phi_int/2, the
+  Rankine active failure plane; the paper's text says pi/4 + phi_int, see docs).
+* ``dam_break``: depth h_left for x < x_dam and h_right beyond (single layer; for two
+  layers ``upper_fraction`` of each depth is put in the upper layer).
+* ``heap``: a symmetric triangular heap of height ``height`` [m] with flanks at
+  ``slope_deg`` [deg] centred at ``center`` [m] (split like dam_break for two layers).
+* ``file``: an ``.npz`` with arrays h1, u1, h2, u2 (two layers) or h, u (single layer)
+  on the case's grid (same number of cells), ``path`` relative to the case file.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+from .models.base import check_range
+
+MODEL_NAMES = ("two_layer", "single_layer")
+
+SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
+    "case": {"name": (str,), "description": (str,), "t_end": (float, int),
+             "models": (list,)},
+    "grid": {"length": (float, int), "dx": (float, int), "cells": (int,),
+             "x_start": (float, int)},
+    "boundaries": {"left": (str,), "right": (str,)},
+    "initial": {"shape": (str,), "L0": (float, int), "H0": (float, int),
+                "wedge_angle_deg": (float, int), "x_dam": (float, int),
+                "h_left": (float, int), "h_right": (float, int),
+                "upper_fraction": (float, int), "center": (float, int),
+                "height": (float, int), "slope_deg": (float, int), "path": (str,)},
+    "numerics": {"solver": (str,), "cfl": (float, int), "dt": (float, int)},
+    "two_layer": {},  # checked by TwoLayerParameters
+    "single_layer": {},  # checked by SingleLayerParameters
+    "output": {"snapshot_times": (list,), "front_threshold": (float, int)},
+}
+
+SHAPES = ("column", "dam_break", "heap", "file")
+
+
+class CaseError(ValueError):
+    """An invalid case file or override; the message names the key and the file."""
+
+
+@dataclass
+class Case:
+    """A validated case: everything needed to set up and run the models."""
+
+    data: dict[str, dict[str, Any]]
+    source: str = "<dict>"
+    base_dir: Path = field(default_factory=Path.cwd)
+
+    # --- construction ---------------------------------------------------------------------
+    @classmethod
+    def from_file(cls, path: str | Path, overrides: list[str] | None = None) -> Case:
+        """Read a TOML case file, apply ``section.key=value`` overrides, validate."""
+        path = Path(path)
+        if not path.is_file():
+            raise CaseError(f"case file {path} does not exist")
+        try:
+            with path.open("rb") as fh:
+                data = tomllib.load(fh)
+        except tomllib.TOMLDecodeError as err:
+            raise CaseError(f"{path}: not valid TOML: {err}") from None
+        case = cls(data, str(path), path.resolve().parent)
+        for item in overrides or []:
+            case.set(item)
+        case.validate()
+        return case
+
+    @classmethod
+    def from_dict(cls, data: dict, source: str = "<dict>") -> Case:
+        case = cls(copy.deepcopy(data), source)
+        case.validate()
+        return case
+
+    def set(self, item: str) -> None:
+        """Apply an override ``section.key=value`` (value parsed as a TOML value)."""
+        if "=" not in item or "." not in item.split("=", 1)[0]:
+            raise CaseError(f"override {item!r} must look like section.key=value")
+        key, raw = item.split("=", 1)
+        section, name = key.strip().split(".", 1)
+        try:
+            value = tomllib.loads(f"v = {raw.strip()}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = raw.strip()  # bare strings such as open or column
+        self.data.setdefault(section, {})[name] = value
+
+    def copy(self) -> Case:
+        return Case(copy.deepcopy(self.data), self.source, self.base_dir)
+
+    # --- validation -----------------------------------------------------------------------
+    def _err(self, msg: str) -> CaseError:
+        return CaseError(f"{self.source}: {msg}")
+
+    def validate(self) -> None:
+        """Check sections, keys, types and ranges; raise CaseError naming the key."""
+        from .models import SingleLayerParameters, TwoLayerParameters
+
+        for section, content in self.data.items():
+            if section not in SCHEMA:
+                raise self._err(f"unknown section [{section}]; allowed: {list(SCHEMA)}")
+            if not isinstance(content, dict):
+                raise self._err(f"[{section}] must be a table")
+            allowed = SCHEMA[section]
+            if not allowed:
+                continue
+            for key, value in content.items():
+                if key not in allowed:
+                    raise self._err(f"unknown key {section}.{key}; allowed: "
+                                    f"{sorted(allowed)}")
+                if isinstance(value, bool) or not isinstance(value, allowed[key]):
+                    names = " or ".join(t.__name__ for t in allowed[key])
+                    raise self._err(f"{section}.{key} must be {names}, got {value!r}")
+        for name, cls in (("two_layer", TwoLayerParameters),
+                          ("single_layer", SingleLayerParameters)):
+            try:
+                cls.from_dict(self.data.get(name, {}))
+            except (ValueError, TypeError) as err:
+                raise self._err(f"[{name}] {err}") from None
+        for model in self.models:
+            if model not in MODEL_NAMES:
+                raise self._err(f"case.models: unknown model {model!r}; allowed: "
+                                f"{list(MODEL_NAMES)}")
+        try:
+            check_range("case.t_end", self.t_end, 0, math.inf, low_open=True, unit="s")
+            check_range("grid.length", self.length, 0, math.inf, low_open=True,
+                        unit="m")
+            check_range("grid.dx", self.dx, 0, self.length, low_open=True, unit="m")
+            check_range("numerics.cfl", self.cfl, 0, 1, low_open=True)
+            for t in self.snapshot_times:
+                check_range("output.snapshot_times", t, 0, self.t_end, unit="s")
+            check_range("output.front_threshold", self.front_threshold, 0, math.inf,
+                        low_open=True, unit="m")
+        except ValueError as err:
+            raise self._err(str(err)) from None
+        for side in ("left", "right"):
+            bc = self.data.get("boundaries", {}).get(side, "wall" if side == "left"
+                                                      else "open")
+            if bc not in ("wall", "open"):
+                raise self._err(f"boundaries.{side} must be 'wall' or 'open', got {bc!r}")
+        if "initial" not in self.data or "shape" not in self.data["initial"]:
+            raise self._err("[initial] with a 'shape' is required")
+        if self.initial["shape"] not in SHAPES:
+            raise self._err(f"initial.shape must be one of {list(SHAPES)}, got "
+                            f"{self.initial['shape']!r}")
+        self._check_initial()
+
+    def _check_initial(self) -> None:
+        ini = self.initial
+        shape = ini["shape"]
+        need = {"column": ("L0", "H0"), "dam_break": ("x_dam", "h_left"),
+                "heap": ("center", "height", "slope_deg"), "file": ("path",)}[shape]
+        for key in need:
+            if key not in ini:
+                raise self._err(f"initial.{key} is required for shape {shape!r}")
+        try:
+            for key in ("L0", "H0", "height"):
+                if key in ini:
+                    check_range(f"initial.{key}", ini[key], 0, math.inf, low_open=True,
+                                unit="m")
+            for key in ("h_left", "h_right"):
+                if key in ini:
+                    check_range(f"initial.{key}", ini[key], 0, math.inf, unit="m")
+            if "wedge_angle_deg" in ini:
+                check_range("initial.wedge_angle_deg", ini["wedge_angle_deg"], 0, 90,
+                            low_open=True, high_open=True, unit="deg")
+            if "slope_deg" in ini:
+                check_range("initial.slope_deg", ini["slope_deg"], 0, 90,
+                            low_open=True, high_open=True, unit="deg")
+            if "upper_fraction" in ini:
+                check_range("initial.upper_fraction", ini["upper_fraction"], 0, 1)
+        except ValueError as err:
+            raise self._err(str(err)) from None
+        if shape == "file" and not (self.base_dir / ini["path"]).is_file():
+            raise self._err(f"initial.path: file {ini['path']} not found next to "
+                            "the case file")
+
+    # --- accessors ------------------------------------------------------------------------
+    def _get(self, section: str, key: str, default: Any) -> Any:
+        return self.data.get(section, {}).get(key, default)
+
+    @property
+    def name(self) -> str:
+        return self._get("case", "name", Path(self.source).stem)
+
+    @property
+    def models(self) -> list[str]:
+        return list(self._get("case", "models", ["two_layer"]))
+
+    @property
+    def t_end(self) -> float:
+        return float(self._get("case", "t_end", 10.0))
+
+    @property
+    def length(self) -> float:
+        return float(self._get("grid", "length", 1.0))
+
+    @property
+    def x_start(self) -> float:
+        return float(self._get("grid", "x_start", 0.0))
+
+    @property
+    def dx(self) -> float:
+        if "cells" in self.data.get("grid", {}):
+            return self.length / int(self.data["grid"]["cells"])
+        return float(self._get("grid", "dx", self.length / 100))
+
+    @property
+    def cells(self) -> int:
+        if "cells" in self.data.get("grid", {}):
+            return int(self.data["grid"]["cells"])
+        return max(1, round(self.length / self.dx))
+
+    @property
+    def bc(self) -> tuple[str, str]:
+        b = self.data.get("boundaries", {})
+        return b.get("left", "wall"), b.get("right", "open")
+
+    @property
+    def cfl(self) -> float:
+        return float(self._get("numerics", "cfl", 0.3))
+
+    @property
+    def solver(self) -> str:
+        return self._get("numerics", "solver", "fv-split")
+
+    @property
+    def initial(self) -> dict[str, Any]:
+        return self.data.get("initial", {})
+
+    @property
+    def L0(self) -> float | None:
+        v = self.initial.get("L0")
+        return None if v is None else float(v)
+
+    @property
+    def snapshot_times(self) -> list[float]:
+        return [float(t) for t in self._get("output", "snapshot_times", [])]
+
+    @property
+    def front_threshold(self) -> float:
+        return float(self._get("output", "front_threshold", 1e-3))
+
+    # --- model set-up ---------------------------------------------------------------------
+    def make_grid(self):
+        from pde import CartesianGrid
+
+        return CartesianGrid([[self.x_start, self.x_start + self.length]], self.cells)
+
+    def make_pde(self, model: str):
+        from .models import SingleLayerGranular, TwoLayerGranular
+
+        if model == "two_layer":
+            return TwoLayerGranular(self.data.get("two_layer", {}), bc=self.bc)
+        return SingleLayerGranular(self.data.get("single_layer", {}), bc=self.bc)
+
+    def initial_profiles(self, model: str, grid=None) -> dict[str, np.ndarray]:
+        """Depth and velocity profiles of the initial state for ``model``."""
+        grid = grid or self.make_grid()
+        x = grid.axes_coords[0] - self.x_start
+        ini = self.initial
+        shape = ini["shape"]
+        zeros = np.zeros_like(x)
+        two = model == "two_layer"
+        if shape == "file":
+            return self._profiles_from_file(model, x.size)
+        if shape == "column":
+            L0, H0 = float(ini["L0"]), float(ini["H0"])
+            h = np.where(x < L0, H0, 0.0)
+            if not two:
+                return {"h": h, "u": zeros}
+            phi_int = float(self.data.get("two_layer", {}).get("phi_int_deg", 30.0))
+            alpha = float(ini.get("wedge_angle_deg", 45.0 + phi_int / 2))
+            h2 = np.where(x < L0, np.minimum(H0, (L0 - x) * math.tan(math.radians(alpha))),
+                          0.0)
+            return {"h1": h - h2, "u1": zeros, "h2": h2, "u2": zeros}
+        if shape == "dam_break":
+            h = np.where(x < float(ini["x_dam"]), float(ini["h_left"]),
+                         float(ini.get("h_right", 0.0)))
+        else:  # heap
+            slope = math.tan(math.radians(float(ini["slope_deg"])))
+            h = np.maximum(float(ini["height"]) - slope * np.abs(x - float(ini["center"])),
+                           0.0)
+        if not two:
+            return {"h": h, "u": zeros}
+        f = float(ini.get("upper_fraction", 0.5))
+        return {"h1": f * h, "u1": zeros, "h2": (1 - f) * h, "u2": zeros}
+
+    def _profiles_from_file(self, model: str, n: int) -> dict[str, np.ndarray]:
+        path = self.base_dir / self.initial["path"]
+        keys = ("h1", "u1", "h2", "u2") if model == "two_layer" else ("h", "u")
+        try:
+            with np.load(path) as data:
+                missing = [k for k in keys if k not in data]
+                if missing:
+                    raise self._err(f"initial profile {path.name} lacks arrays "
+                                    f"{missing} needed by the {model} model")
+                out = {k: np.asarray(data[k], dtype=float) for k in keys}
+        except (OSError, ValueError) as err:
+            if isinstance(err, CaseError):
+                raise
+            raise self._err(f"cannot read initial profile {path}: {err}") from None
+        for k, v in out.items():
+            if v.shape != (n,):
+                raise self._err(f"initial profile {path.name}: array {k} has shape "
+                                f"{v.shape}, the grid has ({n},) cells")
+        return out
+
+    def make_state(self, model: str):
+        """PDE, grid and initial FieldCollection for ``model``."""
+        grid = self.make_grid()
+        eq = self.make_pde(model)
+        try:
+            state = eq.make_state(grid, **self.initial_profiles(model, grid))
+        except ValueError as err:
+            if isinstance(err, CaseError):
+                raise
+            raise self._err(f"initial state: {err}") from None
+        return eq, state
+
+
+def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:
+    """Read and validate a case file (see module docstring)."""
+    return Case.from_file(path, overrides)

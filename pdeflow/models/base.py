@@ -1,0 +1,189 @@
+"""Common shell of the granular PDE classes: boundaries, rates, post-step hook.
+
+A model owns its physics (parameters, state layout, kernels); the py-pde class here
+only assembles the kernels into what py-pde expects:
+
+* :meth:`evolution_rate` - vectorised numpy method-of-lines rate;
+* :meth:`make_evolution_rate` - the same rate from compiled numba kernels;
+* :meth:`make_post_step_hook` - the operator-split source stage (31)-(34). It reads
+  the time step from ``post_step_data[0]``, which the ``fv-split`` solver writes; a
+  generic py-pde solver leaves it at 0 and the hook only keeps depths non-negative and
+  velocities zero in dry cells.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+from pde import CartesianGrid, FieldCollection, ScalarField
+from pde.pdes.base import PDEBase
+
+from ..numerics import layout as L
+
+BC_NAMES = {"wall": L.BC_WALL, "open": L.BC_OPEN}
+
+
+def check_range(name: str, value: Any, low: float, high: float, *,
+                low_open: bool = False, high_open: bool = False, unit: str = "") -> float:
+    """Return ``float(value)`` or raise ValueError naming the parameter and its range."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    lo_ok = v > low if low_open else v >= low
+    hi_ok = v < high if high_open else v <= high
+    if not (math.isfinite(v) and lo_ok and hi_ok):
+        lb = "(" if low_open else "["
+        rb = ")" if high_open else "]"
+        u = f" {unit}" if unit else ""
+        raise ValueError(f"{name} must lie in {lb}{low}, {high}{rb}{u}, got {value!r}")
+    return v
+
+
+class GranularPDE(PDEBase):
+    """Base of :class:`TwoLayerGranular` and :class:`SingleLayerGranular`."""
+
+    explicit_time_dependence = False
+    check_implementation = False
+    #: names of the fields of the state, in order
+    field_names: tuple[str, ...] = ()
+    two_layer: bool = False
+
+    def __init__(self, bc: Sequence[str] = ("wall", "open")):
+        super().__init__()
+        if isinstance(bc, str) or len(bc) != 2 or any(b not in BC_NAMES for b in bc):
+            raise ValueError(
+                f"bc must be a pair of 'wall' or 'open' (left, right), got {bc!r}")
+        self.bc = tuple(bc)
+        self.bc_codes = (BC_NAMES[bc[0]], BC_NAMES[bc[1]])
+
+    # --- parameters -----------------------------------------------------------------------
+    def parameter_array(self) -> np.ndarray:
+        """Flat float64 parameter vector read by the kernels (see numerics.layout)."""
+        raise NotImplementedError
+
+    # --- states ---------------------------------------------------------------------------
+    @staticmethod
+    def check_grid(grid: Any) -> float:
+        """Return dx [m] of a uniform non-periodic 1D Cartesian grid, else raise."""
+        if not isinstance(grid, CartesianGrid) or grid.num_axes != 1:
+            raise ValueError(f"grid must be a 1D CartesianGrid, got {grid!r}")
+        if grid.periodic[0]:
+            raise ValueError("grid must not be periodic: use wall or open boundaries")
+        return float(grid.discretization[0])
+
+    def make_state(self, grid: CartesianGrid, **profiles: np.ndarray) -> FieldCollection:
+        """State from depth and velocity profiles (names: h1, u1, h2, u2 or h, u)."""
+        self.check_grid(grid)
+        n = grid.shape[0]
+        fields = []
+        for k in range(0, len(self.field_names), 2):
+            hname = self.field_names[k]
+            uname = "u" + hname[1:]
+            h = np.asarray(profiles.get(hname, np.zeros(n)), dtype=float)
+            u = np.asarray(profiles.get(uname, np.zeros(n)), dtype=float)
+            for name, arr in ((hname, h), (uname, u)):
+                if arr.shape != (n,):
+                    raise ValueError(f"{name} must have shape ({n},), got {arr.shape}")
+                if not np.all(np.isfinite(arr)):
+                    raise ValueError(f"{name} must be finite (no NaN or inf)")
+            if np.any(h < 0):
+                raise ValueError(f"{hname} must be >= 0 m, got min {h.min():g}")
+            fields.append(ScalarField(grid, h, label=hname))
+            fields.append(ScalarField(grid, h * u, label=self.field_names[k + 1]))
+        return FieldCollection(fields)
+
+    def check_state(self, state: FieldCollection) -> float:
+        """Validate a state for this model; return dx."""
+        dx = self.check_grid(state.grid)
+        if state.data.shape[0] != len(self.field_names):
+            raise ValueError(f"state must have {len(self.field_names)} fields "
+                             f"{self.field_names}, got {state.data.shape[0]}")
+        if not np.all(np.isfinite(state.data)):
+            raise ValueError("state contains NaN or inf")
+        for k in range(0, len(self.field_names), 2):
+            if np.any(state.data[k] < 0):
+                raise ValueError(f"{self.field_names[k]} must be >= 0 m")
+        return dx
+
+    # --- rates ----------------------------------------------------------------------------
+    def evolution_rate(self, state: FieldCollection, t: float = 0) -> FieldCollection:
+        """Method-of-lines rate: HLL flux divergence (29) plus sources (26)-(27)."""
+        from ..numerics.vectorized import advection_rate, source_rate
+
+        dx = self.check_grid(state.grid)
+        P = self.parameter_array()
+        q = state.data
+        rate, _ = advection_rate(q, dx, self.bc_codes, P[L.G_Z], self._dry(P),
+                                 P[L.R] if self.two_layer else None)
+        rate += source_rate(q, P, self.two_layer)
+        out = state.copy()
+        out.data[...] = rate
+        return out
+
+    def _dry(self, P: np.ndarray) -> float:
+        return float(P[L.DRY] if self.two_layer else P[L.S_DRY])
+
+    def make_evolution_rate(self, state: FieldCollection, backend: Any) -> Callable:
+        """Compiled method-of-lines rate (numba backend)."""
+        name = getattr(backend, "name", str(backend))
+        if name not in ("numba",):
+            raise NotImplementedError(f"no compiled rate for backend {name}")
+        from numba import njit
+
+        from ..numerics.advection import rate_single, rate_two_layer
+        from ..numerics.mol import source_rate_single, source_rate_two_layer
+
+        dx = self.check_grid(state.grid)
+        P = self.parameter_array()
+        bcl, bcr = self.bc_codes
+        g = P[L.G_Z]
+        dry = self._dry(P)
+        if self.two_layer:
+            r = P[L.R]
+
+            @njit
+            def rate(state_data, t):  # pragma: no cover - compiled
+                out = np.empty_like(state_data)
+                rate_two_layer(state_data, out, dx, bcl, bcr, g, r, dry)
+                source_rate_two_layer(state_data, out, P)
+                return out
+        else:
+
+            @njit
+            def rate(state_data, t):  # pragma: no cover - compiled
+                out = np.empty_like(state_data)
+                rate_single(state_data, out, dx, bcl, bcr, g, dry)
+                source_rate_single(state_data, out, P)
+                return out
+
+        return rate
+
+    # --- operator splitting ---------------------------------------------------------------
+    def new_diagnostics(self, n_cells: int) -> np.ndarray:
+        """Fresh post-step data: bookkeeping followed by F_extra/rho1 per cell."""
+        return np.zeros(L.N_DIAG + n_cells)
+
+    def source_kernel(self) -> Callable:
+        """The compiled source stage ``(q, dt, t, P, diag) -> None`` of this model."""
+        from ..numerics.splitting import source_stage_single, source_stage_two_layer
+
+        return source_stage_two_layer if self.two_layer else source_stage_single
+
+    def make_post_step_hook(self, state: FieldCollection, backend: Any = "numpy"):
+        """Post-step hook applying the split source stage with dt = data[0]."""
+        P = self.parameter_array()
+        kernel = self.source_kernel()
+        name = getattr(backend, "name", str(backend))
+        if name == "numpy":
+            kernel = kernel.py_func
+
+        def post_step_hook(state_data, t, post_step_data):
+            dt = post_step_data[0]
+            kernel(state_data, dt, t + dt, P, post_step_data)
+            return state_data, post_step_data
+
+        return post_step_hook, self.new_diagnostics(state.grid.shape[0])

@@ -1,0 +1,165 @@
+r"""The two-layer granular model of the paper: system (24) with closure (25).
+
+Layer 1 (upper, density rho1) is friction-collisional, layer 2 (lower, rho2 > rho1) is
+frictional; both are depth-averaged with isotropic hydrostatic pressure. With
+q = (h1, h1 u1, h2, h2 u2), g_z = g cos(theta), g_x = g sin(theta), r = rho1/rho2:
+
+.. math::
+   \partial_t h_1 + \partial_x(h_1 u_1) &= M/\rho_1 \\
+   \partial_t(h_1 u_1) + \partial_x(h_1 u_1^2 + g_z h_1^2/2) &=
+        g_x h_1 - g_z h_1 \partial_x h_2 + u_1 M/\rho_1 - t_1/\rho_1 \\
+   \partial_t h_2 + \partial_x(h_2 u_2) &= -M/\rho_2 \\
+   \partial_t(h_2 u_2) + \partial_x(h_2 u_2^2 + g_z h_2^2/2) &=
+        g_x h_2 - g_z r h_2 \partial_x h_1 - u_2 M/\rho_2 + t_2/\rho_2 - t_B/\rho_2
+
+(paper eq. 24), interface stresses (22)-(23), basal Coulomb stress
+t_B = sgn(u2) g_z (rho1 h1 + rho2 h2) tan(phi_B) (15), and M = (t1 - t2)/(u1 - u2) (25).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from ..numerics import layout as L
+from .base import GranularPDE, check_range
+
+HYPERBOLICITY_MODES = {"none": 0, "exact": 1, "bound": 2}
+
+
+@dataclass
+class TwoLayerParameters:
+    """Physical and numerical parameters of :class:`TwoLayerGranular`.
+
+    The paper's Table 1 is lost; defaults marked *calibrated* were chosen to reproduce
+    the paper's reported results of test 5.1 (see ``docs/parameters.md``).
+    """
+
+    g: float = 9.81
+    """gravitational acceleration [m/s^2]"""
+    theta_deg: float = 0.0
+    """bed slope [deg], x pointing down-slope"""
+    density_ratio: float = 0.67
+    """rho1/rho2 in (0, 1): the paper's value for dense-collisional flows [-]"""
+    phi_int_deg: float = 30.0
+    """internal friction angle at the interface [deg] (paper: 30)"""
+    phi_b_deg: float = 30.0
+    """basal friction angle of the lower layer [deg] (calibrated)"""
+    k: float = 0.8
+    """friction reduction on the upper side of the interface, eq. (17), in [0, 1) (calibrated)"""
+    c: float = 0.01
+    """collisional (Voellmy) coefficient of eq. (17) [-] (calibrated)"""
+    w: float = 1e-3
+    """threshold of criterion (34) on lambda3 - lambda2 [m/s]"""
+    dry_tolerance: float = 1e-6
+    """layers thinner than this have zero velocity [m]"""
+    film_depth: float = 1e-3
+    """upper-layer films thinner than this after an exchange are deposited whole [m]"""
+    du_reg: float = 0.0
+    """lower bound of |u1 - u2| in the closure's denominator [m/s]; 0 = the paper's"""
+    hyperbolicity: str = "exact"
+    """restoration of hyperbolicity: 'exact' (paper), 'bound' (F_L), 'none'"""
+    rest_speed: float = 0.01
+    """speed below which a layer counts as practically at rest [m/s]"""
+    rest_depth: float = 1e-3
+    """depth above which the practical-rest test looks at a cell [m]"""
+    mol_eps: float = 1e-3
+    """velocity scale regularising sgn() in the method-of-lines rate [m/s]"""
+
+    def __post_init__(self) -> None:
+        self.validate()
+
+    def validate(self) -> None:
+        """Raise ValueError naming the first parameter outside its allowed range."""
+        check_range("g", self.g, 0, math.inf, low_open=True, unit="m/s^2")
+        check_range("theta_deg", self.theta_deg, -90, 90, low_open=True,
+                    high_open=True, unit="deg")
+        check_range("density_ratio", self.density_ratio, 0, 1, low_open=True,
+                    high_open=True)
+        check_range("phi_int_deg", self.phi_int_deg, 0, 90, low_open=True,
+                    high_open=True, unit="deg")
+        check_range("phi_b_deg", self.phi_b_deg, 0, 90, low_open=True, high_open=True,
+                    unit="deg")
+        check_range("k", self.k, 0, 1, high_open=True)
+        check_range("c", self.c, 0, math.inf)
+        check_range("w", self.w, 0, math.inf, low_open=True, unit="m/s")
+        check_range("dry_tolerance", self.dry_tolerance, 0, 1, low_open=True, unit="m")
+        check_range("film_depth", self.film_depth, 0, 1, unit="m")
+        check_range("du_reg", self.du_reg, 0, math.inf, unit="m/s")
+        check_range("rest_speed", self.rest_speed, 0, math.inf, low_open=True,
+                    unit="m/s")
+        check_range("rest_depth", self.rest_depth, 0, math.inf, unit="m")
+        check_range("mol_eps", self.mol_eps, 0, math.inf, low_open=True, unit="m/s")
+        if self.hyperbolicity not in HYPERBOLICITY_MODES:
+            raise ValueError(f"hyperbolicity must be one of {list(HYPERBOLICITY_MODES)}, "
+                             f"got {self.hyperbolicity!r}")
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> TwoLayerParameters:
+        """Build from a mapping, rejecting unknown keys by name."""
+        names = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - names)
+        if unknown:
+            raise ValueError(f"unknown two-layer parameter(s) {unknown}; "
+                             f"allowed: {sorted(names)}")
+        return cls(**data)
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    def to_array(self) -> np.ndarray:
+        """Kernel parameter vector (layout in :mod:`pdeflow.numerics.layout`)."""
+        th = math.radians(self.theta_deg)
+        P = np.zeros(L.N_TWO_LAYER)
+        P[L.G_Z] = self.g * math.cos(th)
+        P[L.G_X] = self.g * math.sin(th)
+        P[L.R] = self.density_ratio
+        P[L.TAN_INT] = math.tan(math.radians(self.phi_int_deg))
+        P[L.TAN_B] = math.tan(math.radians(self.phi_b_deg))
+        P[L.K] = self.k
+        P[L.C] = self.c
+        P[L.W] = self.w
+        P[L.DRY] = self.dry_tolerance
+        P[L.FILM] = self.film_depth
+        P[L.DU_REG] = self.du_reg
+        P[L.HYPERBOLICITY] = HYPERBOLICITY_MODES[self.hyperbolicity]
+        P[L.SLOW_U] = self.rest_speed
+        P[L.SLOW_H] = self.rest_depth
+        P[L.MOL_EPS] = self.mol_eps
+        return P
+
+
+class TwoLayerGranular(GranularPDE):
+    """Two-layer depth-averaged granular flow (paper eqs. 24-27) as a py-pde PDE.
+
+    State: ``FieldCollection`` of h1 [m], h1u1 [m^2/s], h2 [m], h2u2 [m^2/s] on a 1D
+    ``CartesianGrid`` whose cells are the finite volumes. Integrate with
+    ``solver="fv-split"`` (the paper's scheme) or any py-pde solver (method of lines).
+    """
+
+    field_names = ("h1", "h1u1", "h2", "h2u2")
+    two_layer = True
+
+    def __init__(self, parameters: TwoLayerParameters | dict | None = None, *,
+                 bc: tuple[str, str] = ("wall", "open"), **kwargs: Any):
+        """
+        Args:
+            parameters: a :class:`TwoLayerParameters` or a dict of its fields.
+            bc: boundary at (left, right): 'wall' (reflective) or 'open' (transmissive).
+            **kwargs: individual parameters overriding ``parameters``.
+        """
+        super().__init__(bc)
+        if parameters is None:
+            parameters = {}
+        if isinstance(parameters, TwoLayerParameters):
+            parameters = parameters.to_dict()
+        self.parameters = TwoLayerParameters.from_dict({**parameters, **kwargs})
+
+    def parameter_array(self) -> np.ndarray:
+        return self.parameters.to_array()
+
+    def __repr__(self) -> str:
+        return f"TwoLayerGranular({self.parameters}, bc={self.bc})"

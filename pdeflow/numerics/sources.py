@@ -1,0 +1,152 @@
+r"""Source terms (26)-(27): mass exchange with closure (25), and implicit friction (32).
+
+All quantities are kinematic (divided by rho2, see :mod:`pdeflow.numerics.layout`);
+r = rho1/rho2, g = g_z, layer 1 = upper, layer 2 = lower, du = u1 - u2.
+
+Closure (25)
+------------
+Interface shear stresses from the upper side (22) and the lower side (23), with the
+hydrostatic interface pressure -t_zz = rho1 g h1 from (20)-(21):
+
+.. math::  t_1/\rho_2 = \mathrm{sgn}(du)\,[k\, r g h_1 \tan\varphi_{int} + c\, du^2],\qquad
+           t_2/\rho_2 = \mathrm{sgn}(du)\, r g h_1 \tan\varphi_{int},
+
+.. math::  M/\rho_2 = \frac{t_1 - t_2}{\rho_2\, du}
+           = \frac{c\, du^2 - (1-k)\, r g h_1 \tan\varphi_{int}}{\max(|du|, du_{reg})}.
+
+M > 0 erodes the lower layer into the upper one, M < 0 deposits. du_reg = 0 is the
+paper's closure, singular at du = 0 (REFERENCE section 6); du_reg > 0 bounds the rate.
+The *equilibrium depth* at which M vanishes for the current du is
+h1_eq = c du^2 / ((1 - k) r g tan(phi_int)).
+
+Exchange stage (31)
+-------------------
+h1 += dt M/rho1 and h2 -= dt M/rho2, with M limited so that h1 neither crosses h1_eq
+nor goes negative and h2 stays non-negative; an upper layer left thinner than
+``film`` is deposited whole (it could never be resolved). The exchanged mass carries
+the upper layer's velocity u1 in both directions, which is what the momentum sources
+of (27) amount to once t2 is eliminated through (25) (t2 = t1 - M du); this keeps
+rho1 h1 u1 + rho2 h2 u2 conserved even when M is limited.
+
+Implicit friction (32)
+----------------------
+With depths frozen, backward Euler for the momentum sources reads, with masses
+m1 = r h1, m2 = h2 and b = u + dt g_x (after advection and exchange),
+
+.. math::  m_1 (u_1 - b_1) + \Delta t\, F_{12} = 0,\qquad
+           m_2 (u_2 - b_2) - \Delta t\, F_{12} + \Delta t\, F_B = 0,
+
+.. math::  F_{12} \in K\,\mathrm{Sgn}(u_1 - u_2) + C (u_1-u_2)|u_1-u_2|,\qquad
+           F_B \in B\,\mathrm{Sgn}(u_2),
+
+K = k r g h1 tan(phi_int), C = c, B = g (r h1 + h2) tan(phi_B), Sgn set-valued at 0.
+These are the optimality conditions of a strictly convex function of (u1, u2), so the
+solution is unique; it is found in closed form by deciding first whether the lower
+layer sticks (u2 = 0), then whether the layers lock (u1 = u2). A layer therefore stops
+in finite time and stays stopped (no chattering of sgn(du)).
+
+Where the lower layer is absent (h2 <= dry) the bed acts as a lower layer at rest: the
+upper layer feels the interface law (22) against u2 = 0 and deposits onto the bed by
+the same closure. Where the upper layer is absent the lower layer is a single Coulomb
+layer with basal angle phi_B.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+
+@njit(cache=True, inline="always")
+def _sign(x: float) -> float:
+    if x > 0.0:
+        return 1.0
+    if x < 0.0:
+        return -1.0
+    return 0.0
+
+
+@njit(cache=True)
+def coulomb_single(b: float, mu_dt: float) -> float:
+    """Backward-Euler Coulomb step u = b - mu_dt Sgn(u) (set-valued): shrink towards 0.
+
+    ``b`` is the velocity before friction [m/s], ``mu_dt`` = dt g_z tan(phi) [m/s].
+    """
+    if b > mu_dt:
+        return b - mu_dt
+    if b < -mu_dt:
+        return b + mu_dt
+    return 0.0
+
+
+@njit(cache=True)
+def _drag_root(y: float, mass: float, cdt: float) -> float:
+    """Positive x with mass x + cdt x^2 = y (y >= 0), in a cancellation-free form."""
+    if y <= 0.0:
+        return 0.0
+    if cdt <= 0.0:
+        return y / mass
+    return 2.0 * y / (mass + math.sqrt(mass * mass + 4.0 * cdt * y))
+
+
+@njit(cache=True)
+def friction_two_layer(b1, b2, m1, m2, Kdt, Cdt, Bdt):
+    """Solve the coupled implicit friction step for (u1, u2); see module docstring.
+
+    ``b1, b2`` velocities before friction [m/s]; ``m1 = r h1``, ``m2 = h2`` [m];
+    ``Kdt = dt K``, ``Cdt = dt C``, ``Bdt = dt B`` [m^2/s] (C dt in [m]).
+    """
+    # 1) try the lower layer stuck: the upper layer slides over a fixed surface
+    u1 = _sign(b1) * _drag_root(m1 * abs(b1) - Kdt, m1, Cdt)
+    push = m2 * b2 + m1 * (b1 - u1)  # force the stuck lower layer must resist, x dt
+    if abs(push) <= Bdt:
+        return u1, 0.0
+    s2 = _sign(push)
+    # 2) lower layer slides in direction s2: total momentum after basal friction
+    mt = m1 + m2
+    p = m1 * b1 + m2 * b2 - Bdt * s2
+    mu = m1 * m2 / mt
+    rel = m1 * (b1 - p / mt)  # = mu (b1 - u_mean) : drive of the relative velocity
+    d = _sign(rel) * _drag_root(abs(rel) - Kdt, mu, Cdt)
+    u2 = (p - m1 * d) / mt
+    if u2 * s2 < 0.0:  # round-off at the stick/slip boundary
+        u2 = 0.0
+    return u2 + d, u2
+
+
+@njit(cache=True)
+def closure_rate(h1: float, du: float, r: float, g: float, tan_int: float, k: float,
+                 c: float, du_reg: float) -> float:
+    """Kinematic mass flux M/rho2 [m/s] of closure (25); -inf at du = 0 if du_reg = 0."""
+    num = c * du * du - (1.0 - k) * r * g * h1 * tan_int
+    den = max(abs(du), du_reg)
+    if den > 0.0:
+        return num / den
+    if num < 0.0:
+        return -math.inf
+    return 0.0
+
+
+@njit(cache=True)
+def exchange_depth(h1: float, h2: float, du: float, dt: float, r: float, g: float,
+                   tan_int: float, k: float, c: float, du_reg: float,
+                   film: float) -> float:
+    """Change of the upper-layer depth [m] in the limited exchange stage (31).
+
+    Negative values deposit upper-layer material into the lower layer (whose depth
+    changes by -r times the returned value).
+    """
+    if h1 <= 0.0:
+        return 0.0
+    rate = closure_rate(h1, du, r, g, tan_int, k, c, du_reg)
+    denom = (1.0 - k) * r * g * tan_int
+    h1_eq = c * du * du / denom if denom > 0.0 else math.inf
+    if rate < 0.0:
+        dh1 = max(rate * dt / r, -(h1 - min(h1_eq, h1)))
+        if h1 + dh1 < film:
+            dh1 = -h1
+        return dh1
+    if rate > 0.0:
+        return max(min(rate * dt / r, h1_eq - h1, h2 / r), 0.0)
+    return 0.0

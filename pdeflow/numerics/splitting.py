@@ -1,0 +1,299 @@
+r"""The paper's operator-split scheme: source stages (30)-(34) and the CFL stepping loop.
+
+One step of length dt (Lie splitting, as in the paper):
+
+1. advection (29): q <- q + dt L_HLL(q), dt = CFL dx / max|S| over the faces;
+2. exchange (31): limited closure (25), see :func:`pdeflow.numerics.sources.exchange_depth`;
+3. implicit momentum sources (32): gravity along the bed, Voellmy interface stress,
+   Coulomb basal friction, solved for both layers together;
+4. hyperbolicity (33)-(34): where the inner eigenvalues are complex, stage 3 is
+   repeated with the smallest extra exchange F_extra that restores hyperbolicity.
+
+Stages 2-4 form :func:`source_stage_two_layer`, which is also what the PDE's post-step
+hook runs; with dt = 0 it only cleans up (non-negative depths, zero velocity in dry
+cells), which is what a method-of-lines solver needs. :func:`advance_two_layer` is
+the stepping loop of the ``fv-split`` solver: compiled once and cached on disk, with
+all parameters passed as arrays, so that sweeps never recompile.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from . import layout as L
+from .advection import rate_single, rate_two_layer
+from .hll import velocity
+from .hyperbolicity import is_hyperbolic
+from .sources import _drag_root, coulomb_single, exchange_depth, friction_two_layer
+
+STATUS_END = 0  #: reached t_end
+STATUS_REST = 1  #: everything at rest: nothing will change any more
+STATUS_FAIL = 2  #: non-finite or negative state: the step was undone
+
+
+@njit(cache=True)
+def _friction(b1, b2, h1, h2, dt, P, f):
+    """Implicit stage (32) for one cell with extra exchange ``f`` = F_extra/rho2."""
+    r = P[L.R]
+    g = P[L.G_Z]
+    dry = P[L.DRY]
+    wet1 = h1 > dry
+    wet2 = h2 > dry
+    if wet1 and wet2:
+        m1 = r * h1
+        b1 = b1 - dt * f / m1
+        b2 = b2 + dt * f / h2
+        kdt = dt * P[L.K] * r * g * h1 * P[L.TAN_INT]
+        bdt = dt * g * (r * h1 + h2) * P[L.TAN_B]
+        return friction_two_layer(b1, b2, m1, h2, kdt, dt * P[L.C], bdt)
+    if wet1:
+        # no lower layer: the upper layer rubs on the bed with the interface law (22)
+        m1 = r * h1
+        kdt = dt * P[L.K] * r * g * h1 * P[L.TAN_INT]
+        u1 = _drag_root(m1 * abs(b1) - kdt, m1, dt * P[L.C])
+        return (u1 if b1 > 0.0 else -u1), 0.0
+    if wet2:
+        mu_dt = dt * g * P[L.TAN_B] * (h2 + r * max(h1, 0.0)) / h2
+        return 0.0, coulomb_single(b2, mu_dt)
+    return 0.0, 0.0
+
+
+@njit(cache=True)
+def _restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P):
+    """Smallest F_extra/rho2 [m^2/s^2] making the post-friction state hyperbolic."""
+    g = P[L.G_Z]
+    r = P[L.R]
+    mode = int(P[L.HYPERBOLICITY])
+    w = P[L.W]
+    du0 = u1 - u2
+    # Bracket: f_lo leaves du of the original sign and non-hyperbolic; f_hi makes the
+    # state hyperbolic or flips the sign of du (du(f) decreases monotonically in f, so
+    # the smallest hyperbolic f lies before the sign change).
+    f_hi = du0 / (dt * (1.0 / (r * h1) + 1.0 / h2))
+    f_lo = 0.0
+    for _ in range(60):
+        v1, v2 = _friction(b1, b2, h1, h2, dt, P, f_hi)
+        if (v1 - v2) * du0 <= 0.0 or is_hyperbolic(h1, h2, v1, v2, g, r, mode):
+            break
+        f_lo = f_hi
+        f_hi *= 2.0
+    sgn = 1.0 if du0 > 0.0 else -1.0
+    v1, v2 = _friction(b1, b2, h1, h2, dt, P, f_lo)
+    du_lo = sgn * (v1 - v2)
+    for _ in range(60):
+        v1, v2 = _friction(b1, b2, h1, h2, dt, P, f_hi)
+        if du_lo - sgn * (v1 - v2) <= w or abs(f_hi - f_lo) <= 1e-12 * abs(f_hi):
+            break
+        f_mid = 0.5 * (f_lo + f_hi)
+        v1, v2 = _friction(b1, b2, h1, h2, dt, P, f_mid)
+        if (v1 - v2) * du0 <= 0.0 or is_hyperbolic(h1, h2, v1, v2, g, r, mode):
+            f_hi = f_mid
+        else:
+            f_lo = f_mid
+            du_lo = sgn * (v1 - v2)
+    return f_hi
+
+
+@njit(cache=True)
+def source_stage_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
+                           diag: np.ndarray) -> None:
+    """Stages (31)-(34) on the two-layer state ``q`` in place, for a step ``dt`` [s].
+
+    ``t`` is the time at the end of the step [s]; ``diag`` receives the bookkeeping
+    listed in :mod:`pdeflow.numerics.layout` and, from index N_DIAG on, F_extra/rho1
+    per cell [m^2/s^2].
+    """
+    n = q.shape[1]
+    r = P[L.R]
+    g = P[L.G_Z]
+    gx = P[L.G_X]
+    dry = P[L.DRY]
+    slow_u = P[L.SLOW_U]
+    slow_h = P[L.SLOW_H]
+    mode = int(P[L.HYPERBOLICITY])
+    moving1 = False
+    moving2 = False
+    fast1 = False
+    fast2 = False
+    changed = False
+    fex = diag[L.N_DIAG:]
+    for i in range(n):
+        h1 = q[0, i]
+        m1 = q[1, i]
+        h2 = q[2, i]
+        m2 = q[3, i]
+        if fex[i] != 0.0:
+            fex[i] = 0.0
+        if h1 <= 0.0 and h2 <= 0.0 and m1 == 0.0 and m2 == 0.0:
+            continue
+        h1 = max(h1, 0.0)
+        h2 = max(h2, 0.0)
+        u1 = velocity(h1, m1, dry)
+        u2 = velocity(h2, m2, dry)
+        if dt > 0.0:
+            # --- (31) mass exchange, carrying the upper layer's velocity -----------------
+            if h1 > 0.0:
+                dh1 = exchange_depth(h1, h2, u1 - u2, dt, r, g, P[L.TAN_INT], P[L.K],
+                                     P[L.C], P[L.DU_REG], P[L.FILM])
+                if dh1 != 0.0:
+                    mom = h2 * u2 + r * h1 * u1  # rho-weighted momentum / rho2
+                    h1 = h1 + dh1
+                    h2 = max(h2 - r * dh1, 0.0)
+                    if h1 <= dry:
+                        h1 = h1 if h1 > 0.0 else 0.0
+                        u1 = 0.0
+                    # lower layer takes the rest of the (rho-weighted) momentum
+                    if h2 > dry:
+                        u2 = (mom - r * h1 * u1) / h2
+                    else:
+                        u2 = 0.0
+                        if h1 > dry:
+                            u1 = mom / (r * h1)
+                    changed = True
+                    if dh1 < 0.0:
+                        diag[L.D_DEPOSITED] -= dh1
+                    else:
+                        diag[L.D_ERODED] += dh1
+            # --- (32) implicit momentum sources ------------------------------------------
+            b1 = u1 + dt * gx if h1 > dry else 0.0
+            b2 = u2 + dt * gx if h2 > dry else 0.0
+            v1, v2 = _friction(b1, b2, h1, h2, dt, P, 0.0)
+            # --- (33)-(34) hyperbolicity --------------------------------------------------
+            if mode > 0 and h1 > dry and h2 > dry:
+                if not is_hyperbolic(h1, h2, v1, v2, g, r, mode):
+                    f = _restore_hyperbolicity(b1, b2, h1, h2, v1, v2, dt, P)
+                    v1, v2 = _friction(b1, b2, h1, h2, dt, P, f)
+                    fex[i] = abs(f) / r
+                    diag[L.D_HYP_EVENTS] += 1.0
+                    if fex[i] > diag[L.D_FEXTRA_MAX]:
+                        diag[L.D_FEXTRA_MAX] = fex[i]
+                        diag[L.D_FEXTRA_CELL] = i
+                        diag[L.D_FEXTRA_TIME] = t
+            u1 = v1
+            u2 = v2
+        m1 = h1 * u1 if h1 > dry else 0.0
+        m2 = h2 * u2 if h2 > dry else 0.0
+        if m1 != 0.0:
+            moving1 = True
+            if h1 > slow_h and abs(u1) >= slow_u:
+                fast1 = True
+        if m2 != 0.0:
+            moving2 = True
+            if h2 > slow_h and abs(u2) >= slow_u:
+                fast2 = True
+        q[0, i] = h1
+        q[1, i] = m1
+        q[2, i] = h2
+        q[3, i] = m2
+    if moving1:
+        diag[L.D_MOVE_UPPER] = t
+    if moving2:
+        diag[L.D_MOVE_LOWER] = t
+    if fast1:
+        diag[L.D_FAST_UPPER] = t
+    if fast2:
+        diag[L.D_FAST_LOWER] = t
+    diag[L.D_CHANGED] = 1.0 if (changed or moving1 or moving2) else 0.0
+    diag[L.D_T] = t
+    diag[L.D_STEPS] += 1.0
+
+
+@njit(cache=True)
+def source_stage_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
+                        diag: np.ndarray) -> None:
+    """Implicit Coulomb friction (and gravity along the bed) for the single layer."""
+    n = q.shape[1]
+    g = P[L.S_G_Z]
+    gx = P[L.S_G_X]
+    dry = P[L.S_DRY]
+    mu_dt = dt * g * P[L.S_TAN_B]
+    moving = False
+    fast = False
+    for i in range(n):
+        h = q[0, i]
+        m = q[1, i]
+        if h <= 0.0 and m == 0.0:
+            continue
+        h = max(h, 0.0)
+        u = velocity(h, m, dry)
+        if dt > 0.0 and h > dry:
+            u = coulomb_single(u + dt * gx, mu_dt)
+        m = h * u if h > dry else 0.0
+        if m != 0.0:
+            moving = True
+            if h > P[L.S_SLOW_H] and abs(u) >= P[L.S_SLOW_U]:
+                fast = True
+        q[0, i] = h
+        q[1, i] = m
+    if moving:
+        diag[L.D_MOVE_UPPER] = t
+    if fast:
+        diag[L.D_FAST_UPPER] = t
+    diag[L.D_CHANGED] = 1.0 if moving else 0.0
+    diag[L.D_T] = t
+    diag[L.D_STEPS] += 1.0
+
+
+@njit(cache=True)
+def _advect(q, rate, dt, n_fields):
+    """q += dt * rate; returns (max |mass rate|, all finite and non-negative)."""
+    n = q.shape[1]
+    mass_rate = 0.0
+    ok = True
+    for i in range(n):
+        for k in range(n_fields):
+            v = q[k, i] + dt * rate[k, i]
+            if k % 2 == 0:
+                mass_rate = max(mass_rate, abs(rate[k, i]))
+                if v < 0.0:
+                    # round-off below zero is clipped by the source stage; more is a failure
+                    if v < -1e-12 * (1.0 + abs(q[k, i])):
+                        ok = False
+            if not math.isfinite(v):
+                ok = False
+            q[k, i] = v
+    return mass_rate, ok
+
+
+@njit(cache=True)
+def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int,
+                  bc_right: int, P: np.ndarray, cfl: float, diag: np.ndarray,
+                  rate: np.ndarray, backup: np.ndarray, max_steps: int,
+                  two_layer: bool, stop_at_rest: bool):
+    """Advance ``q`` from ``t`` to ``t_end`` with the CFL-limited splitting scheme.
+
+    Returns ``(t, steps, status)`` with status :data:`STATUS_END`, :data:`STATUS_REST`
+    (everything at rest and unchanged: the solution is stationary from ``t`` on), or
+    :data:`STATUS_FAIL` (the last step produced a non-finite or negative state and was
+    undone; ``q`` holds the last good state).
+    """
+    steps = 0
+    n_fields = q.shape[0]
+    while t < t_end and steps < max_steps:
+        backup[:, :] = q
+        if two_layer:
+            smax = rate_two_layer(q, rate, dx, bc_left, bc_right, P[L.G_Z], P[L.R],
+                                  P[L.DRY])
+        else:
+            smax = rate_single(q, rate, dx, bc_left, bc_right, P[L.S_G_Z], P[L.S_DRY])
+        dt = t_end - t
+        if smax > 0.0:
+            dt = min(dt, cfl * dx / smax)
+        mass_rate, ok = _advect(q, rate, dt, n_fields)
+        if not ok:
+            q[:, :] = backup
+            return t, steps, STATUS_FAIL
+        t_new = t + dt if dt < t_end - t else t_end
+        diag[L.D_DT] = dt
+        if two_layer:
+            source_stage_two_layer(q, dt, t_new, P, diag)
+        else:
+            source_stage_single(q, dt, t_new, P, diag)
+        t = t_new
+        steps += 1
+        if stop_at_rest and mass_rate == 0.0 and diag[L.D_CHANGED] == 0.0:
+            return t, steps, STATUS_REST
+    return t, steps, STATUS_END

@@ -1,0 +1,86 @@
+"""Case files, validation messages, and the command line."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pdeflow.cases import CaseError, load_case
+from pdeflow.cli import main
+
+ROOT = Path(__file__).parents[1]
+CASE = ROOT / "cases" / "paper_5_1_dam_break.toml"
+
+
+@pytest.mark.parametrize("override, words", [
+    ("two_layer.density_ratio=1.5", ["density_ratio", "(0, 1)"]),
+    ("two_layer.k=1.0", ["k", "[0, 1)"]),
+    ("two_layer.phi_int_deg=95", ["phi_int_deg", "(0, 90)"]),
+    ("numerics.cfl=1.5", ["cfl", "(0, 1]"]),
+    ("grid.dx=-0.1", ["grid.dx"]),
+    ("grid.length=0", ["grid.length"]),
+    ("two_layer.bogus=1", ["bogus", "two-layer"]),
+    ("grid.colour=1", ["grid.colour", "allowed"]),
+    ("case.t_end='long'", ["case.t_end", "float"]),
+    ("initial.H0=-2", ["initial.H0"]),
+])
+def test_bad_values_are_rejected_with_their_name(override, words):
+    with pytest.raises(CaseError) as err:
+        load_case(CASE, [override])
+    msg = str(err.value)
+    assert str(CASE) in msg or CASE.name in msg
+    for w in words:
+        assert w in msg
+
+
+def test_case_files_are_data_not_code(tmp_path):
+    p = tmp_path / "evil.toml"
+    p.write_text('[case]\nname = "__import__(\'os\').system(\'echo hi\')"\n'
+                 '[initial]\nshape = "column"\nL0 = 1\nH0 = 1\n')
+    case = load_case(p)
+    assert case.name.startswith("__import__")  # a plain string, never evaluated
+
+
+def test_initial_profile_from_npz(tmp_path):
+    n = 20
+    np.savez(tmp_path / "init.npz", h1=np.full(n, 0.1), u1=np.zeros(n),
+             h2=np.full(n, 0.2), u2=np.zeros(n))
+    p = tmp_path / "c.toml"
+    p.write_text('[grid]\nlength = 1.0\ncells = 20\n[initial]\nshape = "file"\n'
+                 'path = "init.npz"\n')
+    eq, state = load_case(p).make_state("two_layer")
+    assert np.allclose(state.data[2], 0.2)
+    np.savez(tmp_path / "init.npz", h1=np.full(n + 1, 0.1), u1=np.zeros(n),
+             h2=np.full(n, 0.2), u2=np.zeros(n))
+    with pytest.raises(CaseError, match="shape"):
+        load_case(p).make_state("two_layer")
+
+
+def test_cli_run_writes_summary_final_and_plot(tmp_path, capsys):
+    out = tmp_path / "s.json"
+    fin = tmp_path / "f.npz"
+    png = tmp_path / "p.png"
+    rc = main(["run", str(CASE), "--set", "grid.dx=0.1", "--summary", str(out),
+               "--final", str(fin), "--plot", str(png)])
+    assert rc == 0
+    data = json.loads(out.read_text())
+    two = data["models"]["two_layer"]
+    for key in ("stop_time", "lower_stop_time", "upper_stop_time", "front_position",
+                "runout", "max_fextra_over_rho1", "mass_relative_error", "steps",
+                "wall_time_s"):
+        assert key in two
+    with np.load(fin) as f:
+        assert set(f.files) >= {"x", "h1", "u1", "h2", "u2", "t"}
+    with np.load(fin.with_name("f.single_layer.npz")) as f:
+        assert set(f.files) >= {"x", "h", "u", "t"}
+    assert png.stat().st_size > 1000
+    assert "run-out" in capsys.readouterr().out
+
+
+def test_cli_bad_override_is_a_clean_error(tmp_path, capsys):
+    rc = main(["run", str(CASE), "--set", "two_layer.k=2", "--summary",
+               str(tmp_path / "s.json")])
+    assert rc == 2
+    assert "k must lie in" in capsys.readouterr().err
+    assert not (tmp_path / "s.json").exists()
