@@ -71,7 +71,7 @@ def deposit_figure(x: np.ndarray, two: np.ndarray | None, single: np.ndarray | N
     ax.legend(loc="upper right", fontsize=8)
     ax.set_xlabel("x [m]")
     ax.grid(alpha=0.3)
-    ax.set_title(f"{title} final deposits {times}".strip())
+    ax.set_title(f"{title}: final deposits\n{times}".strip(), fontsize=10)
     fig.tight_layout()
     return fig
 

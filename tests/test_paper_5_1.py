@@ -20,7 +20,11 @@ def test_both_layers_come_to_rest_upper_after_lower(runs):
     s = runs["two_layer"].summary
     assert s["at_rest"]
     assert s["lower_stop_time"] is not None and s["upper_stop_time"] is not None
-    assert s["lower_stop_time"] < s["upper_stop_time"] < 1.5  # paper: just before 1.5 s
+    # paper: lower layer at rest at about 0.7 s, upper layer just before 1.5 s
+    assert 0.6 < s["lower_stop_time"] < 0.9
+    assert 1.2 < s["upper_stop_time"] < 1.5
+    # the practical definition (|u| < 1 cm/s where h > 1 mm) agrees within 0.1 s here
+    assert abs(s["upper_slow_time"] - s["upper_stop_time"]) < 0.1
 
 
 def test_two_layer_runout_clearly_shorter(runs):

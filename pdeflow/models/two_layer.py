@@ -46,11 +46,11 @@ class TwoLayerParameters:
     """rho1/rho2 in (0, 1): the paper's value for dense-collisional flows [-]"""
     phi_int_deg: float = 30.0
     """internal friction angle at the interface [deg] (paper: 30)"""
-    phi_b_deg: float = 30.0
+    phi_b_deg: float = 41.0
     """basal friction angle of the lower layer [deg] (calibrated)"""
-    k: float = 0.8
+    k: float = 0.65
     """friction reduction on the upper side of the interface, eq. (17), in [0, 1) (calibrated)"""
-    c: float = 0.01
+    c: float = 0.03
     """collisional (Voellmy) coefficient of eq. (17) [-] (calibrated)"""
     w: float = 1e-3
     """threshold of criterion (34) on lambda3 - lambda2 [m/s]"""

@@ -23,7 +23,8 @@ Exchange stage (31)
 -------------------
 h1 += dt M/rho1 and h2 -= dt M/rho2, with M limited so that h1 neither crosses h1_eq
 nor goes negative and h2 stays non-negative; an upper layer left thinner than
-``film`` is deposited whole (it could never be resolved). The exchanged mass carries
+``film`` is deposited whole, in erosion as in deposition (a film of a few grains is no
+flowing layer, and left alone it can sit at h1_eq and creep for ever). The exchanged mass carries
 the upper layer's velocity u1 in both directions, which is what the momentum sources
 of (27) amount to once t2 is eliminated through (25) (t2 = t1 - M du); this keeps
 rho1 h1 u1 + rho2 h2 u2 conserved even when M is limited.
@@ -142,11 +143,13 @@ def exchange_depth(h1: float, h2: float, du: float, dt: float, r: float, g: floa
     rate = closure_rate(h1, du, r, g, tan_int, k, c, du_reg)
     denom = (1.0 - k) * r * g * tan_int
     h1_eq = c * du * du / denom if denom > 0.0 else math.inf
+    dh1 = 0.0
     if rate < 0.0:
         dh1 = max(rate * dt / r, -(h1 - min(h1_eq, h1)))
-        if h1 + dh1 < film:
-            dh1 = -h1
-        return dh1
-    if rate > 0.0:
-        return max(min(rate * dt / r, h1_eq - h1, h2 / r), 0.0)
-    return 0.0
+    elif rate > 0.0:
+        dh1 = max(min(rate * dt / r, h1_eq - h1, h2 / r), 0.0)
+    if h1 + dh1 < film:
+        # a film thinner than a few grains is no flowing layer: deposit it whole,
+        # whatever the closure says (otherwise it can sit at h1_eq and creep forever)
+        dh1 = -h1
+    return dh1
