@@ -8,7 +8,9 @@ names the key and the file. Sections (all optional except ``[initial]``)::
     [grid]        length [m], dx [m] (or cells), x_start [m]
     [boundaries]  left, right = "wall" | "open"
     [initial]     shape = "column" | "dam_break" | "heap" | "file" and its keys
-    [numerics]    solver = "fv-split" | any py-pde solver name, cfl, dt (py-pde solvers)
+    [numerics]    solver = "fv-split" | any py-pde solver name, cfl, dt (py-pde solvers),
+                  flux = "hll" | "rusanov" | "ifcp", reconstruction = "first-order" |
+                  "muscl", limiter = "minmod" | "mc", splitting = "lie" | "strang"
     [two_layer]   any field of TwoLayerParameters
     [single_layer] any field of SingleLayerParameters
     [output]      snapshot_times [s], front_threshold [m]
@@ -58,7 +60,9 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
                 "h_left": (float, int), "h_right": (float, int),
                 "upper_fraction": (float, int), "center": (float, int),
                 "height": (float, int), "slope_deg": (float, int), "path": (str,)},
-    "numerics": {"solver": (str,), "cfl": (float, int), "dt": (float, int)},
+    "numerics": {"solver": (str,), "cfl": (float, int), "dt": (float, int),
+                 "flux": (str,), "reconstruction": (str,), "limiter": (str,),
+                 "splitting": (str,)},
     "two_layer": {},  # checked by TwoLayerParameters
     "single_layer": {},  # checked by SingleLayerParameters
     "output": {"snapshot_times": (list,), "front_threshold": (float, int)},
@@ -170,6 +174,11 @@ class Case:
                 raise self._err(f"boundaries.{side} must be 'wall' or 'open', got {bc!r}")
         if "initial" not in self.data or "shape" not in self.data["initial"]:
             raise self._err("[initial] with a 'shape' is required")
+        if self.splitting not in ("lie", "strang"):
+            raise self._err(f"numerics.splitting must be 'lie' or 'strang', got "
+                            f"{self.splitting!r}")
+        for model in MODEL_NAMES:
+            self.make_pde(model)  # checks flux, reconstruction, limiter by name
         if self.initial["shape"] not in SHAPES:
             raise self._err(f"initial.shape must be one of {list(SHAPES)}, got "
                             f"{self.initial['shape']!r}")
@@ -280,9 +289,20 @@ class Case:
     def make_pde(self, model: str):
         from .models import SingleLayerGranular, TwoLayerGranular
 
-        if model == "two_layer":
-            return TwoLayerGranular(self.data.get("two_layer", {}), bc=self.bc)
-        return SingleLayerGranular(self.data.get("single_layer", {}), bc=self.bc)
+        num = self.data.get("numerics", {})
+        scheme = {k: num[k] for k in ("flux", "reconstruction", "limiter") if k in num}
+        try:
+            if model == "two_layer":
+                return TwoLayerGranular(self.data.get("two_layer", {}), bc=self.bc,
+                                        **scheme)
+            return SingleLayerGranular(self.data.get("single_layer", {}), bc=self.bc,
+                                       **scheme)
+        except ValueError as err:
+            raise self._err(f"[numerics] {err}") from None
+
+    @property
+    def splitting(self) -> str:
+        return self._get("numerics", "splitting", "lie")
 
     def initial_profiles(self, model: str, grid=None) -> dict[str, np.ndarray]:
         """Depth and velocity profiles of the initial state for ``model``."""

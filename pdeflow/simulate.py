@@ -71,7 +71,7 @@ def run_model(case: Case, model: str, *, tracker: Any = None,
     solver = case.solver
     kwargs: dict[str, Any] = {}
     if solver == "fv-split":
-        kwargs = {"cfl": case.cfl, "backend": backend}
+        kwargs = {"cfl": case.cfl, "backend": backend, "splitting": case.splitting}
     else:
         kwargs = {"dt": float(case.data.get("numerics", {}).get("dt", 1e-4))}
     wall0 = time.perf_counter()

@@ -14,15 +14,15 @@ def grid(n: int = 100, lo: float = 0.0, hi: float = 1.0) -> CartesianGrid:
 
 
 def step(eq, state, t_end: float, cfl: float = 0.3, stop_at_rest: bool = False,
-         max_steps: int = 10**7):
+         max_steps: int = 10**7, strang: bool = False):
     """Run the compiled fv-split loop directly; returns (q, t, steps, status, diag)."""
     q = state.data.copy()
     diag = eq.new_diagnostics(q.shape[1])
     dx = float(state.grid.discretization[0])
     t, steps, status = advance_split(q, 0.0, t_end, dx, *eq.bc_codes,
                                      eq.parameter_array(), cfl, diag, np.empty_like(q),
-                                     np.empty_like(q), max_steps, eq.two_layer,
-                                     stop_at_rest)
+                                     np.empty_like(q), np.empty((3, *q.shape)), max_steps,
+                                     eq.two_layer, stop_at_rest, *eq.scheme_codes, strang)
     return q, t, steps, status, diag
 
 

@@ -24,6 +24,7 @@ from pde.pdes.base import PDEBase
 from ..numerics import layout as L
 
 BC_NAMES = {"wall": L.BC_WALL, "open": L.BC_OPEN}
+RECONSTRUCTIONS = {"first-order": 1, "muscl": 2}
 
 
 def check_range(name: str, value: Any, low: float, high: float, *,
@@ -52,13 +53,45 @@ class GranularPDE(PDEBase):
     field_names: tuple[str, ...] = ()
     two_layer: bool = False
 
-    def __init__(self, bc: Sequence[str] = ("wall", "open")):
+    def __init__(self, bc: Sequence[str] = ("wall", "open"), *, flux: str = "hll",
+                 reconstruction: str = "first-order", limiter: str = "minmod"):
+        """
+        Args:
+            bc: boundary at (left, right): 'wall' (reflective) or 'open' (transmissive).
+            flux: interface flux: 'hll' (the paper's), 'rusanov', or 'ifcp' (sharper;
+                Roe's scheme for one layer).
+            reconstruction: 'first-order' (the paper's) or 'muscl' (second order in
+                space; the fv-split solver then advects with SSP-RK2).
+            limiter: slope limiter of 'muscl': 'minmod' or 'mc' (monotonised central).
+        """
         super().__init__()
         if isinstance(bc, str) or len(bc) != 2 or any(b not in BC_NAMES for b in bc):
             raise ValueError(
                 f"bc must be a pair of 'wall' or 'open' (left, right), got {bc!r}")
+        if flux not in L.FLUXES:
+            raise ValueError(f"flux must be one of {list(L.FLUXES)}, got {flux!r}")
+        if reconstruction not in RECONSTRUCTIONS:
+            raise ValueError(f"reconstruction must be one of {list(RECONSTRUCTIONS)}, "
+                             f"got {reconstruction!r}")
+        if limiter not in L.LIMITERS:
+            raise ValueError(f"limiter must be one of {list(L.LIMITERS)}, got {limiter!r}")
         self.bc = tuple(bc)
         self.bc_codes = (BC_NAMES[bc[0]], BC_NAMES[bc[1]])
+        self.flux = flux
+        self.reconstruction = reconstruction
+        self.limiter = limiter
+
+    @property
+    def scheme_codes(self) -> tuple[int, int, int]:
+        """(flux, order, limiter) codes for the kernels."""
+        return (L.FLUXES[self.flux], RECONSTRUCTIONS[self.reconstruction],
+                L.LIMITERS[self.limiter])
+
+    @property
+    def variant(self) -> str:
+        """Short name of the spatial discretisation, e.g. 'hll/first-order'."""
+        v = f"{self.flux}/{self.reconstruction}"
+        return v + (f"/{self.limiter}" if self.reconstruction == "muscl" else "")
 
     # --- parameters -----------------------------------------------------------------------
     def parameter_array(self) -> np.ndarray:
@@ -114,6 +147,7 @@ class GranularPDE(PDEBase):
         """Method-of-lines rate: HLL flux divergence (29) plus sources (26)-(27)."""
         from ..numerics.vectorized import advection_rate, source_rate
 
+        self._require_numpy_variant()
         dx = self.check_grid(state.grid)
         P = self.parameter_array()
         q = state.data
@@ -123,6 +157,12 @@ class GranularPDE(PDEBase):
         out = state.copy()
         out.data[...] = rate
         return out
+
+    def _require_numpy_variant(self) -> None:
+        if self.flux != "hll" or self.reconstruction != "first-order":
+            raise NotImplementedError(
+                f"the numpy backend implements hll/first-order only, not {self.variant}; "
+                "use the numba backend")
 
     def _dry(self, P: np.ndarray) -> float:
         return float(P[L.DRY] if self.two_layer else P[L.S_DRY])
@@ -142,13 +182,17 @@ class GranularPDE(PDEBase):
         bcl, bcr = self.bc_codes
         g = P[L.G_Z]
         dry = self._dry(P)
+        flux, order, limiter = self.scheme_codes
+        shape = (2, *state.data.shape)  # closure arrays are read-only in numba
         if self.two_layer:
             r = P[L.R]
 
             @njit
             def rate(state_data, t):  # pragma: no cover - compiled
                 out = np.empty_like(state_data)
-                rate_two_layer(state_data, out, dx, bcl, bcr, g, r, dry)
+                work = np.empty(shape)
+                rate_two_layer(state_data, out, work, dx, bcl, bcr, g, r, dry, flux,
+                               order, limiter)
                 source_rate_two_layer(state_data, out, P)
                 return out
         else:
@@ -156,7 +200,9 @@ class GranularPDE(PDEBase):
             @njit
             def rate(state_data, t):  # pragma: no cover - compiled
                 out = np.empty_like(state_data)
-                rate_single(state_data, out, dx, bcl, bcr, g, dry)
+                work = np.empty(shape)
+                rate_single(state_data, out, work, dx, bcl, bcr, g, dry, flux, order,
+                            limiter)
                 source_rate_single(state_data, out, P)
                 return out
 

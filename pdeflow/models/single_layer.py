@@ -94,8 +94,10 @@ class SingleLayerGranular(GranularPDE):
     two_layer = False
 
     def __init__(self, parameters: SingleLayerParameters | dict | None = None, *,
-                 bc: tuple[str, str] = ("wall", "open"), **kwargs: Any):
-        super().__init__(bc)
+                 bc: tuple[str, str] = ("wall", "open"), flux: str = "hll",
+                 reconstruction: str = "first-order", limiter: str = "minmod",
+                 **kwargs: Any):
+        super().__init__(bc, flux=flux, reconstruction=reconstruction, limiter=limiter)
         if parameters is None:
             parameters = {}
         if isinstance(parameters, SingleLayerParameters):
@@ -106,4 +108,4 @@ class SingleLayerGranular(GranularPDE):
         return self.parameters.to_array()
 
     def __repr__(self) -> str:
-        return f"SingleLayerGranular({self.parameters}, bc={self.bc})"
+        return f"SingleLayerGranular({self.parameters}, bc={self.bc}, {self.variant})"

@@ -144,14 +144,17 @@ class TwoLayerGranular(GranularPDE):
     two_layer = True
 
     def __init__(self, parameters: TwoLayerParameters | dict | None = None, *,
-                 bc: tuple[str, str] = ("wall", "open"), **kwargs: Any):
+                 bc: tuple[str, str] = ("wall", "open"), flux: str = "hll",
+                 reconstruction: str = "first-order", limiter: str = "minmod",
+                 **kwargs: Any):
         """
         Args:
             parameters: a :class:`TwoLayerParameters` or a dict of its fields.
             bc: boundary at (left, right): 'wall' (reflective) or 'open' (transmissive).
+            flux, reconstruction, limiter: the spatial scheme (see GranularPDE).
             **kwargs: individual parameters overriding ``parameters``.
         """
-        super().__init__(bc)
+        super().__init__(bc, flux=flux, reconstruction=reconstruction, limiter=limiter)
         if parameters is None:
             parameters = {}
         if isinstance(parameters, TwoLayerParameters):
@@ -162,4 +165,4 @@ class TwoLayerGranular(GranularPDE):
         return self.parameters.to_array()
 
     def __repr__(self) -> str:
-        return f"TwoLayerGranular({self.parameters}, bc={self.bc})"
+        return f"TwoLayerGranular({self.parameters}, bc={self.bc}, {self.variant})"

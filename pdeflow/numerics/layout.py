@@ -58,3 +58,12 @@ N_DIAG = 16  #: the per-cell F_extra/rho1 of the last step follows at N_DIAG
 # --- boundary conditions ---------------------------------------------------------------
 BC_WALL = 0
 BC_OPEN = 1
+
+# --- interface fluxes, reconstructions, limiters, splittings ----------------------------
+FLUX_HLL = 0
+FLUX_RUSANOV = 1
+FLUX_IFCP = 2
+FLUXES = {"hll": FLUX_HLL, "rusanov": FLUX_RUSANOV, "ifcp": FLUX_IFCP}
+LIMITER_MINMOD = 0
+LIMITER_MC = 1
+LIMITERS = {"minmod": LIMITER_MINMOD, "mc": LIMITER_MC}

@@ -20,8 +20,8 @@ import numpy as np
 from numba import njit
 
 from . import layout as L
-from .hll import velocity
 from .sources import closure_rate
+from .state import velocity
 
 
 @njit(cache=True)

@@ -25,9 +25,9 @@ from numba import njit
 
 from . import layout as L
 from .advection import rate_single, rate_two_layer
-from .hll import velocity
 from .hyperbolicity import is_hyperbolic
 from .sources import _drag_root, coulomb_single, exchange_depth, friction_two_layer
+from .state import velocity
 
 STATUS_END = 0  #: reached t_end
 STATUS_REST = 1  #: everything at rest: nothing will change any more
@@ -238,20 +238,22 @@ def source_stage_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
 
 
 @njit(cache=True)
-def _advect(q, rate, dt, n_fields):
-    """q += dt * rate; returns (max |mass rate|, all finite and non-negative)."""
+def _update(q, base, rate, dt, weight):
+    """q <- weight * base + (1 - weight) * (q + dt * rate); returns (max |mass rate|, ok).
+
+    ``ok`` is False if the result is not finite or a depth is negative beyond round-off
+    (round-off below zero is clipped by the source stage).
+    """
     n = q.shape[1]
     mass_rate = 0.0
     ok = True
-    for i in range(n):
-        for k in range(n_fields):
-            v = q[k, i] + dt * rate[k, i]
+    for k in range(q.shape[0]):
+        for i in range(n):
+            v = weight * base[k, i] + (1.0 - weight) * (q[k, i] + dt * rate[k, i])
             if k % 2 == 0:
                 mass_rate = max(mass_rate, abs(rate[k, i]))
-                if v < 0.0:
-                    # round-off below zero is clipped by the source stage; more is a failure
-                    if v < -1e-12 * (1.0 + abs(q[k, i])):
-                        ok = False
+                if v < -1e-12 * (1.0 + abs(q[k, i])):
+                    ok = False
             if not math.isfinite(v):
                 ok = False
             q[k, i] = v
@@ -259,41 +261,107 @@ def _advect(q, rate, dt, n_fields):
 
 
 @njit(cache=True)
+def _rate(q, rate, work, dx, bc_left, bc_right, P, two_layer, flux, order, limiter):
+    if two_layer:
+        return rate_two_layer(q, rate, work, dx, bc_left, bc_right, P[L.G_Z], P[L.R],
+                              P[L.DRY], flux, order, limiter)
+    return rate_single(q, rate, work, dx, bc_left, bc_right, P[L.S_G_Z], P[L.S_DRY],
+                       flux, order, limiter)
+
+
+@njit(cache=True)
+def _sources(q, dt, t, P, diag, two_layer):
+    if two_layer:
+        source_stage_two_layer(q, dt, t, P, diag)
+    else:
+        source_stage_single(q, dt, t, P, diag)
+
+
+@njit(cache=True)
+def friction_predictor(q: np.ndarray, dt: float, P: np.ndarray, two_layer: bool) -> None:
+    """Zero the momentum of layers that the implicit friction (32) would hold at rest,
+    in place. Applied to the intermediate stage of SSP-RK2: otherwise the predictor's
+    pressure momentum, which friction balances, moves mass and heaps creep. Moving
+    layers are left untouched (friction proper is applied once, in the source stage)."""
+    for i in range(q.shape[1]):
+        if two_layer:
+            dry = P[L.DRY]
+            h1 = max(q[0, i], 0.0)
+            h2 = max(q[2, i], 0.0)
+            if h1 <= dry and h2 <= dry:
+                continue
+            b1 = velocity(h1, q[1, i], dry) + dt * P[L.G_X] if h1 > dry else 0.0
+            b2 = velocity(h2, q[3, i], dry) + dt * P[L.G_X] if h2 > dry else 0.0
+            u1, u2 = _friction(b1, b2, h1, h2, dt, P, 0.0)
+            if u1 == 0.0:
+                q[1, i] = 0.0
+            if u2 == 0.0:
+                q[3, i] = 0.0
+        else:
+            dry = P[L.S_DRY]
+            h = max(q[0, i], 0.0)
+            if h > dry:
+                u = coulomb_single(q[1, i] / h + dt * P[L.S_G_X],
+                                   dt * P[L.S_G_Z] * P[L.S_TAN_B])
+                if u == 0.0:
+                    q[1, i] = 0.0
+
+
+@njit(cache=True)
 def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int,
                   bc_right: int, P: np.ndarray, cfl: float, diag: np.ndarray,
-                  rate: np.ndarray, backup: np.ndarray, max_steps: int,
-                  two_layer: bool, stop_at_rest: bool):
+                  rate: np.ndarray, backup: np.ndarray, work: np.ndarray, max_steps: int,
+                  two_layer: bool, stop_at_rest: bool, flux: int, order: int,
+                  limiter: int, strang: bool):
     """Advance ``q`` from ``t`` to ``t_end`` with the CFL-limited splitting scheme.
 
-    Returns ``(t, steps, status)`` with status :data:`STATUS_END`, :data:`STATUS_REST`
-    (everything at rest and unchanged: the solution is stationary from ``t`` on), or
+    ``rate`` and ``backup`` have the shape of ``q``; ``work`` has shape (3, *q.shape).
+    ``flux`` (layout.FLUX_*), ``order`` (1: first order with forward Euler; 2: MUSCL
+    with the SSP-RK2/Heun integrator, see :func:`friction_predictor`) and ``limiter``
+    (layout.LIMITER_*) choose the advection stage; ``strang`` applies half a source
+    step before and after it (else Lie, as in the paper).
+
+    Returns ``(t, steps, status)``: status :data:`STATUS_END`; :data:`STATUS_REST`
+    (everything at rest and unchanged: stationary from ``t`` on); or
     :data:`STATUS_FAIL` (the last step produced a non-finite or negative state and was
     undone; ``q`` holds the last good state).
     """
     steps = 0
-    n_fields = q.shape[0]
+    rec = work[:2]
+    q0 = work[2]
     while t < t_end and steps < max_steps:
         backup[:, :] = q
-        if two_layer:
-            smax = rate_two_layer(q, rate, dx, bc_left, bc_right, P[L.G_Z], P[L.R],
-                                  P[L.DRY])
-        else:
-            smax = rate_single(q, rate, dx, bc_left, bc_right, P[L.S_G_Z], P[L.S_DRY])
+        smax = _rate(q, rate, rec, dx, bc_left, bc_right, P, two_layer, flux, order,
+                     limiter)
         dt = t_end - t
         if smax > 0.0:
             dt = min(dt, cfl * dx / smax)
-        mass_rate, ok = _advect(q, rate, dt, n_fields)
+        t_new = t + dt if dt < t_end - t else t_end
+        changed = 0.0
+        if strang:
+            diag[L.D_DT] = 0.5 * dt
+            _sources(q, 0.5 * dt, t, P, diag, two_layer)
+            changed = diag[L.D_CHANGED]
+            _rate(q, rate, rec, dx, bc_left, bc_right, P, two_layer, flux, order, limiter)
+        if order == 1:
+            mass_rate, ok = _update(q, q, rate, dt, 0.0)
+        else:
+            q0[:, :] = q
+            mass_rate, ok = _update(q, q0, rate, dt, 0.0)
+            if ok:
+                friction_predictor(q, dt, P, two_layer)
+                _rate(q, rate, rec, dx, bc_left, bc_right, P, two_layer, flux, order,
+                      limiter)
+                mass2, ok = _update(q, q0, rate, dt, 0.5)
+                mass_rate = max(mass_rate, mass2)
         if not ok:
             q[:, :] = backup
             return t, steps, STATUS_FAIL
-        t_new = t + dt if dt < t_end - t else t_end
-        diag[L.D_DT] = dt
-        if two_layer:
-            source_stage_two_layer(q, dt, t_new, P, diag)
-        else:
-            source_stage_single(q, dt, t_new, P, diag)
+        diag[L.D_DT] = 0.5 * dt if strang else dt
+        _sources(q, 0.5 * dt if strang else dt, t_new, P, diag, two_layer)
+        changed = max(changed, diag[L.D_CHANGED])
         t = t_new
         steps += 1
-        if stop_at_rest and mass_rate == 0.0 and diag[L.D_CHANGED] == 0.0:
+        if stop_at_rest and mass_rate == 0.0 and changed == 0.0:
             return t, steps, STATUS_REST
     return t, steps, STATUS_END

@@ -35,13 +35,17 @@ class FVSplitSolver(SolverBase):
     name = "fv-split"
 
     def __init__(self, pde: GranularPDE, *, backend: str = "numba", cfl: float = 0.3,
-                 stop_at_rest: bool = True, max_steps: int = 100_000_000):
+                 splitting: str = "lie", stop_at_rest: bool = True,
+                 max_steps: int = 100_000_000):
         """
         Args:
             pde: a :class:`~pdeflow.models.TwoLayerGranular` or
-                :class:`~pdeflow.models.SingleLayerGranular`.
+                :class:`~pdeflow.models.SingleLayerGranular` (its flux and reconstruction
+                choose the advection stage; MUSCL is advanced with SSP-RK2/Heun).
             backend: 'numba' (compiled loop) or 'numpy' (Python loop, for debugging).
             cfl: Courant number in (0, 1] (paper: 0.3).
+            splitting: 'lie' (advection, then sources: the paper's) or 'strang' (half a
+                source step on each side of the advection step).
             stop_at_rest: end the run once nothing moves or changes any more.
             max_steps: safety limit on the number of steps per call.
         """
@@ -51,6 +55,9 @@ class FVSplitSolver(SolverBase):
             raise ValueError(f"backend must be 'numba' or 'numpy', got {backend!r}")
         super().__init__(pde, backend="numba" if backend == "auto" else backend)
         self.cfl = check_range("cfl", cfl, 0, 1, low_open=True)
+        if splitting not in ("lie", "strang"):
+            raise ValueError(f"splitting must be 'lie' or 'strang', got {splitting!r}")
+        self.splitting = splitting
         self.stop_at_rest = bool(stop_at_rest)
         self.max_steps = int(max_steps)
         self.diagnostics: np.ndarray | None = None
@@ -63,11 +70,15 @@ class FVSplitSolver(SolverBase):
         hook, diag = pde.make_post_step_hook(state, backend=self.backend)
         self.diagnostics = diag
         self.info.update(dt=None, steps=0, dt_adaptive=True, stochastic=False,
-                         cfl=self.cfl, post_step_data=diag, scheme="HLL + Lie splitting")
+                         cfl=self.cfl, post_step_data=diag, variant=pde.variant,
+                         splitting=self.splitting)
         P = pde.parameter_array()
         bcl, bcr = pde.bc_codes
         rate = np.empty_like(state.data)
         backup = np.empty_like(state.data)
+        work = np.empty((3, *state.data.shape))
+        flux, order, limiter = pde.scheme_codes
+        strang = self.splitting == "strang"
         two = pde.two_layer
         cfl = self.cfl
         stop = self.stop_at_rest
@@ -76,7 +87,8 @@ class FVSplitSolver(SolverBase):
 
             def advance(q: np.ndarray, t0: float, t1: float):
                 return advance_split(q, t0, t1, dx, bcl, bcr, P, cfl, diag, rate,
-                                     backup, self.max_steps, two, stop)
+                                     backup, work, self.max_steps, two, stop, flux,
+                                     order, limiter, strang)
         else:
             advance = self._numpy_loop(state, dx, P, hook, diag)
 
@@ -88,7 +100,8 @@ class FVSplitSolver(SolverBase):
                 raise SimulationBlowUp(
                     f"step {self.info['steps'] + 1} from t={t:.6g} s produced a "
                     f"non-finite or negative state ({pde.__class__.__name__}, fv-split, "
-                    f"cfl={cfl}); the last good state at t={t:.6g} s is kept")
+                    f"{pde.variant}, {self.splitting}, cfl={cfl}); the last good state at "
+                    f"t={t:.6g} s is kept")
             if status == STATUS_REST:
                 self.info["rest_time"] = float(t)
                 raise FinishedSimulation(f"everything at rest at t={t:.6g} s")
@@ -103,6 +116,9 @@ class FVSplitSolver(SolverBase):
         from ..numerics.vectorized import advection_rate
 
         pde: GranularPDE = self.pde
+        pde._require_numpy_variant()
+        if self.splitting != "lie":
+            raise NotImplementedError("the numpy loop implements Lie splitting only")
         g = P[L.G_Z]
         dry = pde._dry(P)
         r = P[L.R] if pde.two_layer else None
