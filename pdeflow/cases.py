@@ -14,6 +14,7 @@ names the key and the file. Sections (all optional except ``[initial]``)::
     [two_layer]   any field of TwoLayerParameters
     [single_layer] any field of SingleLayerParameters
     [output]      snapshot_times [s], front_threshold [m]
+    [sweep]       aspect_ratios = [a, ...] (H0 = a L0; see pdeflow.sweep)
 
 Initial shapes (x measured from the left end of the domain):
 
@@ -66,6 +67,7 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
     "two_layer": {},  # checked by TwoLayerParameters
     "single_layer": {},  # checked by SingleLayerParameters
     "output": {"snapshot_times": (list,), "front_threshold": (float, int)},
+    "sweep": {"aspect_ratios": (list,)},
 }
 
 SHAPES = ("column", "dam_break", "heap", "file")

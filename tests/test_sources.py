@@ -48,10 +48,12 @@ def test_friction_stops_in_finite_time_and_stays():
 
 @settings(max_examples=300, deadline=None)
 @given(h1=pos, h2=pos, du=st.floats(-5, 5), dt=st.floats(1e-4, 1e-1),
-       c=st.floats(0, 0.5), k=st.floats(0, 0.95), du_reg=st.floats(0, 1))
-def test_exchange_limited_never_negative_nor_overshooting(h1, h2, du, dt, c, k, du_reg):
+       c=st.floats(0, 0.5), k=st.floats(0, 0.95), du_reg=st.floats(0, 1),
+       tau=st.sampled_from([0.0, 0.01, 0.5]))
+def test_exchange_limited_never_negative_nor_overshooting(h1, h2, du, dt, c, k, du_reg,
+                                                          tau):
     r, g, tan = 0.67, 9.81, np.tan(np.radians(30))
-    dh1 = exchange_depth(h1, h2, du, dt, r, g, tan, k, c, du_reg, 1e-3)
+    dh1 = exchange_depth(h1, h2, du, dt, r, g, tan, k, c, du_reg, 1e-3, tau)
     assert h1 + dh1 >= 0 and h2 - r * dh1 >= -1e-15
     h_eq = c * du * du / ((1 - k) * r * g * tan)
     if dh1 > 0:
@@ -63,9 +65,19 @@ def test_exchange_limited_never_negative_nor_overshooting(h1, h2, du, dt, c, k, 
 def test_paper_closure_deposits_everything_at_zero_relative_velocity():
     """The singularity of closure (25) at du = 0 (REFERENCE section 6), documented."""
     r, g, tan = 0.67, 9.81, np.tan(np.radians(30))
-    assert exchange_depth(0.5, 0.5, 0.0, 1e-3, r, g, tan, 0.8, 0.01, 0.0, 1e-3) == -0.5
-    bounded = exchange_depth(0.5, 0.5, 0.0, 1e-3, r, g, tan, 0.8, 0.01, 0.3, 1e-3)
+    assert exchange_depth(0.5, 0.5, 0.0, 1e-3, r, g, tan, 0.8, 0.01, 0.0, 1e-3, 0.0) == -0.5
+    bounded = exchange_depth(0.5, 0.5, 0.0, 1e-3, r, g, tan, 0.8, 0.01, 0.3, 1e-3, 0.0)
     assert -0.5 < bounded < 0
+    # relaxed closure: exact relaxation towards h1_eq = 0 with time scale tau
+    relaxed = exchange_depth(0.5, 0.5, 0.0, 1e-3, r, g, tan, 0.8, 0.01, 0.0, 1e-3, 0.2)
+    assert relaxed == pytest.approx(-0.5 * (1 - np.exp(-1e-3 / 0.2)), rel=1e-12)
+
+
+def test_relaxed_closure_keeps_paper_rate_where_it_is_slower():
+    r, g, tan = 0.67, 9.81, np.tan(np.radians(30))
+    args = (0.3, 0.5, 2.0, 1e-3, r, g, tan, 0.5, 0.03, 0.0, 1e-3)
+    assert exchange_depth(*args, 0.01) == exchange_depth(*args, 0.0)  # relaxation faster
+    assert exchange_depth(*args, 10.0) > exchange_depth(*args, 0.0)  # relaxation slower
 
 
 def test_discriminant_agrees_with_roots_on_random_states():

@@ -45,3 +45,40 @@ def mangeney(x: np.ndarray, t: float, h0: float, x0: float = 0.0, g: float = 9.8
     h = np.where(x <= xa, h0, np.where(x <= xb, h_fan, 0.0))
     u = np.where(x <= xa, m * t, np.where(x <= xb, u_fan, 0.0))
     return h, u
+
+
+def stoker(x: np.ndarray, t: float, h_left: float, h_right: float, x0: float = 0.0,
+           g: float = 9.81) -> tuple[np.ndarray, np.ndarray]:
+    """Stoker's frictionless dam break onto a wet bed (h_right > 0).
+
+    The middle state (h_m, u_m) solves 2 (c_l - c_m) = (h_m - h_r) sqrt(g (h_m + h_r) /
+    (2 h_m h_r)) (rarefaction meets shock); the shock moves at S = h_m u_m / (h_m - h_r).
+    Regions: reservoir; rarefaction fan x0 - c_l t .. x0 + (u_m - c_m) t with
+    h = (2 c_l - xi)^2 / (9 g), u = 2/3 (xi + c_l); middle state up to x0 + S t;
+    undisturbed h_r beyond. Returns (h [m], u [m/s]).
+    """
+    from scipy.optimize import brentq
+
+    if h_right <= 0:
+        return ritter(x, t, h_left, x0=x0, g=g)
+    cl = math.sqrt(g * h_left)
+
+    def f(hm: float) -> float:
+        return (2 * (cl - math.sqrt(g * hm))
+                - (hm - h_right) * math.sqrt(g * (hm + h_right) / (2 * hm * h_right)))
+
+    hm = brentq(f, h_right, h_left)
+    cm = math.sqrt(g * hm)
+    um = 2 * (cl - cm)
+    s = hm * um / (hm - h_right)
+    x = np.asarray(x, dtype=float)
+    if t <= 0:
+        return np.where(x < x0, h_left, h_right), np.zeros_like(x)
+    xi = (x - x0) / t
+    h = np.where(xi <= -cl, h_left,
+                 np.where(xi <= um - cm, (2 * cl - xi) ** 2 / (9 * g),
+                          np.where(xi <= s, hm, h_right)))
+    u = np.where(xi <= -cl, 0.0,
+                 np.where(xi <= um - cm, 2.0 / 3.0 * (xi + cl),
+                          np.where(xi <= s, um, 0.0)))
+    return h, u

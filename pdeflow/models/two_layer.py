@@ -60,6 +60,13 @@ class TwoLayerParameters:
     """upper-layer films thinner than this after an exchange are deposited whole [m]"""
     du_reg: float = 0.0
     """lower bound of |u1 - u2| in the closure's denominator [m/s]; 0 = the paper's"""
+    exchange_closure: str = "paper"
+    """'paper': closure (25) as published (singular at du = 0); 'relaxed': its rate
+    bounded by a relaxation towards the equilibrium depth on the time scale
+    tau_star sqrt(H/g) (see pdeflow.numerics.sources); 'none': no mass exchange (two
+    immiscible layers, for verification and teaching)"""
+    tau_star: float = 1.0
+    """relaxation time of the 'relaxed' closure in units of sqrt(H/g) [-]"""
     hyperbolicity: str = "exact"
     """restoration of hyperbolicity: 'exact' (paper), 'bound' (F_L), 'none'"""
     rest_speed: float = 0.01
@@ -93,6 +100,10 @@ class TwoLayerParameters:
                     unit="m/s")
         check_range("rest_depth", self.rest_depth, 0, math.inf, unit="m")
         check_range("mol_eps", self.mol_eps, 0, math.inf, low_open=True, unit="m/s")
+        check_range("tau_star", self.tau_star, 0, math.inf, low_open=True)
+        if self.exchange_closure not in ("paper", "relaxed", "none"):
+            raise ValueError("exchange_closure must be 'paper', 'relaxed' or 'none', got "
+                             f"{self.exchange_closure!r}")
         if self.hyperbolicity not in HYPERBOLICITY_MODES:
             raise ValueError(f"hyperbolicity must be one of {list(HYPERBOLICITY_MODES)}, "
                              f"got {self.hyperbolicity!r}")
@@ -129,6 +140,8 @@ class TwoLayerParameters:
         P[L.SLOW_U] = self.rest_speed
         P[L.SLOW_H] = self.rest_depth
         P[L.MOL_EPS] = self.mol_eps
+        P[L.TAU_STAR] = {"paper": 0.0, "relaxed": self.tau_star,
+                         "none": -1.0}[self.exchange_closure]
         return P
 
 

@@ -26,7 +26,8 @@ HYPERBOLICITY = 11  #: 0 none, 1 exact inner eigenvalues (paper), 2 bound F_L
 SLOW_U = 12  #: speed below which a layer counts as "practically at rest" [m/s]
 SLOW_H = 13  #: depth above which the practical rest test looks at a cell [m]
 MOL_EPS = 14  #: velocity scale regularising sgn(u) in the method-of-lines rate [m/s]
-N_TWO_LAYER = 15
+TAU_STAR = 15  #: relaxed closure tau = TAU_STAR sqrt(H/g_z); 0: paper's; < 0: no exchange
+N_TWO_LAYER = 16
 
 # --- single-layer parameter vector (first entries coincide with the two-layer one) -----
 S_G_Z = 0

@@ -45,7 +45,7 @@ def source_rate_two_layer(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> Non
         if wet1:
             du = u1 - u2
             m = closure_rate(h1, du, r, g, P[L.TAN_INT], P[L.K], P[L.C], du_reg)
-            if m > 0.0 and not wet2:
+            if (m > 0.0 and not wet2) or P[L.TAU_STAR] < 0.0:
                 m = 0.0
             t1 = (P[L.K] * r * g * h1 * P[L.TAN_INT] + P[L.C] * du * du) * du / max(
                 abs(du), eps)

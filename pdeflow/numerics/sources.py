@@ -19,6 +19,14 @@ paper's closure, singular at du = 0 (REFERENCE section 6); du_reg > 0 bounds the
 The *equilibrium depth* at which M vanishes for the current du is
 h1_eq = c du^2 / ((1 - k) r g tan(phi_int)).
 
+Relaxed closure (``exchange_closure = "relaxed"``): the exchange can be no faster than a
+relaxation towards h1_eq on the flow's own time scale tau = tau_star sqrt(H / g_z)
+(H = h1 + h2): over a step the depth change is the smaller of the paper's explicit
+change and the exact relaxation (h1_eq - h1)(1 - exp(-dt/tau)). Where the layers shear
+(|du| not small) the paper's rate is the slower one and is used unchanged; as du -> 0 the
+rate stays bounded by h1/tau instead of diverging, so the deposited volume no longer
+depends on the time step and hence on dx.
+
 Exchange stage (31)
 -------------------
 h1 += dt M/rho1 and h2 -= dt M/rho2, with M limited so that h1 neither crosses h1_eq
@@ -132,11 +140,14 @@ def closure_rate(h1: float, du: float, r: float, g: float, tan_int: float, k: fl
 @njit(cache=True)
 def exchange_depth(h1: float, h2: float, du: float, dt: float, r: float, g: float,
                    tan_int: float, k: float, c: float, du_reg: float,
-                   film: float) -> float:
+                   film: float, tau: float) -> float:
     """Change of the upper-layer depth [m] in the limited exchange stage (31).
 
     Negative values deposit upper-layer material into the lower layer (whose depth
-    changes by -r times the returned value).
+    changes by -r times the returned value). ``tau`` [s] > 0 selects the *relaxed*
+    closure: the change is the smaller of the paper's explicit step and the exactly
+    integrated relaxation towards h1_eq with time scale tau,
+    (h1_eq - h1)(1 - exp(-dt/tau)); ``tau`` = 0 is the paper's closure.
     """
     if h1 <= 0.0:
         return 0.0
@@ -146,8 +157,14 @@ def exchange_depth(h1: float, h2: float, du: float, dt: float, r: float, g: floa
     dh1 = 0.0
     if rate < 0.0:
         dh1 = max(rate * dt / r, -(h1 - min(h1_eq, h1)))
+        if tau > 0.0:
+            relax = (h1 - min(h1_eq, h1)) * (1.0 - math.exp(-dt / tau))
+            dh1 = max(dh1, -relax)
     elif rate > 0.0:
         dh1 = max(min(rate * dt / r, h1_eq - h1, h2 / r), 0.0)
+        if tau > 0.0:
+            relax = (min(h1_eq, h1 + h2 / r) - h1) * (1.0 - math.exp(-dt / tau))
+            dh1 = min(dh1, max(relax, 0.0))
     if h1 + dh1 < film:
         # a film thinner than a few grains is no flowing layer: deposit it whole,
         # whatever the closure says (otherwise it can sit at h1_eq and creep forever)

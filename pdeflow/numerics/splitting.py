@@ -135,9 +135,11 @@ def source_stage_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
         u2 = velocity(h2, m2, dry)
         if dt > 0.0:
             # --- (31) mass exchange, carrying the upper layer's velocity -----------------
-            if h1 > 0.0:
+            if h1 > 0.0 and P[L.TAU_STAR] >= 0.0:
+                tau = P[L.TAU_STAR] * math.sqrt((h1 + h2) / g) if P[L.TAU_STAR] > 0.0 \
+                    else 0.0
                 dh1 = exchange_depth(h1, h2, u1 - u2, dt, r, g, P[L.TAN_INT], P[L.K],
-                                     P[L.C], P[L.DU_REG], P[L.FILM])
+                                     P[L.C], P[L.DU_REG], P[L.FILM], tau)
                 if dh1 != 0.0:
                     mom = h2 * u2 + r * h1 * u1  # rho-weighted momentum / rho2
                     h1 = h1 + dh1

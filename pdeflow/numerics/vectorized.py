@@ -118,7 +118,7 @@ def source_rate(q: np.ndarray, P: np.ndarray, two_layer: bool) -> np.ndarray:
     du = u1 - u2
     num = P[L.C] * du * du - (1.0 - P[L.K]) * r * g * h1 * P[L.TAN_INT]
     m = num / np.maximum(np.abs(du), max(P[L.DU_REG], eps))
-    m = np.where(wet1 & ((m <= 0) | wet2), m, 0.0)
+    m = np.where(wet1 & ((m <= 0) | wet2) & (P[L.TAU_STAR] >= 0), m, 0.0)
     sgn_du = du / np.maximum(np.abs(du), eps)
     t1 = np.where(wet1, (P[L.K] * r * g * h1 * P[L.TAN_INT] + P[L.C] * du * du) * sgn_du,
                   0.0)

@@ -1,0 +1,239 @@
+"""Self-convergence of quantities of interest under grid refinement.
+
+``pdeflow converge CASE.toml --levels N`` (or :func:`converge`) runs a case on N
+successive halvings of dx and reports, per level, the quantities of interest (QoIs):
+upper-layer volume V1(t) at fixed times, the lower and upper stop times (exactly u = 0,
+and |u| < 1 cm/s where h > 1 mm), the run-out, and the largest F_extra/rho1 with where
+and when it occurred. For every QoI it gives the change between the two finest grids and,
+with three or more levels, the observed order p = log2(|Q_h - Q_h/2| / |Q_h/2 - Q_h/4|)
+and the Richardson estimate Q_h/4 + (Q_h/4 - Q_h/2)/(2^p - 1) where p > 0.
+
+For sweep cases (with a ``[sweep]`` section) it refines the sweep and reports the
+fitted run-out prefactor and exponent per level.
+
+``python -m pdeflow.analysis.convergence --report docs`` regenerates
+``docs/convergence.md`` and its figures: the paper's closure next to the relaxed one,
+for test 5.1 (dx = 0.05 .. 0.003125 m) and test 5.2 (dx = 0.01 .. 0.00125 m).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..cases import Case, load_case
+from ..simulate import run_model
+
+QOI_KEYS = ("lower_stop_time", "upper_stop_time", "lower_slow_time", "upper_slow_time",
+            "runout", "max_fextra_over_rho1")
+
+
+def _refined(case: Case, level: int, dx0: float) -> Case:
+    c = case.copy()
+    grid = c.data.setdefault("grid", {})
+    grid.pop("cells", None)
+    grid["dx"] = dx0 / 2**level
+    c.validate()
+    return c
+
+
+def converge(case: Case, levels: int, model: str = "two_layer",
+             volume_times: tuple[float, ...] = (0.01, 0.1, 0.25, 0.5, 1.0)
+             ) -> dict[str, Any]:
+    """Run ``model`` of ``case`` on ``levels`` halvings of dx; QoIs per level."""
+    dx0 = case.dx
+    rows = []
+    for level in range(levels):
+        c = _refined(case, level, dx0)
+        c.data.setdefault("output", {})["snapshot_times"] = [
+            t for t in volume_times if t <= c.t_end]
+        res = run_model(c, model)
+        s = res.summary
+        row: dict[str, Any] = {"dx": c.dx, "cells": c.cells, "steps": s["steps"],
+                               "wall_time_s": s["wall_time_s"]}
+        for key in QOI_KEYS:
+            row[key] = s.get(key)
+        row["max_fextra_x"] = s.get("max_fextra_x")
+        row["max_fextra_time"] = s.get("max_fextra_time")
+        for t in volume_times:
+            snap = res.snapshots.get(round(float(t), 9))
+            if snap is not None:
+                data = snap[0]
+            elif t >= res.t_final and s["at_rest"]:
+                data = res.state.data  # stationary from t_final on
+            else:
+                data = None
+            row[f"V1({t:g})"] = (float(np.sum(data[0]) * c.dx)
+                                 if data is not None and model == "two_layer" else None)
+        rows.append(row)
+    qois = [k for k in rows[0] if k not in ("dx", "cells", "steps", "wall_time_s",
+                                             "max_fextra_x", "max_fextra_time")]
+    return {"case": case.name, "model": model, "levels": rows,
+            "analysis": {k: richardson([r[k] for r in rows]) for k in qois}}
+
+
+def richardson(values: list[float | None]) -> dict[str, float | None]:
+    """Change between the finest two values, observed order and extrapolation."""
+    out: dict[str, float | None] = {"finest": values[-1], "relative_change": None,
+                                    "order": None, "extrapolated": None}
+    v = values
+    if len(v) >= 2 and v[-1] is not None and v[-2] is not None:
+        scale = max(abs(v[-1]), 1e-12)
+        out["relative_change"] = abs(v[-1] - v[-2]) / scale
+    if len(v) >= 3 and None not in v[-3:]:
+        d1 = abs(v[-2] - v[-3])
+        d2 = abs(v[-1] - v[-2])
+        if d1 > 0 and d2 > 0:
+            p = math.log2(d1 / d2)
+            out["order"] = p
+            if p > 0:
+                out["extrapolated"] = v[-1] + (v[-1] - v[-2]) / (2**p - 1)
+    return out
+
+
+def converge_sweep(case: Case, levels: int, model: str = "two_layer") -> dict[str, Any]:
+    """Refine a sweep case; fitted prefactor and exponent per level."""
+    from ..sweep import run_sweep
+
+    dx0 = case.dx
+    rows = []
+    for level in range(levels):
+        c = _refined(case, level, dx0)
+        t0 = time.perf_counter()
+        res = run_sweep(c, models=[model])["models"][model]
+        rows.append({"dx": c.dx, "prefactor": res["prefactor"], "exponent": res["exponent"],
+                     "all_at_rest": res["all_at_rest"], "points": res["points"],
+                     "wall_time_s": time.perf_counter() - t0})
+    return {"case": case.name, "model": model, "levels": rows,
+            "analysis": {k: richardson([r[k] for r in rows])
+                         for k in ("prefactor", "exponent")}}
+
+
+def _fmt(v: Any) -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    return str(v)
+
+
+def table(result: dict[str, Any], keys: list[str] | None = None) -> str:
+    """Markdown table: one row per level, then the change/order/extrapolation rows."""
+    rows = result["levels"]
+    keys = keys or [k for k in rows[0] if k != "points"]
+    lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
+    for r in rows:
+        lines.append("| " + " | ".join(_fmt(r.get(k)) for k in keys) + " |")
+    ana = result["analysis"]
+    for label, field in (("rel. change (finest two)", "relative_change"),
+                         ("observed order", "order"), ("Richardson", "extrapolated")):
+        cells = [label] + [_fmt(ana[k][field]) if k in ana else "" for k in keys[1:]]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def volume_figure(results: dict[str, dict[str, Any]], path: Path) -> None:
+    """Upper-layer volume at fixed times against dx, one panel per closure."""
+    import matplotlib.pyplot as plt
+
+    from ..plotting import save
+
+    fig, axes = plt.subplots(1, len(results), figsize=(5 * len(results), 3.8),
+                             sharey=True, squeeze=False)
+    for ax, (name, res) in zip(axes[0], results.items(), strict=True):
+        rows = res["levels"]
+        dx = [r["dx"] for r in rows]
+        for key in [k for k in rows[0] if k.startswith("V1(")]:
+            vals = [r[key] for r in rows]
+            ax.semilogx(dx, vals, "o-", label=key.replace("V1(", "t = ").rstrip(")") + " s")
+        ax.set_title(name)
+        ax.set_xlabel("dx [m]")
+        ax.invert_xaxis()
+        ax.grid(alpha=0.3, which="both")
+    axes[0][0].set_ylabel("upper-layer volume V1 [m^2]")
+    axes[0][0].legend(fontsize=7)
+    fig.tight_layout()
+    save(fig, path)
+
+
+def report(out_dir: str | Path, levels_51: int = 5, levels_52: int = 4,
+           case_51: str = "cases/paper_5_1_dam_break.toml",
+           case_52: str = "cases/collapse_sweep.toml") -> Path:
+    """Regenerate docs/convergence.md and its figure (paper vs relaxed closure)."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    closures = {"paper closure": ["two_layer.exchange_closure='paper'"],
+                "relaxed closure": ["two_layer.exchange_closure='relaxed'"]}
+    r51 = {name: converge(load_case(case_51, over), levels_51)
+           for name, over in closures.items()}
+    r52 = {name: converge_sweep(load_case(case_52, over), levels_52)
+           for name, over in closures.items()}
+    volume_figure(r51, out_dir / "convergence_v1.png")
+    lines = ["# Grid convergence of the two-layer results", "",
+             "Generated by `python -m pdeflow.analysis.convergence --report docs` "
+             f"({levels_51} levels for 5.1, {levels_52} for 5.2). Stop times in s, run-out "
+             "in m, F_extra/rho1 in m^2/s^2, volumes in m^2.", ""]
+    for name, res in r51.items():
+        lines += [f"## Test 5.1, {name}", "", table(res), ""]
+    lines += ["![upper-layer volume against dx](convergence_v1.png)", ""]
+    for name, res in r52.items():
+        lines += [f"## Test 5.2 run-out fit, {name}", "",
+                  table(res, ["dx", "prefactor", "exponent", "all_at_rest",
+                              "wall_time_s"]), ""]
+    path = out_dir / "convergence.md"
+    from ..io import atomic_path
+
+    with atomic_path(path) as tmp:
+        tmp.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    ap.add_argument("case", nargs="?", help="case file (a sweep case refines the sweep)")
+    ap.add_argument("--levels", type=int, default=4, help="number of grids (dx halved)")
+    ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                    help="override a case value (repeatable)")
+    ap.add_argument("--model", default="two_layer", choices=["two_layer", "single_layer"])
+    ap.add_argument("--summary", metavar="OUT.json", help="write the results as JSON")
+    ap.add_argument("--report", metavar="DIR",
+                    help="regenerate DIR/convergence.md (paper vs relaxed closure)")
+
+
+def cmd_converge(args: argparse.Namespace) -> int:
+    from ..io import write_json
+
+    if args.report:
+        print(f"wrote {report(args.report)}")
+        return 0
+    if not args.case:
+        raise SystemExit("pdeflow converge: a case file (or --report DIR) is required")
+    case = load_case(args.case, args.set)
+    if args.levels < 2:
+        raise SystemExit("pdeflow converge: --levels must be at least 2")
+    if case.data.get("sweep"):
+        res = converge_sweep(case, args.levels, args.model)
+        print(table(res, ["dx", "prefactor", "exponent", "all_at_rest", "wall_time_s"]))
+    else:
+        res = converge(case, args.levels, args.model)
+        print(table(res))
+    if args.summary:
+        write_json(args.summary, res)
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="pdeflow converge", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_arguments(ap)
+    return cmd_converge(ap.parse_args(argv))
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+
+    sys.exit(main())

@@ -1,0 +1,168 @@
+"""Aspect-ratio sweeps of column collapses and the run-out scaling law (paper test 5.2).
+
+A sweep case is an ordinary case file with a ``[sweep]`` section::
+
+    [sweep]
+    aspect_ratios = [2, 3, 4, 6, 8, 10, 14, 18, 24, 30]   # a = H0 / L0
+
+For every a the column height is set to H0 = a L0 and every model of the case is run to
+rest; the normalised run-out r = (R - L0)/L0 uses the front position R (downstream face
+of the last cell with total depth above ``output.front_threshold``). A power law
+r = p a^e is fitted by least squares on log r against log a. The paper reports
+r = 2.25 a^1.06 (single layer, phi_B = 30 deg) and r = 1.61 a^0.84 (two layers); the DEM
+of Lacaze et al. (2008) gives the exponent 0.83 +- 0.03.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .cases import Case, load_case
+from .simulate import run_model
+
+PAPER_FITS = {"single_layer": (2.25, 1.06), "two_layer": (1.61, 0.84)}
+DEM_EXPONENT = 0.83
+
+
+def fit_power_law(a: np.ndarray, r: np.ndarray) -> tuple[float, float]:
+    """Least-squares fit of log r = log p + e log a; returns (p, e)."""
+    a = np.asarray(a, dtype=float)
+    r = np.asarray(r, dtype=float)
+    ok = (a > 0) & (r > 0)
+    if ok.sum() < 2:
+        raise ValueError("a power-law fit needs at least two positive run-outs")
+    e, logp = np.polyfit(np.log(a[ok]), np.log(r[ok]), 1)
+    return float(np.exp(logp)), float(e)
+
+
+def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
+              models: list[str] | None = None) -> dict[str, Any]:
+    """Run every model at every aspect ratio; return the sweep summary."""
+    ratios = aspect_ratios or [float(a) for a in case.data.get("sweep", {}).get(
+        "aspect_ratios", [])]
+    if not ratios:
+        raise ValueError(f"{case.source}: sweep.aspect_ratios is empty")
+    L0 = case.L0
+    if L0 is None:
+        raise ValueError(f"{case.source}: a sweep needs initial.L0 (a column)")
+    models = models or case.models
+    out: dict[str, Any] = {"case": case.name, "L0": L0, "dx": case.dx,
+                           "front_threshold": case.front_threshold, "models": {}}
+    wall0 = time.perf_counter()
+    for model in models:
+        rows = []
+        for a in ratios:
+            c = case.copy()
+            c.data["initial"]["H0"] = float(a) * L0
+            c.data.setdefault("output", {})["snapshot_times"] = []
+            c.validate()
+            s = run_model(c, model).summary
+            r = None if s["runout"] is None else s["runout"] / L0
+            rows.append({"a": float(a), "r": r, "runout": s["runout"],
+                         "stop_time": s["stop_time"], "at_rest": s["at_rest"],
+                         "steps": s["steps"], "wall_time_s": s["wall_time_s"],
+                         "mass_relative_error": s["mass_relative_error"]})
+        good = [(row["a"], row["r"]) for row in rows if row["r"] and row["at_rest"]]
+        p, e = fit_power_law(*zip(*good, strict=True)) if len(good) >= 2 else (None, None)
+        out["models"][model] = {
+            "points": [[row["a"], row["r"]] for row in rows],
+            "runs": rows,
+            "prefactor": p,
+            "exponent": e,
+            "paper_prefactor": PAPER_FITS[model][0],
+            "paper_exponent": PAPER_FITS[model][1],
+            "all_at_rest": all(row["at_rest"] for row in rows),
+        }
+    out["wall_time_s"] = time.perf_counter() - wall0
+    return out
+
+
+def sweep_figure(summary: dict[str, Any], path: str | Path) -> Path:
+    """Log-log plot of r against a with the fits, the paper's fits and the DEM slope."""
+    import matplotlib.pyplot as plt
+
+    from .plotting import save
+
+    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    styles = {"single_layer": ("k", "o", "single layer"),
+              "two_layer": ("tab:orange", "s", "two layers")}
+    amin, amax = np.inf, 0.0
+    for model, res in summary["models"].items():
+        color, marker, label = styles[model]
+        pts = np.array([p for p in res["points"] if p[1]], dtype=float)
+        if pts.size == 0:
+            continue
+        amin, amax = min(amin, pts[:, 0].min()), max(amax, pts[:, 0].max())
+        ax.loglog(pts[:, 0], pts[:, 1], marker, color=color, label=f"{label}")
+        aa = np.geomspace(pts[:, 0].min(), pts[:, 0].max(), 50)
+        if res["prefactor"]:
+            ax.loglog(aa, res["prefactor"] * aa ** res["exponent"], "-", color=color,
+                      lw=1, label=f"fit {res['prefactor']:.2f} a^{res['exponent']:.2f}")
+        p, e = res["paper_prefactor"], res["paper_exponent"]
+        ax.loglog(aa, p * aa**e, ":", color=color, lw=1, label=f"paper {p} a^{e}")
+    if amax > 0:
+        aa = np.geomspace(amin, amax, 50)
+        two = summary["models"].get("two_layer", {})
+        anchor = (two.get("prefactor") or 1.0) * amin ** (two.get("exponent") or DEM_EXPONENT)
+        ax.loglog(aa, anchor * (aa / amin) ** DEM_EXPONENT, "--", color="gray", lw=1,
+                  label=f"DEM slope a^{DEM_EXPONENT} (Lacaze et al.)")
+    ax.set_xlabel("aspect ratio a = H0/L0")
+    ax.set_ylabel("normalised run-out r = (R - L0)/L0")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3, which="both")
+    fig.tight_layout()
+    return save(fig, path)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m pdeflow.sweep CASE.toml [--set k=v] [--summary out.json] [--plot f.png]``"""
+    import argparse
+
+    from .io import write_json
+
+    ap = argparse.ArgumentParser(prog="pdeflow sweep", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_arguments(ap)
+    args = ap.parse_args(argv)
+    return cmd_sweep(args, write_json)
+
+
+def add_arguments(ap: Any) -> None:
+    """The sweep command's options (shared by ``pdeflow sweep`` and ``-m``)."""
+    ap.add_argument("case", help="sweep case file (a column case with a [sweep] section)")
+    ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                    help="override a case value (repeatable)")
+    ap.add_argument("--summary", metavar="OUT.json", help="write the sweep summary here")
+    ap.add_argument("--plot", metavar="OUT.png", help="write the r(a) figure here")
+    ap.add_argument("-q", "--quiet", action="store_true", help="print nothing")
+
+
+def cmd_sweep(args: Any, write_json: Any = None) -> int:
+    """Run the sweep described by parsed ``args``; print the fits."""
+    if write_json is None:
+        from .io import write_json
+    case = load_case(args.case, args.set)
+    summary = run_sweep(case)
+    if args.summary:
+        write_json(args.summary, summary)
+    if args.plot:
+        sweep_figure(summary, args.plot)
+    if not args.quiet:
+        for model, res in summary["models"].items():
+            pts = ", ".join(f"{a:g}:{r:.3g}" if r else f"{a:g}:-" for a, r in res["points"])
+            fit = (f"r = {res['prefactor']:.3g} a^{res['exponent']:.3f}"
+                   if res["prefactor"] else "no fit")
+            print(f"{model:13} {fit}   (paper {res['paper_prefactor']} "
+                  f"a^{res['paper_exponent']})   a:r {pts}")
+        print(f"wall time {summary['wall_time_s']:.2f} s")
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+
+    sys.exit(main())
