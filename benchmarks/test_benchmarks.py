@@ -1,0 +1,99 @@
+"""pytest-benchmark tests: timings to track across commits, and the hard targets.
+
+Run with ``python -m pytest benchmarks`` (``--benchmark-save=NAME`` and
+``--benchmark-compare`` to compare commits). Each benchmark calls a compiled run after
+a warm-up; the assertions check what does not depend on the machine's load (results,
+signatures), timings are only reported. The numbers in docs/performance.md come from
+``run_benchmarks.py``, which interleaves runs for stable ratios.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pytest_benchmark")
+
+import suite  # noqa: E402
+
+VARIANTS = ("hll/first-order", "rusanov/first-order", "ifcp/first-order", "hll/muscl/minmod",
+            "ifcp/muscl/mc", "hll/first-order+strang")
+
+
+@pytest.mark.parametrize("model", ["single_layer", "two_layer"])
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_cell_updates(benchmark, model, variant):
+    """5.1 case, dx = 0.0125 m, to t = 0.4 s: one model and variant."""
+    from pdeflow.analysis.workprecision import case_on_grid, parse_variant, resolve_case
+
+    case = case_on_grid(resolve_case(suite.CASE_5_1), 0.0125, parse_variant(variant))
+    run = suite.fv_stepper_run(case, model, 0.4)
+    out = run()
+    benchmark.extra_info["cell_updates"] = out["steps"] * out["cells"]
+    benchmark.pedantic(run, rounds=5, warmup_rounds=1)
+    assert np.all(np.isfinite(out["data"]))
+
+
+@pytest.mark.parametrize("model", ["single_layer", "two_layer"])
+def test_case_5_1_to_rest(benchmark, model):
+    from pdeflow.cases import load_case
+    from pdeflow.simulate import run_model
+
+    case = load_case(suite.CASE_5_1, ["output.snapshot_times=[]"])
+    res = benchmark.pedantic(lambda: run_model(case, model), rounds=5, warmup_rounds=1)
+    assert res.summary["at_rest"]
+
+
+@pytest.mark.parametrize("H0", [0.5, 2.0])
+def test_sweep_member_pdeflow(benchmark, H0):
+    case = suite.sweep_case(H0, "single_layer")
+    pkg, base = suite._pkg_vs_baseline(case)
+    out = benchmark.pedantic(pkg, rounds=5, warmup_rounds=1)
+    _, steps, h = base()
+    assert out["steps"] == steps
+    np.testing.assert_allclose(out["data"][0], h, atol=1e-12)
+
+
+@pytest.mark.parametrize("H0", [0.5, 2.0])
+def test_sweep_member_baseline(benchmark, H0):
+    _, base = suite._pkg_vs_baseline(suite.sweep_case(H0, "single_layer"))
+    benchmark.pedantic(base, rounds=5, warmup_rounds=1)
+
+
+@pytest.mark.parametrize("H0", [0.5, 2.0])
+def test_sweep_member_pyclaw(benchmark, H0):
+    import pyclaw_run
+
+    if not pyclaw_run.available():
+        pytest.skip("clawpack is not installed")
+    case = suite.sweep_case(H0, "single_layer")
+    t_rest = suite.fv_stepper_run(case, "single_layer")()["t"]
+    L = suite.sweep_length(H0)
+    benchmark.pedantic(lambda: pyclaw_run.collapse(suite.SWEEP_L0, H0, L, suite.SWEEP_DX,
+                                                   t_rest), rounds=3, warmup_rounds=1)
+
+
+def test_one_signature_for_a_sweep_of_both_models():
+    """A sweep of run_model calls (both models, several grids) compiles advance_split
+    once. (A run with tracker interrupts adds a float-t signature: see
+    docs/performance.md, Findings.)"""
+    from pdeflow.numerics.splitting import advance_split
+    from pdeflow.simulate import run_model
+
+    before = set(advance_split.signatures)
+    for H0 in (0.5, 1.0):
+        for model in ("single_layer", "two_layer"):
+            run_model(suite.sweep_case(H0, model), model)
+    new = set(advance_split.signatures) - before
+    assert len(new) <= 1 and len(advance_split.signatures) >= 1
+
+
+def test_wet_region_only():
+    """A 10x longer domain costs far less than 10x (medians of interleaved runs)."""
+    rows = suite.wet_region_savings(repeats=3)
+    for r in rows:
+        assert r["steps"] == r["steps_long"]
+        assert r["ratio"] < 5.0, r
+        assert math.isfinite(r["wall_s"])
