@@ -1,8 +1,14 @@
-"""Command line: ``pdeflow run CASE.toml [--set section.key=value ...] [outputs]``."""
+"""Command line: ``pdeflow run | plot | export`` (``pdeflow COMMAND --help`` for each).
+
+Each subcommand is a function ``cmd_<name>(args) -> exit code`` and its options are set
+up in :func:`build_parser`; errors in the user's input (case files, stored runs, movie
+formats) are printed as one line and exit with code 2.
+"""
 
 from __future__ import annotations
 
 import argparse
+import logging
 import sys
 from pathlib import Path
 from typing import Any
@@ -12,7 +18,30 @@ from . import __version__
 RUN_HELP = """Run every model listed in the case file (case.models) to rest or t_end.
 
 Without output options the summary and all figures go to results/<case name>/.
-Outputs are written atomically: a failed run leaves no partial file behind."""
+Outputs are written atomically: a failed run leaves no partial file behind.
+For cases with several models, per-model outputs (--final, --store, --movie) go to
+the given name for the first model and to NAME.<model>.SUFFIX for the others.
+
+examples:
+  pdeflow run cases/paper_5_1_dam_break.toml
+  pdeflow run cases/paper_5_1_dam_break.toml --set two_layer.c=0.05 --summary s.json
+  pdeflow run cases/ritter_dam_break.toml --live            # desktop window
+  pdeflow run cases/paper_5_1_dam_break.toml --movie 5_1.mp4 --store 5_1.h5
+  pdeflow plot 5_1.h5 5_1.single_layer.h5 --time 0.4 --out t04.png"""
+
+PLOT_HELP = """Plot stored runs (written by `pdeflow run --store`) at one time, or as a movie.
+
+The first run is drawn filled (layers stacked on the bed), further runs as lines on
+top, for comparison: e.g. the two-layer and single-layer runs of one case, or two
+parameter sets. Each run is shown at its stored time nearest to --time (default: its
+last frame, the final state). A short description of each file is printed."""
+
+EXPORT_HELP = """Export a stored run to CSV, NumPy .npz or NetCDF (chosen by the suffix).
+
+CSV: one row per (time, cell), columns t [s], x [m], h1, u1, h2, u2 [m, m/s] and
+fextra_over_rho1 [m^2/s^2] (two layers) or h, u (one layer). NPZ: arrays t, x and
+each quantity as (time, cell), plus the metadata as JSON. NetCDF needs xarray
+(pip install 'pdeflow[export]'); the metadata goes into its attributes."""
 
 
 def _fmt(v: Any, unit: str = "") -> str:
@@ -40,6 +69,53 @@ def print_summary(summary: dict[str, Any], out: Any = None) -> None:
                                       for m in models), file=out)
 
 
+def _model_path(path: str | Path, model: str, first: bool) -> Path:
+    """Per-model output name: PATH for the first model, NAME.<model>.SUFFIX after it."""
+    path = Path(path)
+    return path if first else path.with_name(f"{path.stem}.{model}{path.suffix}")
+
+
+def _positive(name: str, value: float | None) -> None:
+    from .cases import CaseError
+
+    if value is not None and not value > 0:
+        raise CaseError(f"{name} must be > 0, got {value!r}")
+
+
+def _run_trackers(args: argparse.Namespace, case: Any, model: str,
+                  first: bool) -> list[Any]:
+    """The trackers that the run options ask for (progress, live plot, storage)."""
+    trackers: list[Any] = []
+    interval = case.t_end / 100
+    progress = (args.progress if args.progress is not None
+                else sys.stdout.isatty() and not args.quiet)
+    if progress:
+        from .trackers.live import ProgressBar
+
+        trackers.append(ProgressBar(interval, label=model))
+    from .trackers.live import display_mode
+
+    show = args.live and display_mode("auto") != "none"  # headless: nothing to show
+    if show or args.movie or args.frames:
+        from .trackers.live import LivePlotTracker
+
+        movie = _model_path(args.movie, model, first) if args.movie else None
+        frames = (Path(args.frames) / model) if args.frames else None
+        trackers.append(LivePlotTracker(
+            args.live_every or interval, title=f"{case.name}: {model.replace('_', ' ')}",
+            display="auto" if show else "none", movie=movie, frames=frames,
+            fps=args.fps))
+    if args.store:
+        from .storage import RunStorageTracker, run_metadata
+
+        meta = run_metadata(case, model, overrides=args.set, case_file=str(args.case),
+                            store_every=args.store_every or interval)
+        trackers.append(RunStorageTracker(_model_path(args.store, model, first),
+                                          args.store_every or interval, metadata=meta,
+                                          autocommit=False))
+    return trackers
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     from .cases import load_case
     from .io import write_json, write_npz
@@ -47,9 +123,45 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .simulate import run_model
 
     case = load_case(args.case, args.set)
+    for name in ("live_every", "store_every", "fps"):
+        _positive(f"--{name.replace('_', '-')}", getattr(args, name))
+    if args.movie:
+        from .trackers.live import check_movie_path
+
+        check_movie_path(args.movie)
+    if args.store:
+        from .storage import require_h5py
+
+        require_h5py()
+    live_window = False
+    if args.live:
+        from .trackers.live import display_mode
+
+        live_window = display_mode("auto") == "window"
+        if display_mode("auto") == "none":
+            print("pdeflow: warning: --live needs a display (matplotlib backend "
+                  "is non-interactive); use --movie or --frames on a headless machine",
+                  file=sys.stderr)
     results = {}
-    for model in case.models:
-        results[model] = run_model(case, model)
+    stores: dict[str, Any] = {}
+    all_trackers: list[Any] = []
+    if args.live or args.movie or args.frames:
+        # drawing frames takes longer than the run itself: py-pde's warning about it
+        # would only be noise here
+        logging.getLogger("pde.solvers.controller").setLevel(logging.ERROR)
+    try:
+        for i, model in enumerate(case.models):
+            trackers = _run_trackers(args, case, model, first=i == 0)
+            all_trackers.extend(trackers)
+            for t in trackers:
+                if hasattr(t, "commit"):
+                    stores[model] = t
+            results[model] = run_model(case, model, tracker=trackers or None)
+    except BaseException:
+        for t in all_trackers:  # no partial movie or storage file stays behind
+            if hasattr(t, "discard"):
+                t.discard()
+        raise
     summary = {
         "case": case.name,
         "case_file": str(args.case),
@@ -58,19 +170,24 @@ def cmd_run(args: argparse.Namespace) -> int:
         "parameters": {m: case.make_pde(m).parameters.to_dict() for m in case.models},
         "models": {m: r.summary for m, r in results.items()},
     }
-    default_out = not (args.summary or args.final or args.plot or args.outdir)
+    default_out = not (args.summary or args.final or args.plot or args.outdir
+                       or args.store or args.movie or args.frames)
     outdir = Path(args.outdir) if args.outdir else (
         Path("results") / case.name if default_out else None)
     written = []
+    for model, tracker in stores.items():
+        written.append(tracker.commit({"summary": summary["models"][model]}))
+    for t in all_trackers:
+        if getattr(t, "movie", None) is not None:
+            written.append(t.movie.path)
+        if getattr(t, "frames_dir", None) is not None and t.frame_paths:
+            written.append(t.frames_dir / f"frame_*.png ({len(t.frame_paths)} frames)")
     if args.summary or outdir:
         written.append(write_json(args.summary or outdir / "summary.json", summary))
     if args.final:
-        first = case.models[0]
-        final = Path(args.final)
-        for m in case.models:
-            path = final if m == first else final.with_name(
-                f"{final.stem}.{m}{final.suffix}")
-            written.append(write_npz(path, results[m].final_arrays()))
+        for i, m in enumerate(case.models):
+            written.append(write_npz(_model_path(args.final, m, i == 0),
+                                     results[m].final_arrays()))
     if args.plot:
         two = results.get("two_layer")
         one = results.get("single_layer")
@@ -83,39 +200,214 @@ def cmd_run(args: argparse.Namespace) -> int:
         print_summary(summary)
         for p in written:
             print(f"wrote {p}")
+    if live_window:
+        import matplotlib.pyplot as plt
+
+        if not args.quiet:
+            print("close the plot window(s) to finish")
+        plt.show()
+    return 0
+
+
+def _describe(run: Any) -> str:
+    m = run.metadata
+    t_final = m.get("t_final")
+    rest = " (at rest)" if m.get("at_rest") else ""
+    fmax = float(run.fextra.max()) if run.fextra.size else 0.0
+    return (f"{run.path}: {m.get('case_name', '?')}, {run.model}, {len(run.times)} frames "
+            f"t = {run.times[0]:g}..{run.times[-1]:.4g} s, "
+            f"end {'-' if t_final is None else f'{t_final:.4g} s'}{rest}, "
+            f"max stored F_extra/rho1 {fmax:.3g} m2/s2")
+
+
+def cmd_plot(args: argparse.Namespace) -> int:
+    from .plotting import RunFigure, Series
+    from .storage import open_run
+
+    _positive("--fps", args.fps)
+    if args.movie:
+        from .trackers.live import check_movie_path
+
+        check_movie_path(args.movie)
+    runs = [open_run(p) for p in args.runs]
+    labels = [r.label for r in runs]
+    if len({r.path.name for r in runs}) < len(runs):
+        labels = [f"{r.path} ({r.model.replace('_', ' ')})" for r in runs]
+    series = [Series(r.x, r.model, lab) for r, lab in zip(runs, labels, strict=True)]
+    title = args.title if args.title is not None else runs[0].metadata.get(
+        "case_name", runs[0].path.stem)
+    written = []
+    if args.movie:
+        from .trackers.live import replay
+
+        frames = []
+        for t in runs[0].times:
+            idx = [r.index(min(t, r.times[-1])) for r in runs]
+            frames.append((float(t), [r.data[i] for r, i in zip(runs, idx, strict=True)],
+                           [r.fextra[i] for r, i in zip(runs, idx, strict=True)]))
+        written.append(replay(frames, series, args.movie, title=title, fps=args.fps))
+    if args.out or not args.movie:
+        idx = [r.index(args.time) for r in runs]
+        times = [float(r.times[i]) for r, i in zip(runs, idx, strict=True)]
+        if len({round(t, 9) for t in times}) > 1:  # show each run's own time
+            for s, t in zip(series, times, strict=True):
+                s.label = f"{s.label}, t = {t:.3g} s"
+        fig = RunFigure(series, title=title)
+        fig.update(times[0], [r.data[i] for r, i in zip(runs, idx, strict=True)],
+                   [r.fextra[i] for r, i in zip(runs, idx, strict=True)])
+        if len({round(t, 9) for t in times}) > 1:
+            fig.set_title("(times in the legend)" if args.time is None
+                          else f"(nearest stored times to t = {args.time:g} s)")
+        out = args.out or runs[0].path.with_suffix(".png")
+        written.append(fig.save(out))
+        fig.close()
+    if not args.quiet:
+        for r in runs:
+            print(_describe(r))
+        for p in written:
+            print(f"wrote {p}")
+    return 0
+
+
+def cmd_export(args: argparse.Namespace) -> int:
+    from .storage import open_run
+
+    run = open_run(args.run)
+    out = run.export(args.out)
+    if not args.quiet:
+        print(_describe(run))
+        print(f"wrote {out}")
     return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
+    raw = argparse.RawDescriptionHelpFormatter
     parser = argparse.ArgumentParser(
         prog="pdeflow",
-        description="Depth-averaged single- and two-layer granular flow models on py-pde.")
+        description="Depth-averaged single- and two-layer granular flow models on py-pde.",
+        epilog="docs/user_guide.md explains the commands, docs/cases.md the case files.")
     parser.add_argument("--version", action="version", version=f"pdeflow {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    # --- run ------------------------------------------------------------------------------
     run = sub.add_parser("run", help="run a case file", description=RUN_HELP,
-                         formatter_class=argparse.RawDescriptionHelpFormatter)
+                         formatter_class=raw)
     run.add_argument("case", help="TOML case file (see cases/ and docs/cases.md)")
     run.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                      help="override a case value, e.g. --set two_layer.c=0.05 (repeatable)")
-    run.add_argument("--summary", metavar="OUT.json", help="write the JSON summary here")
-    run.add_argument("--final", metavar="OUT.npz",
+    out = run.add_argument_group("result files")
+    out.add_argument("--summary", metavar="OUT.json", help="write the JSON summary here")
+    out.add_argument("--final", metavar="OUT.npz",
                      help="write the final state (x, h1, u1, h2, u2 or x, h, u, and t); "
                      "further models go to OUT.<model>.npz")
-    run.add_argument("--plot", metavar="OUT.png", help="write the final-deposit figure")
-    run.add_argument("--outdir", metavar="DIR",
+    out.add_argument("--plot", metavar="OUT.png", help="write the final-deposit figure")
+    out.add_argument("--outdir", metavar="DIR",
                      help="write summary.json and all figures (snapshots, deposits) here")
+    out.add_argument("--store", metavar="OUT.h5",
+                     help="store the run in HDF5 (py-pde FileStorage: state and "
+                     "F_extra/rho1 every --store-every s, and the final state; case, "
+                     "parameters, variant, version and summary as metadata); further "
+                     "models go to OUT.<model>.h5. Needs h5py")
+    out.add_argument("--store-every", type=float, metavar="DT",
+                     help="simulation time between stored frames [s] (default t_end/100)")
+    watch = run.add_argument_group("watching the run")
+    watch.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                       help="show a progress bar (default: only when stdout is a "
+                       "terminal)")
+    watch.add_argument("--live", action="store_true",
+                       help="draw the layers, velocities and F_extra/rho1 in a window "
+                       "while the run goes (needs a display; close it to finish)")
+    watch.add_argument("--movie", metavar="OUT.mp4",
+                       help="write the live plot as a movie, headless: .mp4 (needs "
+                       "ffmpeg, e.g. pip install imageio-ffmpeg) or .gif; further "
+                       "models go to OUT.<model>.mp4")
+    watch.add_argument("--frames", metavar="DIR",
+                       help="write the live plot as PNG frames DIR/<model>/frame_*.png")
+    watch.add_argument("--live-every", type=float, metavar="DT",
+                       help="simulation time between live frames [s] (default t_end/100)")
+    watch.add_argument("--fps", type=float, default=10.0,
+                       help="frames per second of --movie (default 10)")
     run.add_argument("-q", "--quiet", action="store_true", help="print nothing")
     run.set_defaults(func=cmd_run)
+
+    # --- plot -----------------------------------------------------------------------------
+    plot = sub.add_parser("plot", help="plot or compare stored runs (.h5)",
+                          description=PLOT_HELP, formatter_class=raw)
+    plot.add_argument("runs", nargs="+", metavar="RUN.h5",
+                      help="stored runs (pdeflow run --store); the first is drawn filled")
+    plot.add_argument("--time", type=float, metavar="T",
+                      help="time to show [s] (nearest stored frame; default: the end)")
+    plot.add_argument("--out", metavar="FIG.png",
+                      help="write the figure here (default: the first RUN with .png)")
+    plot.add_argument("--movie", metavar="OUT.mp4",
+                      help="write a movie over all stored frames (.mp4 or .gif)")
+    plot.add_argument("--fps", type=float, default=10.0,
+                      help="frames per second of --movie (default 10)")
+    plot.add_argument("--title", help="figure title (default: the case name)")
+    plot.add_argument("-q", "--quiet", action="store_true", help="print nothing")
+    plot.set_defaults(func=cmd_plot)
+
+    # --- export ---------------------------------------------------------------------------
+    export = sub.add_parser("export", help="export a stored run to CSV, NPZ or NetCDF",
+                            description=EXPORT_HELP, formatter_class=raw)
+    export.add_argument("run", metavar="RUN.h5", help="stored run (pdeflow run --store)")
+    export.add_argument("out", metavar="OUT.csv",
+                        help="output file: .csv, .npz or .nc (NetCDF, needs xarray)")
+    export.add_argument("-q", "--quiet", action="store_true", help="print nothing")
+    export.set_defaults(func=cmd_export)
+
+    # --- sweep, converge, compare ---------------------------------------------------------
+    from . import sweep as sweep_mod
+    from .analysis import convergence
+
+    sw = sub.add_parser("sweep", help="aspect-ratio sweep and run-out law (paper 5.2)",
+                        description=sweep_mod.__doc__, formatter_class=raw)
+    sweep_mod.add_arguments(sw)
+    sw.set_defaults(func=sweep_mod.cmd_sweep)
+    cv = sub.add_parser("converge", help="grid-convergence study of a case",
+                        description=convergence.__doc__, formatter_class=raw)
+    convergence.add_arguments(cv)
+    cv.set_defaults(func=convergence.cmd_converge)
+    cp = sub.add_parser("compare", help="work-precision comparison of solver variants",
+                        description="Runs every variant on a sequence of grids against an "
+                        "exact solution or a fine-grid reference; writes a work-precision "
+                        "diagram and table (pdeflow.analysis.workprecision).",
+                        formatter_class=raw)
+    cp.add_argument("args", nargs=argparse.REMAINDER,
+                    help="CASE.toml|ritter|mangeney [--variants V ...] [--grids N|DX ...] "
+                    "[--reference auto|exact|fine|fine:VARIANT] [--out-dir DIR] ...")
+    cp.set_defaults(func=cmd_compare)
     return parser
+
+
+def cmd_compare(args: argparse.Namespace) -> int:
+    """Forward to :func:`pdeflow.analysis.workprecision.main` (its own options)."""
+    from .analysis import workprecision
+
+    return int(workprecision.main(list(args.args)) or 0)
 
 
 def main(argv: list[str] | None = None) -> int:
     from .cases import CaseError
+    from .storage import StorageError
 
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["compare"]:
+        # the work-precision harness parses its own options (and its own --help)
+        from .analysis import workprecision
+
+        return int(workprecision.main(argv[1:]) or 0)
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except CaseError as err:
+    except (CaseError, StorageError) as err:
+        print(f"pdeflow: error: {err}", file=sys.stderr)
+        return 2
+    except ValueError as err:
+        from .trackers.live import MovieError
+
+        if not isinstance(err, MovieError):
+            raise
         print(f"pdeflow: error: {err}", file=sys.stderr)
         return 2
 

@@ -84,3 +84,24 @@ def test_cli_bad_override_is_a_clean_error(tmp_path, capsys):
     assert rc == 2
     assert "k must lie in" in capsys.readouterr().err
     assert not (tmp_path / "s.json").exists()
+
+
+def test_cli_sweep_converge_compare(tmp_path):
+    out = tmp_path / "sweep.json"
+    rc = main(["sweep", str(ROOT / "cases" / "collapse_sweep.toml"), "--set", "grid.dx=0.02",
+               "--set", "sweep.aspect_ratios=[2, 6]", "--summary", str(out), "-q"])
+    assert rc == 0
+    data = json.loads(out.read_text())
+    for model in ("two_layer", "single_layer"):
+        m = data["models"][model]
+        assert len(m["points"]) == 2 and m["exponent"] > 0 and m["prefactor"] > 0
+    conv = tmp_path / "conv.json"
+    rc = main(["converge", str(CASE), "--levels", "2", "--model", "single_layer",
+               "--set", "case.models=['single_layer']", "--set", "grid.dx=0.1",
+               "--summary", str(conv)])
+    assert rc == 0
+    assert len(json.loads(conv.read_text())["levels"]) == 2
+    rc = main(["compare", "ritter", "--variants", "hll/first-order", "--grids", "50", "100",
+               "--out-dir", str(tmp_path / "wp"), "--quiet", "--repeats", "1"])
+    assert rc == 0
+    assert (tmp_path / "wp" / "ritter_workprecision.png").stat().st_size > 1000

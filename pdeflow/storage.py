@@ -1,0 +1,503 @@
+"""Stored runs: py-pde ``FileStorage`` (HDF5) with F_extra and metadata, reopening, export.
+
+Writing (``pdeflow run CASE --store out.h5 [--store-every DT]``, or in Python)::
+
+    from pdeflow.storage import RunStorageTracker, open_run, run_metadata
+    tracker = RunStorageTracker("out.h5", interrupts=0.05,
+                                metadata=run_metadata(case, "two_layer"))
+    run_model(case, "two_layer", tracker=tracker)          # or eq.solve(..., tracker=...)
+    run = open_run("out.h5")                                # -> StoredRun
+    run.times, run.x, run.profiles(-1)["h1"], run.metadata["parameters"]
+    run.to_csv("out.csv"); run.to_netcdf("out.nc")          # NetCDF needs xarray
+
+Each stored frame is a py-pde ``FieldCollection`` of the state (h1, h1u1, h2, h2u2 or
+h, hu; depths in m, discharges in m^2/s) followed by the field ``fextra_over_rho1``
+[m^2/s^2] read from the ``fv-split`` solver's post-step data (zeros for other solvers
+and for one layer). Frames are taken at the tracker's interrupts (simulation time, s)
+and once more at the end of the run (the rest time when the solver stops at rest).
+The file is therefore also readable with plain py-pde: ``pde.FileStorage(path)``.
+
+Metadata (JSON in the HDF5 attribute ``pdeflow``): the format tag, pdeflow and py-pde
+versions, case name, file and data (all sections, after overrides), the overrides,
+the model, its variant, its parameters, and at the end t_final, the stop reason and
+(when written by the CLI) the run's summary.
+
+Files are complete or absent: the run writes to a temporary name next to the target
+(``.NAME.XXXX.part.h5``) and renames it once the run has finished; a run that fails
+leaves no file behind. HDF5 needs ``h5py`` (``pip install 'pdeflow[storage]'``).
+"""
+
+from __future__ import annotations
+
+import datetime
+import json
+import math
+import os
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pde.trackers.base import InfoDict, TrackerBase
+
+from .numerics import layout as L
+
+FORMAT = "pdeflow-run/1"
+FEXTRA_LABEL = "fextra_over_rho1"
+STATE_LABELS = {"two_layer": ("h1", "h1u1", "h2", "h2u2"), "single_layer": ("h", "hu")}
+UNITS = {"h1": "m", "h2": "m", "h": "m", "u1": "m/s", "u2": "m/s", "u": "m/s",
+         "h1u1": "m^2/s", "h2u2": "m^2/s", "hu": "m^2/s", FEXTRA_LABEL: "m^2/s^2",
+         "x": "m", "t": "s"}
+DRY = 1e-12
+
+
+class StorageError(ValueError):
+    """A stored run that cannot be written or read; the message names the file."""
+
+
+def require_h5py() -> None:
+    """Raise StorageError with the install hint if h5py is missing."""
+    try:
+        import h5py  # noqa: F401
+    except ImportError:  # pragma: no cover - h5py is installed with the test extra
+        raise StorageError("storing runs in HDF5 needs h5py: "
+                           "pip install 'pdeflow[storage]'") from None
+
+
+def jsonable(value: Any) -> Any:
+    """``value`` with numpy scalars/arrays and tuples turned into JSON types."""
+    if isinstance(value, dict):
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return jsonable(value.tolist())
+    if isinstance(value, np.generic):
+        return jsonable(value.item())
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, Path):
+        return str(value)
+    return value
+
+
+# --- helpers shared with the live plots ---------------------------------------------------
+class PendingFile:
+    """A file written under a temporary name next to ``path`` and renamed on commit.
+
+    The temporary name keeps the suffix (``.NAME.XXXX.part.SUFFIX``), so that writers
+    that choose a format by the file name (movies) still do so.
+    """
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.",
+                                   suffix=f".part{self.path.suffix}", dir=self.path.parent)
+        os.close(fd)
+        self.tmp = Path(tmp)
+        self.done = False
+
+    def commit(self) -> Path:
+        """Rename the temporary file onto the target; return the target.
+
+        The file gets the permissions of a file created normally (mkstemp makes
+        temporary files private to the user).
+        """
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(self.tmp, 0o666 & ~umask)
+        os.replace(self.tmp, self.path)
+        self.done = True
+        return self.path
+
+    def discard(self) -> None:
+        """Remove the temporary file (the target is left as it was)."""
+        self.tmp.unlink(missing_ok=True)
+        self.done = True
+
+    def __enter__(self) -> Path:
+        return self.tmp
+
+    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
+        if exc_type is None:
+            self.commit()
+        else:
+            self.discard()
+
+
+def fextra_over_rho1(info: InfoDict | None, n: int) -> np.ndarray:
+    """F_extra/rho1 per cell [m^2/s^2] of the last step, from the solver's post-step
+    data in the simulation ``info`` (as :class:`pdeflow.trackers.SnapshotTracker`
+    reads it); zeros if the solver keeps none (py-pde solvers, one layer)."""
+    diag = None if info is None else info.get("solver", {}).get("post_step_data")
+    if isinstance(diag, np.ndarray) and diag.size == L.N_DIAG + n:
+        return diag[L.N_DIAG:].copy()
+    return np.zeros(n)
+
+
+def final_time(info: InfoDict | None) -> float | None:
+    """End time [s] of a run from the controller's diagnostics: the rest time if the
+    ``fv-split`` solver stopped at rest, else the controller's final time."""
+    if not info:
+        return None
+    rest = info.get("solver", {}).get("rest_time")
+    if rest is not None:
+        return float(rest)
+    t = info.get("controller", {}).get("t_final")
+    return None if t is None else float(t)
+
+
+def model_of(field_or_rows: Any) -> str:
+    """'two_layer' for 4 state rows, 'single_layer' for 2."""
+    rows = getattr(field_or_rows, "data", field_or_rows).shape[0]
+    if rows == 4:
+        return "two_layer"
+    if rows == 2:
+        return "single_layer"
+    raise ValueError(f"a granular state has 2 or 4 fields, got {rows}")
+
+
+def _variant_parts(case: Any, eq: Any) -> list[str]:
+    """What distinguishes this run's numerics and closure from the paper's defaults:
+    the PDE's scheme (``eq.variant``, e.g. 'hll/first-order'), the splitting, and for
+    two layers the exchange closure and the hyperbolicity mode."""
+    num = case.data.get("numerics", {})
+    parts = [case.solver]
+    if getattr(eq, "variant", None):
+        parts.append(str(eq.variant))
+    else:
+        parts += [f"{k}={num[k]}" for k in ("flux", "reconstruction", "limiter") if k in num]
+    splitting = getattr(case, "splitting", num.get("splitting"))
+    if splitting and case.solver == "fv-split":
+        parts.append(f"{splitting} splitting")
+    params = eq.parameters.to_dict()
+    for key in ("exchange_closure", "hyperbolicity"):
+        if key in params and getattr(eq, "two_layer", False):
+            parts.append(f"{key}={params[key]}")
+    return parts
+
+
+def run_metadata(case: Any, model: str, *, overrides: Sequence[str] = (),
+                 case_file: str | None = None, **extra: Any) -> dict[str, Any]:
+    """Metadata of one model run of a :class:`pdeflow.cases.Case` for the stored file."""
+    from . import __version__
+
+    eq = case.make_pde(model)
+    variant = ", ".join([model, *_variant_parts(case, eq)])
+    meta = {
+        "case_name": case.name,
+        "case_file": case_file if case_file is not None else case.source,
+        "case": case.data,
+        "overrides": list(overrides),
+        "model": model,
+        "variant": variant,
+        "parameters": eq.parameters.to_dict(),
+        "solver": case.solver,
+        "cfl": case.cfl,
+        "boundaries": list(case.bc),
+        "dx": case.dx,
+        "pdeflow_version": __version__,
+    }
+    meta.update(extra)
+    return jsonable(meta)
+
+
+# --- writing ------------------------------------------------------------------------------
+class RunStorageTracker(TrackerBase):
+    """py-pde tracker writing a run to an HDF5 file through py-pde's ``FileStorage``.
+
+    Args:
+        path: the HDF5 file to create (replaced only once the run has finished).
+        interrupts: when to store, in simulation time: a number is an interval [s]
+            (starting at t = 0), a list gives the times; anything py-pde accepts.
+        metadata: JSON-able run description (see :func:`run_metadata`).
+        autocommit: rename the file into place when the run finishes; with False, call
+            :meth:`commit` (which can add metadata such as the summary) or
+            :meth:`discard`.
+        compression: gzip the datasets.
+
+    py-pde does not finalize trackers when a run raises (a blow-up, a failing tracker):
+    call :meth:`discard` then, as ``pdeflow run`` does, to remove the temporary file.
+    """
+
+    def __init__(self, path: str | Path, interrupts: Any = 0.05, *,
+                 metadata: dict[str, Any] | None = None, autocommit: bool = True,
+                 compression: bool = True):
+        super().__init__(interrupts=interrupts)
+        self.path = Path(path)
+        self.metadata = dict(metadata or {})
+        self.autocommit = autocommit
+        self.compression = compression
+        self._pending: PendingFile | None = None
+        self._storage: Any = None
+        self._info: InfoDict | None = None
+        self._field: Any = None
+        self._labels: tuple[str, ...] = ()
+        self.last_time = -math.inf
+        self.frames = 0
+
+    def _collection(self, state: Any, fex: np.ndarray) -> Any:
+        from pde import FieldCollection, ScalarField
+
+        grid = state.grid
+        fields = [ScalarField(grid, state.data[k].copy(), label=name)
+                  for k, name in enumerate(self._labels)]
+        fields.append(ScalarField(grid, fex, label=FEXTRA_LABEL))
+        return FieldCollection(fields)
+
+    def initialize(self, field: Any, info: InfoDict | None = None) -> float:
+        from pde import FileStorage
+
+        require_h5py()
+        self._info = info
+        self._field = field
+        model = model_of(field)
+        self._labels = STATE_LABELS[model]
+        meta = {"format": FORMAT, "model": model, **self.metadata}
+        import pde
+
+        from . import __version__
+        meta.setdefault("pdeflow_version", __version__)
+        meta["py_pde_version"] = pde.__version__
+        meta["created"] = datetime.datetime.now(datetime.timezone.utc).isoformat(
+            timespec="seconds")
+        meta["fields"] = [*self._labels, FEXTRA_LABEL]
+        meta["units"] = {k: UNITS[k] for k in meta["fields"]}
+        self._pending = PendingFile(self.path)
+        self._storage = FileStorage(self._pending.tmp, info={"pdeflow": jsonable(meta)},
+                                    write_mode="truncate_once",
+                                    compression=self.compression)
+        n = field.grid.shape[0]
+        self._storage.start_writing(self._collection(field, np.zeros(n)))
+        return super().initialize(field, info)
+
+    def handle(self, field: Any, t: float) -> None:
+        self._field = field
+        fex = fextra_over_rho1(self._info, field.grid.shape[0])
+        self._storage.append(self._collection(field, fex), time=float(t))
+        self.last_time = float(t)
+        self.frames += 1
+
+    def finalize(self, info: InfoDict | None = None) -> None:
+        super().finalize(info)
+        if self._storage is None:
+            return
+        info = info or {}
+        t_end = final_time(info)
+        state = info.get("last_state", self._field)
+        if state is not None and t_end is not None and t_end > self.last_time + 1e-12:
+            self.handle(state, t_end)
+        controller = info.get("controller", {})
+        self._storage.info["pdeflow"].update(jsonable({
+            "t_final": t_end,
+            "stop_reason": controller.get("stop_reason"),
+            "successful": controller.get("successful"),
+            "at_rest": "rest_time" in info.get("solver", {}),
+            "frames": self.frames,
+        }))
+        self._storage.end_writing()
+        self._storage.close()
+        if self.autocommit:
+            self.commit()
+
+    def commit(self, extra: dict[str, Any] | None = None) -> Path:
+        """Add ``extra`` to the metadata, then rename the file into place."""
+        if self._pending is None or self._pending.done:
+            raise StorageError(f"{self.path}: nothing to commit (no run written)")
+        if extra:
+            import h5py
+
+            with h5py.File(self._pending.tmp, "r+") as fh:
+                meta = json.loads(fh.attrs["pdeflow"])
+                meta.update(jsonable(extra))
+                fh.attrs["pdeflow"] = json.dumps(meta)
+        return self._pending.commit()
+
+    def discard(self) -> None:
+        """Abandon the run's file (used when a run fails): nothing is left behind."""
+        if self._storage is not None:
+            try:
+                self._storage.close()
+            except Exception:  # pragma: no cover - closing a broken file
+                pass
+        if self._pending is not None and not self._pending.done:
+            self._pending.discard()
+
+
+# --- reading ------------------------------------------------------------------------------
+@dataclass
+class StoredRun:
+    """A stored run loaded into memory (see :func:`open_run`)."""
+
+    path: Path
+    times: np.ndarray
+    """stored times [s], shape (nt,)"""
+    x: np.ndarray
+    """cell centres [m], shape (n,)"""
+    data: np.ndarray
+    """state rows per time, shape (nt, 4 or 2, n): h1, h1u1, h2, h2u2 or h, hu"""
+    fextra: np.ndarray
+    """F_extra/rho1 per time and cell [m^2/s^2], shape (nt, n)"""
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def model(self) -> str:
+        return self.metadata.get("model") or model_of(self.data[0])
+
+    @property
+    def two_layer(self) -> bool:
+        return self.model == "two_layer"
+
+    @property
+    def label(self) -> str:
+        """File name and model, for legends."""
+        return f"{self.path.name} ({self.model.replace('_', ' ')})"
+
+    def index(self, t: float | None = None) -> int:
+        """Index of the stored time nearest to t [s] (None: the last one)."""
+        if t is None:
+            return len(self.times) - 1
+        return int(np.argmin(np.abs(self.times - float(t))))
+
+    def profiles(self, i: int) -> dict[str, np.ndarray]:
+        """Depths [m], velocities [m/s] and F_extra/rho1 [m^2/s^2] of frame i."""
+        d = self.data[i]
+        names = ("h1", "u1", "h2", "u2") if self.two_layer else ("h", "u")
+        out: dict[str, np.ndarray] = {}
+        for k in range(0, d.shape[0], 2):
+            h = d[k]
+            out[names[k]] = h.copy()
+            out[names[k + 1]] = np.where(h > DRY, d[k + 1] / np.where(h > DRY, h, 1), 0.0)
+        if self.two_layer:
+            out[FEXTRA_LABEL] = self.fextra[i].copy()
+        return out
+
+    def columns(self) -> list[str]:
+        """Names of the exported quantities (after t and x)."""
+        return (["h1", "u1", "h2", "u2", FEXTRA_LABEL] if self.two_layer else ["h", "u"])
+
+    def table(self) -> np.ndarray:
+        """Long table: one row per (time, cell), columns t, x, then :meth:`columns`."""
+        nt, n = len(self.times), self.x.size
+        cols = [np.repeat(self.times, n), np.tile(self.x, nt)]
+        per = [self.profiles(i) for i in range(nt)]
+        for name in self.columns():
+            cols.append(np.concatenate([p[name] for p in per]))
+        return np.column_stack(cols)
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write the long table as CSV (header t,x,...; units in docs/user_guide.md)."""
+        header = ",".join(["t", "x", *self.columns()])
+        with PendingFile(path) as tmp:
+            np.savetxt(tmp, self.table(), delimiter=",", header=header, comments="",
+                       fmt="%.10g")
+        return Path(path)
+
+    def to_npz(self, path: str | Path) -> Path:
+        """Write t, x and each quantity as a (nt, n) array, plus the metadata as JSON."""
+        arrays: dict[str, np.ndarray] = {"t": self.times, "x": self.x}
+        per = [self.profiles(i) for i in range(len(self.times))]
+        for name in self.columns():
+            arrays[name] = np.stack([p[name] for p in per])
+        arrays["metadata_json"] = np.array(json.dumps(self.metadata))
+        with PendingFile(path) as tmp, tmp.open("wb") as fh:
+            np.savez(fh, **arrays)
+        return Path(path)
+
+    def to_xarray(self) -> Any:
+        """An ``xarray.Dataset`` with dimensions (t, x); needs xarray."""
+        try:
+            import xarray as xr
+        except ImportError:
+            raise StorageError("exporting to xarray/NetCDF needs xarray: "
+                               "pip install 'pdeflow[export]'") from None
+        per = [self.profiles(i) for i in range(len(self.times))]
+        data_vars = {name: (("t", "x"), np.stack([p[name] for p in per]),
+                            {"units": UNITS[name]}) for name in self.columns()}
+        attrs = {"pdeflow_metadata": json.dumps(self.metadata),
+                 "model": self.model, "source": str(self.path)}
+        for key in ("case_name", "pdeflow_version", "variant"):
+            if self.metadata.get(key) is not None:
+                attrs[key] = str(self.metadata[key])
+        return xr.Dataset(data_vars,
+                          coords={"t": ("t", self.times, {"units": "s"}),
+                                  "x": ("x", self.x, {"units": "m"})},
+                          attrs=attrs)
+
+    def to_netcdf(self, path: str | Path) -> Path:
+        """Write :meth:`to_xarray` as NetCDF (engine chosen by xarray)."""
+        ds = self.to_xarray()
+        with PendingFile(path) as tmp:
+            ds.to_netcdf(tmp)
+        return Path(path)
+
+    def export(self, path: str | Path) -> Path:
+        """Export by suffix: .csv, .npz, .nc (NetCDF, needs xarray)."""
+        suffix = Path(path).suffix.lower()
+        if suffix == ".csv":
+            return self.to_csv(path)
+        if suffix == ".npz":
+            return self.to_npz(path)
+        if suffix in (".nc", ".nc4", ".netcdf"):
+            return self.to_netcdf(path)
+        raise StorageError(f"{path}: unknown export format {suffix!r}; "
+                           "use .csv, .npz or .nc")
+
+
+def open_storage(path: str | Path) -> Any:
+    """The stored run as a read-only py-pde ``FileStorage`` (for py-pde's own tools)."""
+    from pde import FileStorage
+
+    require_h5py()
+    path = Path(path)
+    if not path.is_file():
+        raise StorageError(f"stored run {path} does not exist")
+    import h5py
+
+    if not h5py.is_hdf5(path):
+        raise StorageError(f"{path}: not an HDF5 file (stored runs are written by "
+                           "pdeflow run --store)")
+    try:
+        storage = FileStorage(path, write_mode="readonly")
+        _ = storage.times  # fails if the file is no py-pde storage
+    except (OSError, KeyError) as err:
+        raise StorageError(f"{path}: not a readable HDF5 run file ({err})") from None
+    return storage
+
+
+def open_run(path: str | Path) -> StoredRun:
+    """Load a stored run (written by :class:`RunStorageTracker` or ``--store``).
+
+    Plain py-pde storages of a granular state (2 or 4 fields, no F_extra, no metadata)
+    are read as well.
+    """
+    path = Path(path)
+    storage = open_storage(path)
+    try:
+        times = np.array(storage.times[:], dtype=float)
+        data = np.array(storage.data[:], dtype=float)
+        grid = storage.grid
+        meta = dict(storage.info.get("pdeflow") or {})
+    except (OSError, KeyError, RuntimeError) as err:
+        raise StorageError(f"{path}: cannot read the stored run ({err})") from None
+    finally:
+        storage.close()
+    if times.size == 0 or data.ndim != 3 or grid is None:
+        raise StorageError(f"{path}: holds no frames of a 1D run")
+    x = np.asarray(grid.axes_coords[0], dtype=float)
+    rows = data.shape[1]
+    if meta.get("fields", [None])[-1] == FEXTRA_LABEL or rows in (3, 5):
+        state, fextra = data[:, :-1], data[:, -1]
+    else:
+        state, fextra = data, np.zeros((data.shape[0], data.shape[2]))
+    if state.shape[1] not in (2, 4):
+        raise StorageError(f"{path}: {rows} fields per frame is no granular run")
+    meta.setdefault("model", model_of(state[0]))
+    return StoredRun(path, times, x, state, fextra, meta)
+
+
+__all__ = ["FORMAT", "PendingFile", "RunStorageTracker", "StorageError", "StoredRun",
+           "final_time", "fextra_over_rho1", "open_run", "open_storage", "run_metadata"]

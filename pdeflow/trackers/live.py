@@ -1,0 +1,309 @@
+"""Live plots of a running simulation: a py-pde tracker, in a window, Jupyter or headless.
+
+:class:`LivePlotTracker` redraws, at its interrupts in *simulation* time, the two layers
+stacked on the bed (lower layer, upper layer, interface and free surface, filled), both
+velocities and F_extra/rho1, with the simulation time in the title (the figure is a
+:class:`pdeflow.plotting.RunFigure`). Where it shows the figure:
+
+* ``display="window"``: a desktop window (an interactive matplotlib backend such as
+  TkAgg or QtAgg), updated while the run goes (``pdeflow run CASE --live``);
+* ``display="jupyter"``: in a notebook, one output updated in place;
+* ``display="none"``: nowhere; with ``movie=`` and/or ``frames=`` it writes a movie
+  (``.mp4`` through ffmpeg, ``.gif`` through Pillow) or numbered PNG frames, which is
+  what a headless machine (``MPLBACKEND=Agg``) does (``--movie out.mp4``,
+  ``--frames DIR``);
+* ``display="auto"`` (default): "jupyter" under the inline backend, "window" under an
+  interactive backend, else "none".
+
+Example::
+
+    from pdeflow.trackers.live import LivePlotTracker
+    live = LivePlotTracker(0.02, title="5.1", movie="dam_break.mp4")
+    eq.solve(state, t_range=5, solver="fv-split", tracker=live)
+
+The last frame is the final state (the rest time if the run stopped at rest). Movies
+and frames are complete or absent: a movie is written under a temporary name and
+renamed when the run ends; :meth:`LivePlotTracker.discard` removes it if the run fails.
+Every interrupt makes the solver land exactly on that time, which shortens one step:
+results differ from a run without the tracker at the level of the discretisation error.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+import numpy as np
+from pde.trackers import ProgressTracker
+from pde.trackers.base import InfoDict, TrackerBase
+
+from ..plotting import RunFigure, Series
+from ..storage import PendingFile, fextra_over_rho1, final_time, model_of
+
+#: matplotlib backends that cannot show a window
+HEADLESS_BACKENDS = ("agg", "pdf", "ps", "svg", "pgf", "cairo", "template")
+
+
+class MovieError(ValueError):
+    """A movie that cannot be written (unknown format, no ffmpeg); names the file."""
+
+
+def display_mode(requested: str = "auto") -> str:
+    """Resolve ``'auto'`` to 'jupyter', 'window' or 'none' from the matplotlib backend."""
+    if requested not in ("auto", "window", "jupyter", "none"):
+        raise ValueError(f"display must be 'auto', 'window', 'jupyter' or 'none', got "
+                         f"{requested!r}")
+    if requested != "auto":
+        return requested
+    backend = matplotlib.get_backend().lower()
+    if "inline" in backend:
+        return "jupyter"
+    if backend in HEADLESS_BACKENDS or backend.endswith("backend_agg"):
+        return "none"
+    return "window"
+
+
+def ffmpeg_path() -> str | None:
+    """An ffmpeg executable: from imageio-ffmpeg if installed, else on PATH, else None."""
+    try:
+        import imageio_ffmpeg
+
+        return imageio_ffmpeg.get_ffmpeg_exe()
+    except (ImportError, RuntimeError):
+        return shutil.which("ffmpeg")
+
+
+def check_movie_path(path: str | Path) -> str:
+    """Return the writer kind ('ffmpeg' or 'pillow') for a movie file, or raise
+    :class:`MovieError` (before any computation) if it cannot be written here."""
+    suffix = Path(path).suffix.lower()
+    if suffix == ".gif":
+        return "pillow"
+    if suffix in (".mp4", ".m4v", ".mov", ".mkv", ".webm", ".avi"):
+        if ffmpeg_path() is None:
+            raise MovieError(f"{path}: writing {suffix} movies needs ffmpeg: "
+                             "pip install 'pdeflow[movie]' (imageio-ffmpeg), or write "
+                             "a .gif instead")
+        return "ffmpeg"
+    raise MovieError(f"{path}: unknown movie format {suffix!r}; use .mp4 or .gif")
+
+
+class MovieFile:
+    """Frames of a figure written to a movie through a matplotlib animation writer,
+    under a temporary name until :meth:`finish` (complete or absent)."""
+
+    def __init__(self, path: str | Path, fig: Any, *, fps: float = 10, dpi: int = 100):
+        from matplotlib import animation
+
+        self.path = Path(path)
+        kind = check_movie_path(self.path)
+        self._pending = PendingFile(self.path)
+        if kind == "ffmpeg":
+            matplotlib.rcParams["animation.ffmpeg_path"] = ffmpeg_path()
+            self._writer = animation.FFMpegWriter(fps=fps, codec="h264",
+                                                  extra_args=["-pix_fmt", "yuv420p"])
+        else:
+            self._writer = animation.PillowWriter(fps=fps)
+        self._fig = fig
+        self._writer.setup(fig, str(self._pending.tmp), dpi=dpi)
+        self.frames = 0
+
+    def grab(self) -> None:
+        """Append the figure as it is now."""
+        self._writer.grab_frame()
+        self.frames += 1
+
+    def finish(self) -> Path:
+        """Close the movie and rename it into place."""
+        self._writer.finish()
+        return self._pending.commit()
+
+    def discard(self) -> None:
+        """Stop the writer and remove the temporary file."""
+        if self._pending.done:
+            return
+        proc = getattr(self._writer, "_proc", None)
+        if proc is not None:
+            try:
+                proc.kill()
+                proc.wait()
+            except OSError:  # pragma: no cover
+                pass
+        self._pending.discard()
+
+
+class LivePlotTracker(TrackerBase):
+    """py-pde tracker drawing the run while it goes (see the module docstring).
+
+    Args:
+        interrupts: when to draw, in simulation time: an interval [s] (from t = 0),
+            a list of times, or anything py-pde accepts.
+        title: text before "t = ... s" in the figure title.
+        display: 'auto', 'window', 'jupyter' or 'none'.
+        movie: write the frames to this movie (.mp4 needs ffmpeg, .gif does not).
+        frames: write the frames as ``frame_00000.png``, ... into this directory.
+        fps: frames per second of the movie.
+        dpi: resolution of movie frames and PNG frames.
+        depth_max: upper depth limit of the plot [m] (default: from the initial state).
+        pause: seconds the window's event loop runs per frame (window display only).
+    """
+
+    def __init__(self, interrupts: Any = 0.05, *, title: str = "",
+                 display: str = "auto", movie: str | Path | None = None,
+                 frames: str | Path | None = None, fps: float = 10, dpi: int = 100,
+                 depth_max: float | None = None, pause: float = 1e-3):
+        super().__init__(interrupts=interrupts)
+        self.title = title
+        self.display = display_mode(display)
+        self.movie_path = None if movie is None else Path(movie)
+        if self.movie_path is not None:
+            check_movie_path(self.movie_path)
+        self.frames_dir = None if frames is None else Path(frames)
+        self.fps = float(fps)
+        self.dpi = int(dpi)
+        self.depth_max = depth_max
+        self.pause = float(pause)
+        self.figure: RunFigure | None = None
+        self.times: list[float] = []
+        self.frame_paths: list[Path] = []
+        self.movie: MovieFile | None = None
+        self._info: InfoDict | None = None
+        self._field: Any = None
+        self._handle: Any = None
+        self.last_time = -math.inf
+
+    # --- py-pde tracker interface ---------------------------------------------------------
+    def initialize(self, field: Any, info: InfoDict | None = None) -> float:
+        self._info = info
+        self._field = field
+        series = [Series(np.asarray(field.grid.axes_coords[0]), model_of(field))]
+        self.figure = RunFigure(series, title=self.title, depth_max=self.depth_max,
+                                pyplot=self.display == "window")
+        if self.frames_dir is not None:
+            self.frames_dir.mkdir(parents=True, exist_ok=True)
+        if self.movie_path is not None:
+            self.movie = MovieFile(self.movie_path, self.figure.fig, fps=self.fps,
+                                   dpi=self.dpi)
+        if self.display == "window":
+            import matplotlib.pyplot as plt
+
+            plt.show(block=False)
+        return super().initialize(field, info)
+
+    def handle(self, field: Any, t: float) -> None:
+        self._field = field
+        self.draw(field.data, float(t),
+                  fextra_over_rho1(self._info, field.grid.shape[0]))
+
+    def finalize(self, info: InfoDict | None = None) -> None:
+        super().finalize(info)
+        if self.figure is None:
+            return
+        info = info or {}
+        t_end = final_time(info)
+        state = info.get("last_state", self._field)
+        if state is not None and t_end is not None and t_end > self.last_time + 1e-12:
+            self.handle(state, t_end)
+        if self.movie is not None:
+            self.movie.finish()
+        if self.display != "window":
+            self.figure.close()
+
+    # --- drawing --------------------------------------------------------------------------
+    def draw(self, data: np.ndarray, t: float, fextra: np.ndarray | None = None) -> None:
+        """Redraw the figure with ``data`` at time t [s] and emit the frame."""
+        assert self.figure is not None, "initialize() first"
+        self.figure.update(t, [data], [fextra])
+        self.times.append(t)
+        self.last_time = t
+        fig = self.figure.fig
+        if self.display == "window":
+            import matplotlib.pyplot as plt
+
+            if plt.fignum_exists(fig.number):
+                fig.canvas.draw_idle()
+                fig.canvas.start_event_loop(self.pause)
+            # else: the user closed the window; the run goes on (movie/frames still)
+        elif self.display == "jupyter":
+            from IPython.display import Image, display
+
+            image = Image(data=self.figure.png(self.dpi), format="png")
+            if self._handle is None:
+                self._handle = display(image, display_id=True)
+            else:
+                self._handle.update(image)
+        if self.movie is not None:
+            self.movie.grab()
+        if self.frames_dir is not None:
+            path = self.frames_dir / f"frame_{len(self.frame_paths):05d}.png"
+            self.frame_paths.append(self.figure.save(path, dpi=self.dpi))
+
+    def discard(self) -> None:
+        """Abandon the movie of a failed run (no partial movie is left behind)."""
+        if self.movie is not None:
+            self.movie.discard()
+        if self.figure is not None and self.display != "window":
+            self.figure.close()
+
+
+class ProgressBar(ProgressTracker):
+    """py-pde's progress bar, updated at fixed *simulation* times (so that a run's
+    result does not depend on the wall clock), which says "at rest" and fills up when
+    the ``fv-split`` solver ends a run at rest before t_end.
+
+    Args:
+        interrupts: simulation time between updates [s] (or anything py-pde accepts).
+        label: text in front of the bar (e.g. the model).
+    """
+
+    def __init__(self, interrupts: Any = 0.05, *, label: str = "", **kwargs: Any):
+        super().__init__(interrupts=interrupts, **kwargs)
+        self.label = label
+
+    def handle(self, field: Any, t: float) -> None:
+        super().handle(field, t)
+        self.progress_bar.set_description(self.label)
+        self.progress_bar.set_postfix_str(f"t = {t:.4g} s", refresh=False)
+
+    def finalize(self, info: InfoDict | None = None) -> None:
+        TrackerBase.finalize(self, info)
+        info = info or {}
+        bar = self.progress_bar
+        rest = info.get("solver", {}).get("rest_time")
+        controller = info.get("controller", {})
+        t_final = controller.get("t_final", -math.inf)
+        if bar.total and (rest is not None
+                          or t_final >= controller.get("t_end", math.inf) - self.atol):
+            bar.n = bar.total
+        if rest is not None:
+            bar.set_postfix_str(f"at rest at t = {rest:.4g} s", refresh=False)
+        elif not controller.get("successful", True):
+            bar.set_postfix_str(f"stopped at t = {t_final:.4g} s", refresh=False)
+        bar.set_description(self.label, refresh=False)
+        bar.close()
+
+
+def replay(frames: list[tuple[float, list[np.ndarray | None], list[np.ndarray | None]]],
+           series: list[Series], path: str | Path, *, title: str = "", fps: float = 10,
+           dpi: int = 100) -> Path:
+    """Write a movie of given frames (t, states, fextras) of one or more runs."""
+    fig = RunFigure(series, title=title)
+    movie = MovieFile(path, fig.fig, fps=fps, dpi=dpi)
+    try:
+        for t, states, fextras in frames:
+            fig.update(t, states, fextras)
+            movie.grab()
+        out = movie.finish()
+    except BaseException:
+        movie.discard()
+        raise
+    finally:
+        fig.close()
+    return out
+
+
+__all__ = ["LivePlotTracker", "MovieError", "MovieFile", "ProgressBar", "check_movie_path",
+           "display_mode", "ffmpeg_path", "replay"]

@@ -1,0 +1,74 @@
+"""The teaching notebooks in docs/ execute from top to bottom (so they never rot).
+
+Each notebook checks its own results with ``assert`` statements; a failing cell fails
+the test. Needs the ``test`` extra (nbclient, nbformat, ipykernel, ipywidgets); the test
+is skipped, not failed, when those are missing or a Jupyter kernel cannot start here.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+import pytest
+
+nbformat = pytest.importorskip("nbformat")
+nbclient = pytest.importorskip("nbclient")
+pytest.importorskip("ipykernel")
+
+DOCS = Path(__file__).parents[1] / "docs"
+NOTEBOOKS = sorted(DOCS.glob("*.ipynb"))
+#: each notebook runs in seconds once the numba kernels are cached (a first run compiles
+#: them, which can take a minute or two); this limit only catches run-away cells
+TIME_LIMIT_S = 300
+
+
+def _kernel_env() -> dict[str, str]:
+    """The test's environment without a forced matplotlib backend (e.g. Agg), so that
+    the kernel uses its inline backend as in a real notebook, and with the notebooks'
+    sliders off: a cell that displays ipywidgets sometimes blocks nbclient until its
+    timeout (jupyter/nbclient#312); the notebooks then call the same functions once
+    with their default values."""
+    env = dict(os.environ)
+    env.pop("MPLBACKEND", None)
+    env["PDEFLOW_NO_WIDGETS"] = "1"
+    return env
+
+
+@pytest.fixture(scope="module")
+def kernel_available() -> None:
+    from jupyter_client.manager import start_new_kernel
+
+    try:
+        km, kc = start_new_kernel(kernel_name="python3", startup_timeout=60,
+                                  env=_kernel_env())
+    except Exception as err:  # no kernelspec, no zmq, sandbox without sockets, ...
+        pytest.skip(f"no Jupyter kernel can start here: {err!r}")
+    kc.stop_channels()
+    km.shutdown_kernel(now=True)
+
+
+def test_there_are_teaching_notebooks():
+    names = {p.stem for p in NOTEBOOKS}
+    assert {"anatomy_two_layer_dam_break", "hyperbolicity_and_fextra",
+            "single_vs_two_layers_runout"} <= names
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
+def test_notebook_executes(path, kernel_available):
+    nb = nbformat.read(path, as_version=4)
+    code = "\n".join(c.source for c in nb.cells if c.cell_type == "code")
+    assert "assert " in code, "a notebook must check its results"
+    assert all(not c.get("outputs") for c in nb.cells if c.cell_type == "code"), \
+        "store notebooks without outputs (they are produced when run)"
+    client = nbclient.NotebookClient(nb, timeout=TIME_LIMIT_S, kernel_name="python3",
+                                     resources={"metadata": {"path": str(DOCS)}})
+    t0 = time.perf_counter()
+    client.execute(env=_kernel_env())  # raises CellExecutionError on a failing cell
+    elapsed = time.perf_counter() - t0
+    assert elapsed < TIME_LIMIT_S, f"{path.name} took {elapsed:.0f} s"
+    outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.outputs]
+    assert not [o for o in outputs if o.output_type == "error"]
+    images = [o for o in outputs if "image/png" in o.get("data", {})]
+    assert images, "the notebook should show figures"
