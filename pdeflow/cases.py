@@ -73,6 +73,16 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
 SHAPES = ("column", "dam_break", "heap", "file")
 
 
+def solver_names() -> list[str]:
+    """Names accepted as ``numerics.solver``: fv-split and py-pde's registered solvers."""
+    import pde.solvers
+
+    from . import solvers  # noqa: F401 - registers fv-split
+
+    names = [n for n in pde.solvers.registered_solvers() if not n.endswith("Solver")]
+    return sorted(names, key=lambda n: (n != "fv-split", n))
+
+
 class CaseError(ValueError):
     """An invalid case file or override; the message names the key and the file."""
 
@@ -147,6 +157,7 @@ class Case:
                 if isinstance(value, bool) or not isinstance(value, allowed[key]):
                     names = " or ".join(t.__name__ for t in allowed[key])
                     raise self._err(f"{section}.{key} must be {names}, got {value!r}")
+                self._check_finite(f"{section}.{key}", value)
         for name, cls in (("two_layer", TwoLayerParameters),
                           ("single_layer", SingleLayerParameters)):
             try:
@@ -161,8 +172,12 @@ class Case:
             check_range("case.t_end", self.t_end, 0, math.inf, low_open=True, unit="s")
             check_range("grid.length", self.length, 0, math.inf, low_open=True,
                         unit="m")
+            self._check_cells()
             check_range("grid.dx", self.dx, 0, self.length, low_open=True, unit="m")
             check_range("numerics.cfl", self.cfl, 0, 1, low_open=True)
+            if "dt" in self.data.get("numerics", {}):
+                check_range("numerics.dt", self.data["numerics"]["dt"], 0, math.inf,
+                            low_open=True, unit="s")
             for t in self.snapshot_times:
                 check_range("output.snapshot_times", t, 0, self.t_end, unit="s")
             check_range("output.front_threshold", self.front_threshold, 0, math.inf,
@@ -176,6 +191,10 @@ class Case:
                 raise self._err(f"boundaries.{side} must be 'wall' or 'open', got {bc!r}")
         if "initial" not in self.data or "shape" not in self.data["initial"]:
             raise self._err("[initial] with a 'shape' is required")
+        solvers = solver_names()
+        if self.solver not in solvers:
+            raise self._err(f"numerics.solver must be one of {solvers}, got "
+                            f"{self.solver!r}")
         if self.splitting not in ("lie", "strang"):
             raise self._err(f"numerics.splitting must be 'lie' or 'strang', got "
                             f"{self.splitting!r}")
@@ -185,6 +204,31 @@ class Case:
             raise self._err(f"initial.shape must be one of {list(SHAPES)}, got "
                             f"{self.initial['shape']!r}")
         self._check_initial()
+
+    def _check_finite(self, key: str, value: Any) -> None:
+        """Numbers (also inside lists) must be finite: TOML allows nan and inf."""
+        items = value if isinstance(value, list) else [value]
+        for v in items:
+            if isinstance(value, list) and key == "output.snapshot_times" and (
+                    isinstance(v, bool) or not isinstance(v, (int, float))):
+                raise self._err(f"{key} must be a list of numbers [s], got {v!r}")
+            if isinstance(v, float) and not math.isfinite(v):
+                raise self._err(f"{key} must be a finite number, got {v!r}")
+
+    def _check_cells(self) -> None:
+        """grid.cells >= 1 (it wins over grid.dx); grid.dx must divide grid.length."""
+        grid = self.data.get("grid", {})
+        if "cells" in grid:
+            if grid["cells"] < 1:
+                raise ValueError(f"grid.cells must be an integer >= 1, got "
+                                 f"{grid['cells']!r}")
+        elif "dx" in grid and self.dx > 0:
+            n = self.length / self.dx
+            if abs(n - round(n)) > 1e-9 * n:
+                raise ValueError(
+                    f"grid.dx = {self.dx:g} m does not divide grid.length = "
+                    f"{self.length:g} m into whole cells ({n:.6g}); use a dx in "
+                    f"(0, {self.length:g}] m with length/dx an integer, or grid.cells")
 
     def _check_initial(self) -> None:
         ini = self.initial

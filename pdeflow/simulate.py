@@ -78,6 +78,11 @@ def run_model(case: Case, model: str, *, tracker: Any = None,
     final, info = eq.solve(state, t_range=case.t_end, solver=solver, tracker=trackers,
                            ret_info=True, **kwargs)
     wall = time.perf_counter() - wall0
+    if str(info.get("controller", {}).get("stop_reason", "")).startswith("User interrupted"):
+        # py-pde turns Ctrl-C into a normal return; a truncated run must not be written
+        # out as if it were complete
+        raise KeyboardInterrupt(f"{model} run of {case.name} interrupted at "
+                                f"t={info['controller'].get('t_final')}")
     sinfo = info.get("solver", {})
     diag = sinfo.get("post_step_data")
     diag = diag if isinstance(diag, np.ndarray) else None

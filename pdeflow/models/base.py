@@ -29,7 +29,13 @@ RECONSTRUCTIONS = {"first-order": 1, "muscl": 2}
 
 def check_range(name: str, value: Any, low: float, high: float, *,
                 low_open: bool = False, high_open: bool = False, unit: str = "") -> float:
-    """Return ``float(value)`` or raise ValueError naming the parameter and its range."""
+    """Return ``float(value)`` or raise ValueError naming the parameter and its range.
+
+    Only real numbers are accepted: strings (even ``"0.5"``) and booleans are rejected
+    as wrong types, NaN and inf as out of range.
+    """
+    if isinstance(value, (str, bytes, bool, np.bool_)):
+        raise ValueError(f"{name} must be a number, got {value!r}")
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -112,6 +118,11 @@ class GranularPDE(PDEBase):
         """State from depth and velocity profiles (names: h1, u1, h2, u2 or h, u)."""
         self.check_grid(grid)
         n = grid.shape[0]
+        known = [f"{p}{name[1:]}" for name in self.field_names[::2] for p in "hu"]
+        unknown = sorted(set(profiles) - set(known))
+        if unknown:
+            raise ValueError(f"unknown profile(s) {unknown} for {self.__class__.__name__}; "
+                             f"allowed: {known}")
         fields = []
         for k in range(0, len(self.field_names), 2):
             hname = self.field_names[k]
@@ -135,11 +146,19 @@ class GranularPDE(PDEBase):
         if state.data.shape[0] != len(self.field_names):
             raise ValueError(f"state must have {len(self.field_names)} fields "
                              f"{self.field_names}, got {state.data.shape[0]}")
-        if not np.all(np.isfinite(state.data)):
-            raise ValueError("state contains NaN or inf")
+        x = state.grid.axes_coords[0]
+        for k, name in enumerate(self.field_names):
+            bad = np.nonzero(~np.isfinite(state.data[k]))[0]
+            if bad.size:
+                raise ValueError(f"{name} must be finite (no NaN or inf), got "
+                                 f"{state.data[k, bad[0]]} in cell {bad[0]} "
+                                 f"(x={x[bad[0]]:g} m) and {bad.size - 1} more")
         for k in range(0, len(self.field_names), 2):
-            if np.any(state.data[k] < 0):
-                raise ValueError(f"{self.field_names[k]} must be >= 0 m")
+            bad = np.nonzero(state.data[k] < 0)[0]
+            if bad.size:
+                raise ValueError(f"{self.field_names[k]} must be >= 0 m, got "
+                                 f"{state.data[k, bad[0]]:g} in cell {bad[0]} "
+                                 f"(x={x[bad[0]]:g} m) and {bad.size - 1} more")
         return dx
 
     # --- rates ----------------------------------------------------------------------------
@@ -220,7 +239,12 @@ class GranularPDE(PDEBase):
         return source_stage_two_layer if self.two_layer else source_stage_single
 
     def make_post_step_hook(self, state: FieldCollection, backend: Any = "numpy"):
-        """Post-step hook applying the split source stage with dt = data[0]."""
+        """Post-step hook applying the split source stage with dt = data[0].
+
+        Every py-pde solver builds this hook before its first step, so the initial
+        state is validated here (:meth:`check_state`) whatever the solver.
+        """
+        self.check_state(state)
         P = self.parameter_array()
         kernel = self.source_kernel()
         name = getattr(backend, "name", str(backend))

@@ -90,12 +90,18 @@ def reconstruct(q: np.ndarray, work: np.ndarray, lo: int, hi: int, bc_left: int,
             else:
                 hr = h
                 ur = -u if bc_right == L.BC_WALL else u
-            sh = _limited(h - hl, hr - h, limiter)
-            if m == 0.0 and q[k + 1, max(i - 1, 0)] == 0.0 and \
-                    q[k + 1, min(i + 1, n - 1)] == 0.0:
-                su = 0.0  # at rest with its neighbours: keep u = 0 on both faces
+            if hl <= dry or hr <= dry:
+                # next to a dry cell (a front or a heap's edge): first order, so that the
+                # face depth weighting the hydrostatic jump is the cell's own depth
+                sh = 0.0
+                su = 0.0
             else:
-                su = _limited(u - ul, ur - u, limiter)
+                sh = _limited(h - hl, hr - h, limiter)
+                if m == 0.0 and q[k + 1, max(i - 1, 0)] == 0.0 and \
+                        q[k + 1, min(i + 1, n - 1)] == 0.0:
+                    su = 0.0  # at rest with its neighbours: keep u = 0 on both faces
+                else:
+                    su = _limited(u - ul, ur - u, limiter)
             hm = h - 0.5 * sh
             hp = h + 0.5 * sh
             work[0, k, i] = hm

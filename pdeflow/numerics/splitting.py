@@ -336,7 +336,14 @@ def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int
         smax = _rate(q, rate, rec, dx, bc_left, bc_right, P, two_layer, flux, order,
                      limiter)
         dt = t_end - t
-        if smax > 0.0:
+        if strang:
+            # the first half source step may accelerate a layer by up to dt/2 |g_x|
+            # (friction only brakes): choose dt with dt (smax + dt |g_x| / 2) = cfl dx
+            gx = abs(P[L.G_X])
+            den = smax + math.sqrt(smax * smax + 2.0 * gx * cfl * dx)
+            if den > 0.0:
+                dt = min(dt, 2.0 * cfl * dx / den)
+        elif smax > 0.0:
             dt = min(dt, cfl * dx / smax)
         t_new = t + dt if dt < t_end - t else t_end
         changed = 0.0

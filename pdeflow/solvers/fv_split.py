@@ -5,7 +5,9 @@ state (recomputed every step), HLL advection (29), then the model's post-step ho
 (source stages (31)-(34)) with that time step. py-pde's controller, trackers and
 storage work unchanged; the solver ends the run itself (``FinishedSimulation``) once
 everything is at rest and unchanged, and refuses to write a state that is not finite
-or has negative depths (the last good state is kept and an error names time and step).
+or has negative depths: the run stops at once with :class:`SimulationBlowUp`, whose
+message names the time, the step, the cell and the state there, and the variant, and
+the last good state is kept (see :func:`diagnose_blowup`).
 
 With the numba backend the whole stepping loop between two tracker interrupts runs in
 one compiled, disk-cached kernel (:func:`pdeflow.numerics.splitting.advance_split`),
@@ -14,6 +16,8 @@ which calls the same source-stage kernel that the hook wraps.
 
 from __future__ import annotations
 
+import logging
+import types
 from typing import Any
 
 import numpy as np
@@ -22,11 +26,133 @@ from pde.trackers.base import FinishedSimulation
 
 from ..models.base import GranularPDE, check_range
 from ..numerics import layout as L
+from ..numerics import splitting as _splitting
 from ..numerics.splitting import STATUS_FAIL, STATUS_REST, advance_split
 
 
+class _RestProfilerFilter(logging.Filter):
+    """Drop py-pde's "more time on trackers than on the simulation" warning after a run
+    that fv-split ended at rest: the controller does not book the time of a stepper
+    call that ends the run (FinishedSimulation) as solver time, so the warning would be
+    wrong."""
+
+    ended_at_rest = False
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if self.ended_at_rest and record.getMessage().startswith("Spent more time"):
+            _RestProfilerFilter.ended_at_rest = False
+            return False
+        return True
+
+
+logging.getLogger("pde.solvers.controller").addFilter(_RestProfilerFilter())
+
+
 class SimulationBlowUp(FloatingPointError):
-    """Raised when a step produced a non-finite or negative state (state kept)."""
+    """Raised when a step produced a non-finite or negative state (state kept).
+
+    Attributes (None where unknown):
+        t: time at the start of the failed step [s] = time of the kept state.
+        step: number of the failed step (1 = the first step of the run).
+        cell: index of the offending cell; ``x`` its centre [m].
+        cell_state: the kept state in that cell, depths [m] and velocities [m/s].
+        variant: model, scheme, splitting, hyperbolicity mode and CFL number.
+        state: copy of the last good state data (fields x cells).
+        report: everything above plus dt [s], the failed values, the stage, the range
+            of bad cells (see :func:`diagnose_blowup`).
+    """
+
+    def __init__(self, message: str, *, report: dict[str, Any] | None = None,
+                 state: np.ndarray | None = None):
+        super().__init__(message)
+        self.report: dict[str, Any] = dict(report or {})
+        self.state = state
+        self.t: float | None = self.report.get("t")
+        self.step: int | None = self.report.get("step")
+        self.cell: int | None = self.report.get("cell")
+        self.x: float | None = self.report.get("x")
+        self.cell_state: dict[str, float] | None = self.report.get("cell_state")
+        self.variant: str | None = self.report.get("variant")
+
+
+def _cell_values(pde: GranularPDE, q: np.ndarray, i: int) -> dict[str, float]:
+    """Depths [m] and velocities [m/s] of the state ``q`` in cell ``i``."""
+    out: dict[str, float] = {}
+    for k in range(0, len(pde.field_names), 2):
+        h = float(q[k, i])
+        name = pde.field_names[k]
+        out[name] = h
+        with np.errstate(all="ignore"):
+            out["u" + name[1:]] = float(q[k + 1, i] / h) if h > 0 else 0.0
+    return out
+
+
+def _fmt_values(values: dict[str, float]) -> str:
+    return ", ".join(f"{k}={v:.6g}" for k, v in values.items())
+
+
+def diagnose_blowup(pde: GranularPDE, q_good: np.ndarray, t: float, t_end: float,
+                    replay: Any) -> dict[str, Any]:
+    """Find where and how the failed step from the kept state ``q_good`` went wrong.
+
+    ``replay(q, t, t_end, update)`` must take exactly one step of the solver's stepping
+    kernel from ``q`` (a copy) at time ``t`` [s], with its state updates performed by
+    ``update(q, base, rate, dt, weight)`` (the kernel's ``_update``: ``q <- weight base +
+    (1 - weight) (q + dt rate)``, returning ``(max |mass rate|, ok)``). The recording
+    update here repeats that arithmetic in numpy and keeps the update that failed, so the
+    step is recomputed exactly, stages and all, in plain Python.
+
+    Returns a dict with ``cell``, ``x`` [m], ``dt`` [s], ``stage`` (1: advection or
+    predictor, 2: corrector of SSP-RK2), ``failed`` (the failed values of all fields in
+    that cell), ``bad_cells`` (indices of all bad cells), ``cause`` (text); or only
+    ``cause`` if the kept state itself is bad (a source stage produced it) or the step
+    could not be replayed.
+    """
+    names = pde.field_names
+    bad_state = ~np.isfinite(q_good)
+    bad_state[::2] |= q_good[::2] < 0
+    if bad_state.any():
+        cells = np.nonzero(bad_state.any(axis=0))[0]
+        return {"cause": "the state before the step is not finite or has a negative "
+                         "depth (produced by a source stage)",
+                "cell": int(cells[0]), "bad_cells": cells.tolist(), "stage": 0,
+                "failed": {n: float(q_good[k, cells[0]]) for k, n in enumerate(names)}}
+    records: list[dict[str, Any]] = []
+
+    def update(q: np.ndarray, base: np.ndarray, rate: np.ndarray, dt: float,
+               weight: float) -> tuple[float, bool]:
+        with np.errstate(all="ignore"):
+            v = weight * base + (1.0 - weight) * (q + dt * rate)
+            bad = ~np.isfinite(v)
+            bad[::2] |= v[::2] < -1e-12 * (1.0 + np.abs(q[::2]))
+            mass_rate = float(np.max(np.abs(rate[::2]))) if rate.size else 0.0
+        records.append({"dt": float(dt), "after": v.copy(), "bad": bad})
+        q[...] = v
+        return mass_rate, not bool(bad.any())
+
+    try:
+        replay(q_good.copy(), t, t_end, update)
+    except Exception as err:  # pragma: no cover - diagnostics must not mask the blow-up
+        return {"cause": f"the failed step could not be replayed ({err!r})"}
+    failed = [(k, rec) for k, rec in enumerate(records) if rec["bad"].any()]
+    if not failed:
+        return {"cause": "the replayed step did not fail (non-deterministic failure?)"}
+    stage, rec = failed[0]
+    bad = rec["bad"]
+    after = rec["after"]
+    cells = np.nonzero(bad.any(axis=0))[0]
+    nonfinite = np.nonzero((~np.isfinite(after)).any(axis=0))[0]
+    if nonfinite.size:
+        cell = int(nonfinite[0])
+        cause = "non-finite values"
+    else:
+        with np.errstate(all="ignore"):
+            rel = np.min(after[::2] / (1.0 + np.abs(q_good[::2])), axis=0)
+        cell = int(cells[np.argmin(rel[cells])])
+        cause = "a negative depth"
+    return {"cause": cause, "cell": cell, "bad_cells": cells.tolist(), "dt": rec["dt"],
+            "stage": stage + 1,
+            "failed": {n: float(after[k, cell]) for k, n in enumerate(names)}}
 
 
 class FVSplitSolver(SolverBase):
@@ -83,31 +209,87 @@ class FVSplitSolver(SolverBase):
         cfl = self.cfl
         stop = self.stop_at_rest
 
+        def run_kernel(kernel: Any, q: np.ndarray, t0: float, t1: float, diag_: np.ndarray,
+                       rate_: np.ndarray, backup_: np.ndarray, work_: np.ndarray,
+                       max_steps: int):
+            return kernel(q, t0, t1, dx, bcl, bcr, P, cfl, diag_, rate_, backup_, work_,
+                          max_steps, two, stop, flux, order, limiter, strang)
+
         if self.backend_name == "numba":
 
             def advance(q: np.ndarray, t0: float, t1: float):
-                return advance_split(q, t0, t1, dx, bcl, bcr, P, cfl, diag, rate,
-                                     backup, work, self.max_steps, two, stop, flux,
-                                     order, limiter, strang)
+                return run_kernel(advance_split, q, t0, t1, diag, rate, backup, work,
+                                  self.max_steps)
         else:
             advance = self._numpy_loop(state, dx, P, hook, diag)
 
+        def replay(q: np.ndarray, t0: float, t1: float, update: Any) -> None:
+            # one step of the kernel's own Python code with an instrumented state update
+            py = advance_split.py_func
+            kernel = types.FunctionType(py.__code__, {**vars(_splitting), "_update": update},
+                                        py.__name__, py.__defaults__, py.__closure__)
+            run_kernel(kernel, q, t0, t1, diag.copy(), np.empty_like(q), np.empty_like(q),
+                       np.empty_like(work), 1)
+
         def stepper(state: Any, t_start: float, t_end: float) -> float:
-            t, steps, status = advance(state.data, t_start, t_end)
+            entry = state.data.copy()
+            t, steps, status = advance(state.data, float(t_start), float(t_end))  # one signature
             self.info["steps"] += int(steps)
             self.info["dt"] = float(diag[L.D_DT]) or None
             if status == STATUS_FAIL:
-                raise SimulationBlowUp(
-                    f"step {self.info['steps'] + 1} from t={t:.6g} s produced a "
-                    f"non-finite or negative state ({pde.__class__.__name__}, fv-split, "
-                    f"{pde.variant}, {self.splitting}, cfl={cfl}); the last good state at "
-                    f"t={t:.6g} s is kept")
+                self._blowup(state, entry, t_start, t, t_end, replay)
             if status == STATUS_REST:
                 self.info["rest_time"] = float(t)
+                _RestProfilerFilter.ended_at_rest = True
                 raise FinishedSimulation(f"everything at rest at t={t:.6g} s")
             return float(t)
 
         return stepper
+
+    def _blowup(self, state: Any, entry: np.ndarray, t_start: float, t: float,
+                t_end: float, replay: Any) -> None:
+        """Raise :class:`SimulationBlowUp` with the diagnostic of the failed step.
+
+        ``state.data`` holds the state before the failed step (time ``t``); if a source
+        stage had already spoiled it, the state at the start of this stepper call
+        (``entry``, time ``t_start``) is restored instead.
+        """
+        pde: GranularPDE = self.pde
+        report = diagnose_blowup(pde, state.data, t, t_end, replay)
+        t_kept = t
+        if report.get("stage") == 0:
+            state.data[...] = entry
+            t_kept = t_start
+        step = int(self.info["steps"]) + 1
+        mode = getattr(getattr(pde, "parameters", None), "hyperbolicity", None)
+        variant = (f"{pde.__class__.__name__}, fv-split {pde.variant}, {self.splitting} "
+                   f"splitting" + (f", hyperbolicity {mode!r}" if mode else "")
+                   + f", cfl={self.cfl}")
+        x_c = state.grid.axes_coords[0]
+        cell = report.get("cell")
+        report.update(t=t, t_kept=t_kept, step=step, variant=variant)
+        where = ""
+        if cell is not None:
+            report["x"] = float(x_c[cell])
+            report["cell_state"] = _cell_values(pde, state.data if t_kept == t else
+                                                entry, cell)
+            bad = report.get("bad_cells", [cell])
+            where = (f": cell {cell} (x={x_c[cell]:.6g} m) went to "
+                     f"{_fmt_values(report['failed'])} from "
+                     f"{_fmt_values(report['cell_state'])} (depths m, velocities m/s); "
+                     f"{len(bad)} bad cell(s) in x=[{x_c[min(bad)]:.6g}, "
+                     f"{x_c[max(bad)]:.6g}] m")
+        dt = report.get("dt")
+        stage = {1: "update", 2: "corrector (SSP-RK2 stage 2)"}.get(report.get("stage"),
+                                                                    "source stage")
+        msg = (f"fv-split blew up in step {step} at t={t:.6g} s"
+               + (f" (dt={dt:.3g} s, {stage})" if dt else "")
+               + f" with {report.get('cause', 'a non-finite or negative state')}{where}. "
+               f"[{variant}] Nothing of this step was kept: the last good state "
+               f"(t={t_kept:.6g} s) is the solver's state, SimulationBlowUp.state and "
+               "pde.diagnostics['last_state'].")
+        self.info["blowup"] = report
+        raise SimulationBlowUp(msg, report=report, state=state.data.copy())
 
     def _numpy_loop(self, state: Any, dx: float, P: np.ndarray, hook: Any,
                     diag: np.ndarray):
