@@ -213,7 +213,7 @@ def markdown(res: dict[str, Any], figure: str | None) -> str:
                  f"{'yes' if o > 0.8 else 'no (below 0.8)'} |")
     for prob in ("ritter", "mangeney"):
         o = last(prob, "hll/muscl", "order_L1_h_away")
-        L.append(f"| MUSCL above 1 in L1(h) on {prob} away from the front | {o:.2f} | "
+        L.append(f"| MUSCL above 1 in L1(h) on {prob} away from the front | {o:.3f} | "
                  f"{'yes' if o > 1.0 else 'no (at or below 1)'} |")
     sm = [r for r in res["smooth"] if r["variant"] == "hll/muscl"][0]["order_L1_h"][-1]
     L.append(f"| MUSCL near 2 on the smooth wave | {sm:.2f} | "

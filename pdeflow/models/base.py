@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from dataclasses import asdict, fields
 from typing import Any
 
 import numpy as np
@@ -48,6 +49,32 @@ def check_range(name: str, value: Any, low: float, high: float, *,
         u = f" {unit}" if unit else ""
         raise ValueError(f"{name} must lie in {lb}{low}, {high}{rb}{u}, got {value!r}")
     return v
+
+
+class ParametersBase:
+    """Shared behaviour of the parameter dataclasses: validation on construction,
+    construction from a mapping that rejects unknown keys by name, and export."""
+
+    kind = "model"  #: used in error messages, e.g. "two-layer"
+
+    def __post_init__(self) -> None:
+        self.validate()
+
+    def validate(self) -> None:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]):
+        """Build from a mapping, rejecting unknown keys by name."""
+        names = {f.name for f in fields(cls)}  # type: ignore[arg-type]
+        unknown = sorted(set(data) - names)
+        if unknown:
+            raise ValueError(f"unknown {cls.kind} parameter(s) {unknown}; "
+                             f"allowed: {sorted(names)}")
+        return cls(**data)
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)  # type: ignore[call-overload]
 
 
 class GranularPDE(PDEBase):

@@ -14,18 +14,20 @@ The friction is applied implicitly and set-valued (a layer stops in finite time)
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..numerics import layout as L
-from .base import GranularPDE, check_range
+from .base import GranularPDE, ParametersBase, check_range
 
 
 @dataclass
-class SingleLayerParameters:
+class SingleLayerParameters(ParametersBase):
     """Parameters of :class:`SingleLayerGranular`."""
+
+    kind = "single-layer"
 
     g: float = 9.81
     """gravitational acceleration [m/s^2]"""
@@ -42,9 +44,6 @@ class SingleLayerParameters:
     mol_eps: float = 1e-3
     """velocity scale regularising sgn() in the method-of-lines rate [m/s]"""
 
-    def __post_init__(self) -> None:
-        self.validate()
-
     def validate(self) -> None:
         """Raise ValueError naming the first parameter outside its allowed range."""
         check_range("g", self.g, 0, math.inf, low_open=True, unit="m/s^2")
@@ -57,19 +56,6 @@ class SingleLayerParameters:
                     unit="m/s")
         check_range("rest_depth", self.rest_depth, 0, math.inf, unit="m")
         check_range("mol_eps", self.mol_eps, 0, math.inf, low_open=True, unit="m/s")
-
-    @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> SingleLayerParameters:
-        """Build from a mapping, rejecting unknown keys by name."""
-        names = {f.name for f in fields(cls)}
-        unknown = sorted(set(data) - names)
-        if unknown:
-            raise ValueError(f"unknown single-layer parameter(s) {unknown}; "
-                             f"allowed: {sorted(names)}")
-        return cls(**data)
-
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
 
     def to_array(self) -> np.ndarray:
         th = math.radians(self.theta_deg)

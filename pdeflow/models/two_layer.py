@@ -19,24 +19,26 @@ t_B = sgn(u2) g_z (rho1 h1 + rho2 h2) tan(phi_B) (15), and M = (t1 - t2)/(u1 - u
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..numerics import layout as L
-from .base import GranularPDE, check_range
+from .base import GranularPDE, ParametersBase, check_range
 
 HYPERBOLICITY_MODES = {"none": 0, "exact": 1, "bound": 2}
 
 
 @dataclass
-class TwoLayerParameters:
+class TwoLayerParameters(ParametersBase):
     """Physical and numerical parameters of :class:`TwoLayerGranular`.
 
     The paper's Table 1 is lost; defaults marked *calibrated* were chosen to reproduce
     the paper's reported results of test 5.1 (see ``docs/parameters.md``).
     """
+
+    kind = "two-layer"
 
     g: float = 9.81
     """gravitational acceleration [m/s^2]"""
@@ -76,9 +78,6 @@ class TwoLayerParameters:
     mol_eps: float = 1e-3
     """velocity scale regularising sgn() in the method-of-lines rate [m/s]"""
 
-    def __post_init__(self) -> None:
-        self.validate()
-
     def validate(self) -> None:
         """Raise ValueError naming the first parameter outside its allowed range."""
         check_range("g", self.g, 0, math.inf, low_open=True, unit="m/s^2")
@@ -107,19 +106,6 @@ class TwoLayerParameters:
         if self.hyperbolicity not in HYPERBOLICITY_MODES:
             raise ValueError(f"hyperbolicity must be one of {list(HYPERBOLICITY_MODES)}, "
                              f"got {self.hyperbolicity!r}")
-
-    @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> TwoLayerParameters:
-        """Build from a mapping, rejecting unknown keys by name."""
-        names = {f.name for f in fields(cls)}
-        unknown = sorted(set(data) - names)
-        if unknown:
-            raise ValueError(f"unknown two-layer parameter(s) {unknown}; "
-                             f"allowed: {sorted(names)}")
-        return cls(**data)
-
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
 
     def to_array(self) -> np.ndarray:
         """Kernel parameter vector (layout in :mod:`pdeflow.numerics.layout`)."""
