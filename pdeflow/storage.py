@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 from pde.trackers.base import InfoDict, TrackerBase
 
-from .numerics import layout as L
+from .trackers import fextra_over_rho1  # noqa: F401 - also re-exported for live.py
 
 FORMAT = "pdeflow-run/1"
 FEXTRA_LABEL = "fextra_over_rho1"
@@ -126,16 +126,6 @@ class PendingFile:
             self.commit()
         else:
             self.discard()
-
-
-def fextra_over_rho1(info: InfoDict | None, n: int) -> np.ndarray:
-    """F_extra/rho1 per cell [m^2/s^2] of the last step, from the solver's post-step
-    data in the simulation ``info`` (as :class:`pdeflow.trackers.SnapshotTracker`
-    reads it); zeros if the solver keeps none (py-pde solvers, one layer)."""
-    diag = None if info is None else info.get("solver", {}).get("post_step_data")
-    if isinstance(diag, np.ndarray) and diag.size == L.N_DIAG + n:
-        return diag[L.N_DIAG:].copy()
-    return np.zeros(n)
 
 
 def final_time(info: InfoDict | None) -> float | None:

@@ -14,6 +14,16 @@ from pde.trackers.base import FinishedSimulation, InfoDict, TrackerBase
 from ..numerics import layout as L
 
 
+def fextra_over_rho1(info: InfoDict | None, n: int) -> np.ndarray:
+    """F_extra/rho1 per cell [m^2/s^2] of the last step, from the ``fv-split`` solver's
+    post-step data in the simulation ``info``; zeros if the solver keeps none (py-pde
+    solvers, one layer)."""
+    diag = None if info is None else info.get("solver", {}).get("post_step_data")
+    if isinstance(diag, np.ndarray) and diag.size == L.N_DIAG + n:
+        return diag[L.N_DIAG:].copy()
+    return np.zeros(n)
+
+
 class SnapshotTracker(TrackerBase):
     """Store copies of the state and of F_extra/rho1 at the interrupt times.
 
@@ -32,14 +42,7 @@ class SnapshotTracker(TrackerBase):
         return super().initialize(field, info)
 
     def handle(self, field: Any, t: float) -> None:
-        diag = None
-        if self._info is not None:
-            diag = self._info.get("solver", {}).get("post_step_data")
-        n = field.grid.shape[0]
-        if isinstance(diag, np.ndarray) and diag.size == L.N_DIAG + n:
-            fex = diag[L.N_DIAG:].copy()
-        else:
-            fex = np.zeros(n)
+        fex = fextra_over_rho1(self._info, field.grid.shape[0])
         self.snapshots[round(float(t), 9)] = (field.data.copy(), fex)
 
 
@@ -70,4 +73,4 @@ class RestTracker(TrackerBase):
             raise FinishedSimulation(f"all speeds below {self.speed} m/s at t={t:.6g} s")
 
 
-__all__ = ["RestTracker", "SnapshotTracker"]
+__all__ = ["RestTracker", "SnapshotTracker", "fextra_over_rho1"]
