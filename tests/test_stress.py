@@ -176,14 +176,13 @@ def scenarios(draw) -> Scenario:
                     "u": v_scale * rng.standard_normal(n)}
     flux, rec = draw(st.sampled_from(POSITIVE_SCHEMES))
     splitting = draw(st.sampled_from(["lie", "strang"]))
-    if splitting == "strang":
+    if splitting == "strang" and two:
         # known bug (docs/stability.md, test_strang_step_keeps_the_cfl_condition): Strang
-        # takes dt from the state *before* its first half source step, which on a slope
-        # accelerates any layer that its friction does not hold (the lower one above
-        # phi_B, the upper one above k tan(phi_int)); the advection then breaks the CFL
-        # condition and can make depths negative. On a horizontal bed the source stage
-        # only decelerates.
-        params["theta_deg"] = 0.0
+        # takes dt before its first half source step; erosion in that half step turns
+        # lower-layer material into upper-layer material 1/r times deeper, the wave
+        # speed grows and the advection breaks the CFL condition. Without exchange the
+        # half step only brakes, or accelerates by gravity, which dt accounts for.
+        params["exchange_closure"] = "none"
     return Scenario(two, params, {"flux": flux, "reconstruction": rec}, splitting,
                     draw(cfl_numbers(rec)), length, profiles)
 
@@ -235,7 +234,7 @@ def rest_states(draw) -> Scenario:
     for i in range(1, n):
         e[i] = max(e[i - 1] + dx * rng.uniform(lo, hi), 0.0)
     kind = draw(st.sampled_from(["single", "lower only", "upper on flat lower"]))
-    # MUSCL does not hold every such heap (test_muscl_heap_below_friction_angle_...)
+    # MUSCL does not hold every such heap (test_muscl_heap_with_a_kink_stays_at_rest)
     flux, rec = draw(st.sampled_from(FIRST_ORDER))
     params: dict[str, Any] = {"phi_b_deg": phi_b, "theta_deg": theta}
     if kind == "single":
@@ -294,6 +293,54 @@ def test_strang_step_keeps_the_cfl_condition():
     for k in range(1, 6):
         t = stepper(state, t, T_FAR)
         check_step_invariants(eq, state.data, mass0, k)
+
+
+@pytest.mark.xfail(strict=True, raises=pdeflow.SimulationBlowUp, reason=(
+    "kernel bug (pdeflow/numerics/splitting.py, advance_split with strang=True): dt is "
+    "chosen before the first half source step and allows for gravity only; here (flat "
+    "bed, r = 0.0625) that half step erodes the whole lower layer of cell 1 into the upper "
+    "one, 1/r = 16 times deeper (h1 0.027 -> 1.19 m), sqrt(g H) triples and the "
+    "advection breaks the CFL condition (h1 = -2.4e-3 m in step 1)"))
+def test_strang_step_keeps_the_cfl_condition_under_erosion():
+    """Found by test_random_states_keep_the_invariants (long profile, seed 7), after the
+    gravity fix above; with Lie splitting the same state keeps every invariant."""
+    params = {"phi_b_deg": 10.0, "density_ratio": 0.0625, "phi_int_deg": 10.0, "k": 0.0,
+              "c": 1.0}
+    profiles = {"h1": np.array([0.0, 0.02697867, 0.00409735]),
+                "u1": np.array([1.19617691, -1.56726095, -0.32841434]),
+                "h2": np.array([0.06066358, 0.07294966, 0.0]),
+                "u2": np.array([-0.02325031, -0.00218792, -0.01245911])}
+    for splitting in ("lie", "strang"):
+        eq, state = Scenario(True, params, {"flux": "hll"}, splitting, 0.75, 1.0,
+                             profiles).make()
+        mass0 = total_mass(eq, state.data)
+        stepper = stepper_for(eq, state, 0.75, splitting)
+        t = 0.0
+        for k in range(1, 6):
+            t = stepper(state, t, T_FAR)
+            check_step_invariants(eq, state.data, mass0, k)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "MUSCL (pdeflow/numerics/advection.py) overshoots the hydrostatic force at a kink of "
+    "a heap: cell 1 of h = [0.0291, 0.0252, 0.0419, 0.0580] m (dx = 0.1 m, wall on the "
+    "right) feels 0.5 (h_i^+ h_{i+1}^- - h_i^- h_{i-1}^+) / (h_i dx) = 0.24, steeper than "
+    "any slope of the data (<= 0.167 < tan 10 deg = 0.176), so friction_predictor does not "
+    "hold it and the heap slumps before stopping; first order keeps it exactly at rest"))
+def test_muscl_heap_with_a_kink_stays_at_rest():
+    """Found by test_states_at_rest_stay_at_rest (long profile) after the dry-edge fix."""
+    h = np.array([0.0290996, 0.02520256, 0.04186015, 0.05796915])
+    assert np.abs(np.diff(h)).max() / 0.1 < 0.95 * math.tan(math.radians(10.0))
+    for rec in ("first-order", "muscl"):
+        eq, state = Scenario(False, {"phi_b_deg": 10.0}, {"flux": "hll",
+                                                          "reconstruction": rec},
+                             "lie", 0.5, 0.4, {"h": h}).make()
+        stepper = stepper_for(eq, state, 0.5)
+        t = 0.0
+        for _ in range(10):
+            t = stepper(state, t, T_FAR)
+        np.testing.assert_array_equal(state.data[0], h)
+        assert np.all(state.data[1] == 0.0)
 
 
 def test_ifcp_is_not_positive_in_a_strong_rarefaction():
@@ -470,23 +517,28 @@ def test_1e5_cells_short_run():
 # --- extremes: heavy forms (slow) ------------------------------------------------------------
 
 @pytest.mark.slow
-def test_1e5_cells_to_rest():
+def test_1e5_cells_first_tenth_of_a_second():
+    """10^5 cells (dx = 7e-5 m) for the first 0.1 s of test 5.1 (~9000 steps; the run to
+    rest takes 6.4e5 steps and half an hour, docs/stability.md)."""
     eq, st0 = column(100_000, 7.0, 1.0, 2.0, bc=("wall", "wall"))
-    final, info = run_to_rest(eq, st0, 5.0)
+    final, info = run_to_rest(eq, st0, 0.1)
     q = final.data
-    assert info["solver"].get("rest_time") is not None
     assert np.all(np.isfinite(q)) and np.all(q[::2] >= 0)
     m0 = total_mass(eq, st0.data)
-    assert abs(total_mass(eq, q) - m0) <= 1e-11 * m0
+    assert abs(total_mass(eq, q) - m0) <= 1e-12 * m0
+    x = final.grid.axes_coords[0]
+    front = x[np.nonzero(q[0] + q[2] > 1e-3)[0][-1]]
+    assert 1.5 < front < 2.0  # 1.75 m at dx = 0.05 m (docs/parameters.md)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("two_layer", [True, False])
 def test_aspect_ratio_100_fine_grid(two_layer):
-    eq, st0 = column(15000, 30.0, 0.1, 10.0, two_layer=two_layer, bc=("wall", "wall"))
+    eq, st0 = column(20000, 40.0, 0.1, 10.0, two_layer=two_layer, bc=("wall", "wall"))
     final, info = run_to_rest(eq, st0, 30.0)
     q = final.data
     assert info["solver"].get("rest_time") is not None
+    assert q[0][-1] == 0.0 and q[-2][-1] == 0.0  # stopped before the far wall
     assert np.all(np.isfinite(q)) and np.all(q[::2] >= 0)
     m0 = total_mass(eq, st0.data)
     assert abs(total_mass(eq, q) - m0) <= 1e-11 * m0
