@@ -8,6 +8,7 @@ from hypothesis import strategies as st
 import pdeflow
 from pdeflow.numerics import layout as L
 from pdeflow.numerics.hyperbolicity import (
+    band_lower_edge,
     discriminant,
     eigenvalues,
     is_hyperbolic,
@@ -125,3 +126,69 @@ def test_fextra_restores_hyperbolicity_and_conserves_momentum(mode):
     if mode == "exact":
         assert not is_hyperbolic(0.5, 0.5, u1[0] - u2[0] + 2 * eq.parameters.w, 0.0,
                                  9.81, r, 1)
+
+
+def _edge_by_bisection(h1, h2, du_bad, r):
+    lo, hi = 0.0, du_bad
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if discriminant(h1, h2, mid, 0.0, 9.81, r) >= 0:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+def test_band_lower_edge_is_the_first_non_hyperbolic_du():
+    rng = np.random.default_rng(3)
+    checked = 0
+    for _ in range(400):
+        h1, h2 = rng.uniform(0.001, 2.0, 2)
+        r = rng.uniform(0.05, 0.999)
+        du = np.linspace(lower_bound_fl(h1, h2, 9.81, r), 3 * np.sqrt(9.81 * (h1 + h2)),
+                         400)
+        bad = [d for d in du if discriminant(h1, h2, d, 0.0, 9.81, r) < 0]
+        if not bad:
+            continue
+        du_bad = bad[rng.integers(len(bad))]
+        edge = band_lower_edge(h1, h2, 9.81, r, du_bad)
+        assert edge == pytest.approx(_edge_by_bisection(h1, h2, bad[0], r), rel=1e-9)
+        assert is_hyperbolic(h1, h2, edge * (1 - 1e-10), 0.0, 9.81, r, 1)
+        assert not is_hyperbolic(h1, h2, edge * (1 + 1e-8), 0.0, 9.81, r, 1)
+        checked += 1
+    assert checked > 100
+    assert band_lower_edge(0.5, 0.5, 9.81, 0.8, 0.01) == -1.0  # 0.01 m/s is hyperbolic
+
+
+@pytest.mark.parametrize("mode", [1, 2])
+def test_direct_restoration_is_the_bisection_limit(mode):
+    """The closed-form inversion of the friction step lands |du| on the band edge:
+    hyperbolic, never more F_extra than bisection to w = 1e-3, and |du| within 1e-8
+    (relative) of bisection to w = 1e-12."""
+    from pdeflow.numerics.splitting import _bisect_fextra, _friction, _restore_hyperbolicity
+
+    rng = np.random.default_rng(7)
+    checked = 0
+    for _ in range(300):
+        eq = pdeflow.TwoLayerGranular(k=rng.uniform(0, 0.9), c=rng.uniform(0, 0.2),
+                                      phi_b_deg=rng.uniform(1e-6, 40),
+                                      density_ratio=rng.uniform(0.5, 0.99))
+        P = eq.parameter_array()
+        P[L.HYPERBOLICITY] = mode
+        h1, h2 = rng.uniform(0.01, 1.5, 2)
+        b1, b2 = rng.uniform(-8, 8, 2)
+        dt = rng.uniform(1e-4, 1e-2)
+        v1, v2 = _friction(b1, b2, h1, h2, dt, P, 0.0)
+        if is_hyperbolic(h1, h2, v1, v2, P[L.G_Z], P[L.R], mode):
+            continue
+        f, u1, u2 = _restore_hyperbolicity(b1, b2, h1, h2, v1, v2, dt, P)
+        assert is_hyperbolic(h1, h2, u1, u2, P[L.G_Z], P[L.R], mode)
+        assert (u1, u2) == _friction(b1, b2, h1, h2, dt, P, f)
+        f_w = _bisect_fextra(b1, b2, h1, h2, v1 - v2, dt, P)
+        assert abs(f) <= abs(f_w) * (1 + 1e-12)
+        P[L.W] = 1e-12
+        f_fine = _bisect_fextra(b1, b2, h1, h2, v1 - v2, dt, P)
+        du_fine = np.subtract(*_friction(b1, b2, h1, h2, dt, P, f_fine))
+        assert abs((u1 - u2) - du_fine) <= 2e-8 * abs(du_fine)
+        checked += 1
+    assert checked > 30

@@ -30,17 +30,25 @@ from .pvm import fluct_single, fluct_two_layer
 from .state import velocity
 
 
+@njit(cache=True, inline="always")
+def _is_wet(q: np.ndarray, i: int, dry: float) -> bool:
+    for k in range(0, q.shape[0], 2):
+        if q[k, i] > dry:
+            return True
+    return False
+
+
 @njit(cache=True)
-def wet_range(h_total: np.ndarray, dry: float) -> tuple[int, int]:
-    """First and last index of cells with ``h_total > dry`` (``(1, 0)`` if none)."""
-    n = h_total.shape[0]
-    lo = 0
-    while lo < n and h_total[lo] <= dry:
+def wet_cells(q: np.ndarray, dry: float, start: int, stop: int) -> tuple[int, int]:
+    """First and last index in ``start..stop`` of a cell where some layer's depth
+    (rows 0, 2, ... of ``q``) exceeds ``dry``; ``(1, 0)`` if there is none."""
+    lo = start
+    while lo <= stop and not _is_wet(q, lo, dry):
         lo += 1
-    if lo == n:
+    if lo > stop:
         return 1, 0
-    hi = n - 1
-    while h_total[hi] <= dry:
+    hi = stop
+    while hi > lo and not _is_wet(q, hi, dry):
         hi -= 1
     return lo, hi
 
@@ -126,13 +134,28 @@ def rate_single(q: np.ndarray, rate: np.ndarray, work: np.ndarray, dx: float,
     ``work`` is scratch space of shape (2, 2, n). Returns the largest wave speed [m/s]
     over the faces that were visited.
     """
-    n = q.shape[1]
     rate[:, :] = 0.0
-    lo, hi = wet_range(q[0], dry)
+    lo, hi = wet_cells(q, dry, 0, q.shape[1] - 1)
+    return advect_single(q, rate, work, dx, bc_left, bc_right, g, dry, flux, order,
+                         limiter, lo, hi)[0]
+
+
+@njit(cache=True)
+def advect_single(q: np.ndarray, rate: np.ndarray, work: np.ndarray, dx: float,
+                  bc_left: int, bc_right: int, g: float, dry: float, flux: int,
+                  order: int, limiter: int, lo: int, hi: int) -> tuple[float, int, int]:
+    """:func:`rate_single` for the wet cells ``lo..hi`` (from :func:`wet_cells`).
+
+    Writes ``rate`` only in the cells it can change, ``lo - 1 .. hi + 1`` (clipped to
+    the grid), and returns (largest wave speed [m/s], first, last of those cells);
+    the rest of ``rate`` is left as it was (the stepper never reads it).
+    """
+    n = q.shape[1]
     if lo > hi:
-        return 0.0
+        return 0.0, 1, 0
     r_lo = max(lo - 1, 0)
     r_hi = min(hi + 1, n - 1)
+    rate[:, r_lo:r_hi + 1] = 0.0
     reconstruct(q, work, r_lo, r_hi, bc_left, bc_right, dry, order, limiter)
     qm = work[0]
     qp = work[1]
@@ -167,7 +190,7 @@ def rate_single(q: np.ndarray, rate: np.ndarray, work: np.ndarray, dx: float,
             rate[0, i] -= (ur * hr - ul * hl) * inv_dx
             rate[1, i] -= (ur * ur * hr + 0.5 * g * hr * hr
                            - ul * ul * hl - 0.5 * g * hl * hl) * inv_dx
-    return smax
+    return smax, r_lo, r_hi
 
 
 @njit(cache=True)
@@ -179,16 +202,24 @@ def rate_two_layer(q: np.ndarray, rate: np.ndarray, work: np.ndarray, dx: float,
     ``work`` is scratch space of shape (2, 4, n). Returns the largest wave speed [m/s]
     over the faces that were visited.
     """
-    n = q.shape[1]
     rate[:, :] = 0.0
-    lo1, hi1 = wet_range(q[0], dry)
-    lo2, hi2 = wet_range(q[2], dry)
-    lo = min(lo1, lo2) if lo1 <= hi1 and lo2 <= hi2 else (lo1 if lo1 <= hi1 else lo2)
-    hi = max(hi1, hi2) if lo1 <= hi1 and lo2 <= hi2 else (hi1 if lo1 <= hi1 else hi2)
+    lo, hi = wet_cells(q, dry, 0, q.shape[1] - 1)
+    return advect_two_layer(q, rate, work, dx, bc_left, bc_right, g, r, dry, flux,
+                            order, limiter, lo, hi)[0]
+
+
+@njit(cache=True)
+def advect_two_layer(q: np.ndarray, rate: np.ndarray, work: np.ndarray, dx: float,
+                     bc_left: int, bc_right: int, g: float, r: float, dry: float,
+                     flux: int, order: int, limiter: int, lo: int,
+                     hi: int) -> tuple[float, int, int]:
+    """:func:`rate_two_layer` for the wet cells ``lo..hi``; as :func:`advect_single`."""
+    n = q.shape[1]
     if lo > hi:
-        return 0.0
+        return 0.0, 1, 0
     r_lo = max(lo - 1, 0)
     r_hi = min(hi + 1, n - 1)
+    rate[:, r_lo:r_hi + 1] = 0.0
     reconstruct(q, work, r_lo, r_hi, bc_left, bc_right, dry, order, limiter)
     qm = work[0]
     qp = work[1]
@@ -246,4 +277,4 @@ def rate_two_layer(q: np.ndarray, rate: np.ndarray, work: np.ndarray, dx: float,
             rate[2, i] -= (u2r * h2r - u2l * h2l) * inv_dx
             rate[3, i] -= ((u2r * u2r * h2r - u2l * u2l * h2l)
                            + g * 0.5 * (h2l + h2r) * (dh2 + r * dh1)) * inv_dx
-    return smax
+    return smax, r_lo, r_hi

@@ -11,25 +11,30 @@ Cheap closed-form screens (Castro-Diaz et al. 2023, REFERENCE section 2):
 .. math::  F_L^2 = \frac{g H^3}{2 h_1 h_2}\Bigl[1 - \sqrt{1 - 4(1-r) h_1 h_2 / H^2}\Bigr]
            \le F_{c1}, \qquad F_R^2 = 2 g H (1 + \sqrt r) \ge F_{c2},
 
-so |du| <= F_L or |du| >= F_R is hyperbolic without further work. Inside the screen
-the exact test decides: in the shifted variable x = lambda - (u1 + u2)/2 the quartic
-is depressed, x^4 + p x^2 + q x + s, and since two roots are always real, all four
-are real iff its discriminant
+so |du| <= F_L or |du| >= F_R is hyperbolic (F_L is the ``bound`` mode's test). The
+exact test: in the shifted variable x = lambda - (u1 + u2)/2 the quartic is
+depressed, x^4 + p x^2 + q x + s, and since two roots are always real, all four are
+real iff its discriminant
 
 .. math::  \Delta = 256 s^3 - 128 p^2 s^2 + 144 p q^2 s - 27 q^4 + 16 p^4 s - 4 p^3 q^2
 
-is non-negative (evaluated in units of g H to avoid overflow). This is the paper's
-"inner eigenvalues real" test without computing the roots; :func:`eigenvalues`
-computes them (for diagnostics and tests).
+is non-negative (evaluated in units of g H to avoid overflow; as a quartic in
+A = (du/2)^2/(g H), see :func:`_quartic_in_a`). This is the paper's "inner eigenvalues
+real" test without computing the roots; :func:`eigenvalues` computes them (for
+diagnostics and tests).
 
 Restoration (33)-(34): F_extra moves momentum between the layers, -dt F/rho1 to the
 upper and +dt F/rho2 to the lower one (total momentum unchanged), inside the implicit
-friction stage. It is the smallest such exchange after which the state is hyperbolic,
-found by bracketing and bisection. The paper stops its iteration when
-lambda_3 - lambda_2 <= w (34); near the boundary that gap grows like the square root
-of the distance in du, so pdeflow applies the threshold w to the bracket in du
-instead: the iteration stops when the hyperbolic state's |du| is within w of the
-last non-hyperbolic one (a resolution of w in du rather than ~w^2).
+friction stage. It is the smallest such exchange after which the state is hyperbolic.
+Because the depths are frozen in that stage, hyperbolicity depends on du alone: the
+target is the lower band edge F_c1 (:func:`band_lower_edge`, a root of the
+discriminant found by safeguarded Halley iteration; F_L itself in ``bound`` mode), and
+the implicit friction step, solved in closed form, is inverted for the F_extra that
+lands |du| on it (:func:`pdeflow.numerics.splitting._restore_hyperbolicity`). The paper
+iterates until lambda_3 - lambda_2 <= w (34); near the boundary that gap grows like
+the square root of the distance in du, so pdeflow reads w as a tolerance in du: the
+restored |du| lies within w below F_c1 (the direct solve lands within round-off of
+it; the bisection kept as a fallback stops when its bracket in du is below w).
 """
 
 from __future__ import annotations
@@ -45,7 +50,7 @@ def lower_bound_fl(h1: float, h2: float, g: float, r: float) -> float:
     """Closed-form lower edge F_L [m/s] of the non-hyperbolic band (Castro-Diaz 2023)."""
     H = h1 + h2
     disc = 1.0 - 4.0 * (1.0 - r) * h1 * h2 / (H * H)
-    return math.sqrt(g * H**3 / (2.0 * h1 * h2) * (1.0 - math.sqrt(max(disc, 0.0))))
+    return math.sqrt(g * H * H * H / (2.0 * h1 * h2) * (1.0 - math.sqrt(max(disc, 0.0))))
 
 
 @njit(cache=True)
@@ -87,31 +92,106 @@ def inner_gap(h1: float, h2: float, u1: float, u2: float, g: float, r: float) ->
 
 
 @njit(cache=True)
+def _quartic_in_a(h1: float, h2: float, r: float) -> tuple[float, float, float, float,
+                                                              float]:
+    r"""Coefficients (a4, a3, a2, a1, a0) of Delta/16 as a quartic in A = (du/2)^2/(g H).
+
+    With e_i = h_i/H (e1 + e2 = 1), beta = e1 e2, d = 1 - 4 beta = (e2 - e1)^2 and
+    c = (1 - r) beta, the depressed quartic has p = -2A - 1, q^2 = 4 A d,
+    s = A^2 - A + c, and its discriminant expands to
+
+    .. math::  \Delta/16 = 256\beta A^4 - 16(4c - 3d + 3) A^3
+               + (16c^2 - 72cd + 120c - 27d^2 + 42d - 15) A^2
+               - (80c^2 + 36cd - 24c - d + 1) A + c(4c - 1)^2 .
+    """
+    e1 = h1 / (h1 + h2)
+    beta = e1 * (1.0 - e1)
+    d = 1.0 - 4.0 * beta
+    c = (1.0 - r) * beta
+    return (256.0 * beta, -16.0 * (4.0 * c - 3.0 * d + 3.0),
+            16.0 * c * c - 72.0 * c * d + 120.0 * c - 27.0 * d * d + 42.0 * d - 15.0,
+            -(80.0 * c * c + 36.0 * c * d - 24.0 * c - d + 1.0),
+            c * (4.0 * c - 1.0) ** 2)
+
+
+@njit(cache=True)
 def discriminant(h1: float, h2: float, u1: float, u2: float, g: float,
                  r: float) -> float:
     """Discriminant of P in units of (g H)^6 (>= 0: all four roots real)."""
-    c2 = g * (h1 + h2)
-    a = 0.5 * (u1 - u2)
-    a2 = a * a / c2
-    e1 = g * h1 / c2
-    e2 = g * h2 / c2
-    # [(x - a)^2 - e1][(x + a)^2 - e2] - r e1 e2 = x^4 + p x^2 + q x + s, x in sqrt(g H)
-    p = -2.0 * a2 - e1 - e2
-    q = 2.0 * a * (e2 - e1) / math.sqrt(c2)
-    s = (a2 - e1) * (a2 - e2) - r * e1 * e2
-    return (256.0 * s**3 - 128.0 * p * p * s * s + 144.0 * p * q * q * s
-            - 27.0 * q**4 + 16.0 * p**4 * s - 4.0 * p**3 * q * q)
+    a4, a3, a2, a1, a0 = _quartic_in_a(h1, h2, r)
+    du = u1 - u2
+    A = 0.25 * du * du / (g * (h1 + h2))
+    return 16.0 * ((((a4 * A + a3) * A + a2) * A + a1) * A + a0)
 
 
 @njit(cache=True)
 def is_hyperbolic(h1: float, h2: float, u1: float, u2: float, g: float, r: float,
                   mode: int) -> bool:
-    """Hyperbolicity test: mode 1 exact inner roots (paper), mode 2 the bound F_L only."""
-    du = abs(u1 - u2)
-    if du <= lower_bound_fl(h1, h2, g, r):
-        return True
+    """Hyperbolicity test: mode 1 exact inner roots (paper), mode 2 the bound F_L only.
+
+    Two roots of P are always real, so the discriminant alone decides mode 1: it is
+    negative exactly when one conjugate pair is complex (cheaper than the screens)."""
+    du = u1 - u2
+    if du * du <= (1.0 - r) * g * (h1 + h2):
+        return True  # below F_L (1 - sqrt(1 - x) >= x/2 gives F_L^2 >= (1 - r) g H)
     if mode == 2:
-        return False  # the bound alone is conservative: it also flags the band's top
-    if du >= upper_bound_fr(h1, h2, g, r):
-        return True
+        # the bound alone is conservative: it also flags the band's top
+        return abs(du) <= lower_bound_fl(h1, h2, g, r)
     return discriminant(h1, h2, u1, u2, g, r) >= 0.0
+
+
+@njit(cache=True)
+def band_lower_edge(h1: float, h2: float, g: float, r: float, du_bad: float) -> float:
+    """Lower edge F_c1 [m/s] of the non-hyperbolic band, given a non-hyperbolic |du|.
+
+    ``du_bad`` (> F_c1, inside the band) brackets the root together with du = 0
+    (hyperbolic: Delta(0) = 16 c (4c - 1)^2 >= 0). Halley's method on the quartic of
+    :func:`_quartic_in_a` from the non-hyperbolic end (the restoration calls it with
+    |du| just above F_c1: two or three iterations), safeguarded by false position;
+    returns F_c1 to one part in 1e-9, from the hyperbolic side up to round-off (callers
+    aiming at the edge stay a hair below it), or -1 if ``du_bad`` is not inside the
+    band.
+    """
+    a4, a3, a2, a1, a0 = _quartic_in_a(h1, h2, r)
+    c2 = g * (h1 + h2)
+    lo = 0.0
+    d_lo = a0
+    hi = 0.25 * du_bad * du_bad / c2
+    x = hi
+    D = (((a4 * x + a3) * x + a2) * x + a1) * x + a0
+    if D >= 0.0:
+        return -1.0
+    d_hi = D
+    for _ in range(100):
+        dD = ((4.0 * a4 * x + 3.0 * a3) * x + 2.0 * a2) * x + a1
+        d2D = (12.0 * a4 * x + 6.0 * a3) * x + 2.0 * a2
+        den = 2.0 * dD * dD - D * d2D
+        step = 2.0 * D * dD / den if den != 0.0 else 0.0
+        if den != 0.0 and abs(step) <= 1e-10 * x:
+            # at the root to within 1e-10: settle on its hyperbolic (smaller A) side
+            eps = 1e-10
+            while D < 0.0 and eps < 1e-6:
+                y = x * (1.0 - eps) - abs(step)
+                D = (((a4 * y + a3) * y + a2) * y + a1) * y + a0
+                if D >= 0.0:
+                    x = y
+                eps *= 4.0
+            if D >= 0.0:
+                lo = x
+            break
+        xn = x - step
+        if not (lo < xn < hi):
+            xn = lo - d_lo * (hi - lo) / (d_hi - d_lo)
+            if not (lo < xn < hi):
+                xn = 0.5 * (lo + hi)
+        x = xn
+        D = (((a4 * x + a3) * x + a2) * x + a1) * x + a0
+        if D >= 0.0:
+            lo = x
+            d_lo = D
+        else:
+            hi = x
+            d_hi = D
+        if hi - lo <= 1e-10 * hi:
+            break
+    return 2.0 * math.sqrt(lo * c2)

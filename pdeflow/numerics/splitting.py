@@ -24,8 +24,8 @@ import numpy as np
 from numba import njit
 
 from . import layout as L
-from .advection import rate_single, rate_two_layer
-from .hyperbolicity import is_hyperbolic
+from .advection import advect_single, advect_two_layer, wet_cells
+from .hyperbolicity import band_lower_edge, is_hyperbolic, lower_bound_fl
 from .sources import _drag_root, coulomb_single, exchange_depth, friction_two_layer
 from .state import velocity
 
@@ -62,39 +62,100 @@ def _friction(b1, b2, h1, h2, dt, P, f):
 
 
 @njit(cache=True)
-def _restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P):
-    """Smallest F_extra/rho2 [m^2/s^2] making the post-friction state hyperbolic."""
+def _bisect_fextra(b1, b2, h1, h2, du0, dt, P):
+    """F_extra/rho2 [m^2/s^2] by bracketing and bisection on the hyperbolicity test:
+    the fallback of :func:`_restore_hyperbolicity`, stopping when the bracket in du is
+    below w."""
     g = P[L.G_Z]
     r = P[L.R]
     mode = int(P[L.HYPERBOLICITY])
     w = P[L.W]
-    du0 = u1 - u2
     # Bracket: f_lo leaves du of the original sign and non-hyperbolic; f_hi makes the
     # state hyperbolic or flips the sign of du (du(f) decreases monotonically in f, so
     # the smallest hyperbolic f lies before the sign change).
     f_hi = du0 / (dt * (1.0 / (r * h1) + 1.0 / h2))
     f_lo = 0.0
+    du_lo = abs(du0)
+    sgn = 1.0 if du0 > 0.0 else -1.0
     for _ in range(60):
         v1, v2 = _friction(b1, b2, h1, h2, dt, P, f_hi)
-        if (v1 - v2) * du0 <= 0.0 or is_hyperbolic(h1, h2, v1, v2, g, r, mode):
+        du_hi = sgn * (v1 - v2)
+        if du_hi <= 0.0 or is_hyperbolic(h1, h2, v1, v2, g, r, mode):
             break
         f_lo = f_hi
+        du_lo = du_hi
         f_hi *= 2.0
-    sgn = 1.0 if du0 > 0.0 else -1.0
-    v1, v2 = _friction(b1, b2, h1, h2, dt, P, f_lo)
-    du_lo = sgn * (v1 - v2)
-    for _ in range(60):
-        v1, v2 = _friction(b1, b2, h1, h2, dt, P, f_hi)
-        if du_lo - sgn * (v1 - v2) <= w or abs(f_hi - f_lo) <= 1e-12 * abs(f_hi):
+    for _ in range(200):
+        if du_lo - du_hi <= w or abs(f_hi - f_lo) <= 1e-12 * abs(f_hi):
             break
         f_mid = 0.5 * (f_lo + f_hi)
         v1, v2 = _friction(b1, b2, h1, h2, dt, P, f_mid)
-        if (v1 - v2) * du0 <= 0.0 or is_hyperbolic(h1, h2, v1, v2, g, r, mode):
+        du_mid = sgn * (v1 - v2)
+        if du_mid <= 0.0 or is_hyperbolic(h1, h2, v1, v2, g, r, mode):
             f_hi = f_mid
+            du_hi = du_mid
         else:
             f_lo = f_mid
-            du_lo = sgn * (v1 - v2)
+            du_lo = du_mid
     return f_hi
+
+
+@njit(cache=True)
+def _restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P):
+    r"""Smallest F_extra/rho2 [m^2/s^2] making the post-friction state hyperbolic, and
+    the velocities (u1, u2) [m/s] it leads to.
+
+    The depths are frozen, so the target is a relative velocity: the lower band edge
+    F_c1 (F_L in ``bound`` mode). Stage (32) with the extra exchange f = F_extra/rho2
+    shifts b1 by -dt f/m1 and b2 by +dt f/m2 and keeps m1 b1 + m2 b2, so on each branch
+    of its closed-form solution (:func:`pdeflow.numerics.sources.friction_two_layer`)
+    du is an explicit function of f, inverted here for du = sgn(du0) d with
+
+    * lower layer sliding in direction s2 (mu = m1 m2/(m1 + m2), p = m1 b1 + m2 b2
+      - dt B s2): :math:`m_1 b_1 - m_1 p/(m_1+m_2) - \Delta t f
+      = \mathrm{sgn}(du_0)\,(\Delta t K + \mu d + \Delta t C d^2)`;
+    * lower layer stuck: :math:`m_1 (b_1 - \Delta t f/m_1)
+      = \mathrm{sgn}(du_0)\,(\Delta t K + m_1 d + \Delta t C d^2)`.
+
+    The branch is not known beforehand: each candidate is checked by solving (32)
+    with it (hyperbolic, and |du| within w of the target); if none passes (round-off
+    at a branch boundary), bisection decides (:func:`_bisect_fextra`).
+    """
+    g = P[L.G_Z]
+    r = P[L.R]
+    mode = int(P[L.HYPERBOLICITY])
+    du0 = u1 - u2
+    if mode == 2:
+        edge = lower_bound_fl(h1, h2, g, r)
+    else:
+        edge = band_lower_edge(h1, h2, g, r, abs(du0))
+    if edge > 0.0:
+        d = edge * (1.0 - 1e-8)  # a hair inside: round-off must not leave the band edge
+        sgn = 1.0 if du0 > 0.0 else -1.0
+        m1 = r * h1
+        m2 = h2
+        mt = m1 + m2
+        kdt = dt * P[L.K] * r * g * h1 * P[L.TAN_INT]
+        cdt = dt * P[L.C]
+        bdt = dt * g * (r * h1 + h2) * P[L.TAN_B]
+        s_first = 1.0 if u2 >= 0.0 else -1.0
+        for branch in range(3):
+            if branch == 2:
+                f = (m1 * b1 - sgn * (kdt + m1 * d + cdt * d * d)) / dt
+            else:
+                s2 = s_first if branch == 0 else -s_first
+                p = m1 * b1 + m2 * b2 - bdt * s2
+                f = (m1 * b1 - m1 * p / mt
+                     - sgn * (kdt + m1 * m2 / mt * d + cdt * d * d)) / dt
+            if f * sgn <= 0.0:
+                continue
+            v1, v2 = _friction(b1, b2, h1, h2, dt, P, f)
+            # below the edge is hyperbolic down to F_L (the band is one interval)
+            if edge - P[L.W] <= sgn * (v1 - v2) <= edge:
+                return f, v1, v2
+    f = _bisect_fextra(b1, b2, h1, h2, du0, dt, P)
+    v1, v2 = _friction(b1, b2, h1, h2, dt, P, f)
+    return f, v1, v2
 
 
 @njit(cache=True)
@@ -106,7 +167,14 @@ def source_stage_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
     listed in :mod:`pdeflow.numerics.layout` and, from index N_DIAG on, F_extra/rho1
     per cell [m^2/s^2].
     """
-    n = q.shape[1]
+    sources_two_layer(q, dt, t, P, diag, 0, q.shape[1] - 1)
+
+
+@njit(cache=True)
+def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
+                      diag: np.ndarray, lo: int, hi: int) -> None:
+    """:func:`source_stage_two_layer` on the cells ``lo..hi`` only (the others must be
+    dry and at rest, where the stage changes nothing)."""
     r = P[L.R]
     g = P[L.G_Z]
     gx = P[L.G_X]
@@ -120,14 +188,14 @@ def source_stage_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
     fast2 = False
     changed = False
     fex = diag[L.N_DIAG:]
-    for i in range(n):
+    for i in range(lo, hi + 1):
         h1 = q[0, i]
         m1 = q[1, i]
         h2 = q[2, i]
         m2 = q[3, i]
         if fex[i] != 0.0:
             fex[i] = 0.0
-        if h1 <= 0.0 and h2 <= 0.0 and m1 == 0.0 and m2 == 0.0:
+        if h1 == 0.0 and h2 == 0.0 and m1 == 0.0 and m2 == 0.0:
             continue
         h1 = max(h1, 0.0)
         h2 = max(h2, 0.0)
@@ -166,8 +234,7 @@ def source_stage_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
             # --- (33)-(34) hyperbolicity --------------------------------------------------
             if mode > 0 and h1 > dry and h2 > dry:
                 if not is_hyperbolic(h1, h2, v1, v2, g, r, mode):
-                    f = _restore_hyperbolicity(b1, b2, h1, h2, v1, v2, dt, P)
-                    v1, v2 = _friction(b1, b2, h1, h2, dt, P, f)
+                    f, v1, v2 = _restore_hyperbolicity(b1, b2, h1, h2, v1, v2, dt, P)
                     fex[i] = abs(f) / r
                     diag[L.D_HYP_EVENTS] += 1.0
                     if fex[i] > diag[L.D_FEXTRA_MAX]:
@@ -207,17 +274,23 @@ def source_stage_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
 def source_stage_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
                         diag: np.ndarray) -> None:
     """Implicit Coulomb friction (and gravity along the bed) for the single layer."""
-    n = q.shape[1]
+    sources_single(q, dt, t, P, diag, 0, q.shape[1] - 1)
+
+
+@njit(cache=True)
+def sources_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
+                   diag: np.ndarray, lo: int, hi: int) -> None:
+    """:func:`source_stage_single` on the cells ``lo..hi`` only."""
     g = P[L.S_G_Z]
     gx = P[L.S_G_X]
     dry = P[L.S_DRY]
     mu_dt = dt * g * P[L.S_TAN_B]
     moving = False
     fast = False
-    for i in range(n):
+    for i in range(lo, hi + 1):
         h = q[0, i]
         m = q[1, i]
-        if h <= 0.0 and m == 0.0:
+        if h == 0.0 and m == 0.0:
             continue
         h = max(h, 0.0)
         u = velocity(h, m, dry)
@@ -240,17 +313,17 @@ def source_stage_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
 
 
 @njit(cache=True)
-def _update(q, base, rate, dt, weight):
-    """q <- weight * base + (1 - weight) * (q + dt * rate); returns (max |mass rate|, ok).
+def _update(q, base, rate, dt, weight, lo, hi):
+    """q <- weight * base + (1 - weight) * (q + dt * rate) in cells ``lo..hi``; returns
+    (max |mass rate|, ok).
 
     ``ok`` is False if the result is not finite or a depth is negative beyond round-off
     (round-off below zero is clipped by the source stage).
     """
-    n = q.shape[1]
     mass_rate = 0.0
     ok = True
     for k in range(q.shape[0]):
-        for i in range(n):
+        for i in range(lo, hi + 1):
             v = weight * base[k, i] + (1.0 - weight) * (q[k, i] + dt * rate[k, i])
             if k % 2 == 0:
                 mass_rate = max(mass_rate, abs(rate[k, i]))
@@ -263,29 +336,36 @@ def _update(q, base, rate, dt, weight):
 
 
 @njit(cache=True)
-def _rate(q, rate, work, dx, bc_left, bc_right, P, two_layer, flux, order, limiter):
+def _rate(q, rate, work, dx, bc_left, bc_right, P, two_layer, flux, order, limiter,
+          start, stop):
+    """Advection rate of the wet cells within ``start..stop`` (all others dry):
+    returns (largest wave speed, first, last cell whose rate was written)."""
+    dry = P[L.DRY] if two_layer else P[L.S_DRY]
+    lo, hi = wet_cells(q, dry, start, stop)
     if two_layer:
-        return rate_two_layer(q, rate, work, dx, bc_left, bc_right, P[L.G_Z], P[L.R],
-                              P[L.DRY], flux, order, limiter)
-    return rate_single(q, rate, work, dx, bc_left, bc_right, P[L.S_G_Z], P[L.S_DRY],
-                       flux, order, limiter)
+        return advect_two_layer(q, rate, work, dx, bc_left, bc_right, P[L.G_Z], P[L.R],
+                                dry, flux, order, limiter, lo, hi)
+    return advect_single(q, rate, work, dx, bc_left, bc_right, P[L.S_G_Z], dry, flux,
+                         order, limiter, lo, hi)
 
 
 @njit(cache=True)
-def _sources(q, dt, t, P, diag, two_layer):
+def _sources(q, dt, t, P, diag, two_layer, lo, hi):
     if two_layer:
-        source_stage_two_layer(q, dt, t, P, diag)
+        sources_two_layer(q, dt, t, P, diag, lo, hi)
     else:
-        source_stage_single(q, dt, t, P, diag)
+        sources_single(q, dt, t, P, diag, lo, hi)
 
 
 @njit(cache=True)
-def friction_predictor(q: np.ndarray, dt: float, P: np.ndarray, two_layer: bool) -> None:
+def friction_predictor(q: np.ndarray, dt: float, P: np.ndarray, two_layer: bool,
+                       lo: int, hi: int) -> None:
     """Zero the momentum of layers that the implicit friction (32) would hold at rest,
     in place. Applied to the intermediate stage of SSP-RK2: otherwise the predictor's
     pressure momentum, which friction balances, moves mass and heaps creep. Moving
-    layers are left untouched (friction proper is applied once, in the source stage)."""
-    for i in range(q.shape[1]):
+    layers are left untouched (friction proper is applied once, in the source stage).
+    Only the cells ``lo..hi`` are visited."""
+    for i in range(lo, hi + 1):
         if two_layer:
             dry = P[L.DRY]
             h1 = max(q[0, i], 0.0)
@@ -328,13 +408,36 @@ def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int
     :data:`STATUS_FAIL` (the last step produced a non-finite or negative state and was
     undone; ``q`` holds the last good state).
     """
+    n = q.shape[1]
     steps = 0
     rec = work[:2]
     q0 = work[2]
+    fex = diag[L.N_DIAG:]
+    # Cells outside the wet region plus the stencil are dry and at rest, which every
+    # stage leaves unchanged: only the active cells are visited. The first step visits
+    # all cells (the source stage cleans the initial state); the wet region then grows
+    # by at most one cell per advection stage, so the next search window is the last
+    # region widened by two.
+    w_lo = 0
+    w_hi = n - 1
+    s_lo = 0
+    s_hi = n - 1
+    first = True
     while t < t_end and steps < max_steps:
-        backup[:, :] = q
-        smax = _rate(q, rate, rec, dx, bc_left, bc_right, P, two_layer, flux, order,
-                     limiter)
+        # cells a step can change: two advection stages around the wet region
+        lo, hi = wet_cells(q, P[L.DRY] if two_layer else P[L.S_DRY], w_lo, w_hi)
+        if first:
+            b_lo = 0
+            b_hi = n - 1
+        elif lo > hi:
+            b_lo = 1
+            b_hi = 0
+        else:
+            b_lo = max(lo - 2, 0)
+            b_hi = min(hi + 2, n - 1)
+        backup[:, b_lo:b_hi + 1] = q[:, b_lo:b_hi + 1]
+        smax, a_lo, a_hi = _rate(q, rate, rec, dx, bc_left, bc_right, P, two_layer,
+                                 flux, order, limiter, lo, hi)
         dt = t_end - t
         if strang:
             # the first half source step may accelerate a layer by up to dt/2 |g_x|
@@ -349,26 +452,56 @@ def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int
         changed = 0.0
         if strang:
             diag[L.D_DT] = 0.5 * dt
-            _sources(q, 0.5 * dt, t, P, diag, two_layer)
+            _sources(q, 0.5 * dt, t, P, diag, two_layer, b_lo if first else a_lo,
+                     b_hi if first else a_hi)
             changed = diag[L.D_CHANGED]
-            _rate(q, rate, rec, dx, bc_left, bc_right, P, two_layer, flux, order, limiter)
+            # (a deposit can lift a cell of sub-dry layers above dry: search wider)
+            _, a_lo, a_hi = _rate(q, rate, rec, dx, bc_left, bc_right, P, two_layer,
+                                  flux, order, limiter, b_lo, b_hi)
         if order == 1:
-            mass_rate, ok = _update(q, q, rate, dt, 0.0)
+            mass_rate, ok = _update(q, q, rate, dt, 0.0, a_lo, a_hi)
         else:
-            q0[:, :] = q
-            mass_rate, ok = _update(q, q0, rate, dt, 0.0)
+            q0[:, b_lo:b_hi + 1] = q[:, b_lo:b_hi + 1]
+            mass_rate, ok = _update(q, q0, rate, dt, 0.0, a_lo, a_hi)
             if ok:
-                friction_predictor(q, dt, P, two_layer)
-                _rate(q, rate, rec, dx, bc_left, bc_right, P, two_layer, flux, order,
-                      limiter)
-                mass2, ok = _update(q, q0, rate, dt, 0.5)
+                friction_predictor(q, dt, P, two_layer, a_lo, a_hi)
+                _, c_lo, c_hi = _rate(q, rate, rec, dx, bc_left, bc_right, P,
+                                      two_layer, flux, order, limiter, b_lo, b_hi)
+                # cells of the first stage that the second does not reach get rate 0
+                for i in range(a_lo, a_hi + 1):
+                    if i < c_lo or i > c_hi:
+                        rate[:, i] = 0.0
+                if a_lo > a_hi:
+                    a_lo = c_lo
+                    a_hi = c_hi
+                elif c_lo <= c_hi:
+                    a_lo = min(a_lo, c_lo)
+                    a_hi = max(a_hi, c_hi)
+                mass2, ok = _update(q, q0, rate, dt, 0.5, a_lo, a_hi)
                 mass_rate = max(mass_rate, mass2)
         if not ok:
-            q[:, :] = backup
+            q[:, b_lo:b_hi + 1] = backup[:, b_lo:b_hi + 1]
             return t, steps, STATUS_FAIL
         diag[L.D_DT] = 0.5 * dt if strang else dt
-        _sources(q, 0.5 * dt if strang else dt, t_new, P, diag, two_layer)
+        if first:
+            a_lo = 0
+            a_hi = n - 1
+        elif a_lo > a_hi:
+            a_lo = s_lo  # nothing wet: the stage only needs to clear the last F_extra
+            a_hi = s_lo - 1
+        # F_extra of cells that left the active region
+        for i in range(s_lo, min(s_hi, a_lo - 1) + 1):
+            fex[i] = 0.0
+        for i in range(max(s_lo, a_hi + 1), s_hi + 1):
+            fex[i] = 0.0
+        _sources(q, 0.5 * dt if strang else dt, t_new, P, diag, two_layer, a_lo, a_hi)
         changed = max(changed, diag[L.D_CHANGED])
+        s_lo = a_lo
+        s_hi = a_hi
+        if lo <= hi:
+            w_lo = max(lo - 2, 0)
+            w_hi = min(hi + 2, n - 1)
+        first = False
         t = t_new
         steps += 1
         if stop_at_rest and mass_rate == 0.0 and changed == 0.0:

@@ -97,8 +97,9 @@ def diagnose_blowup(pde: GranularPDE, q_good: np.ndarray, t: float, t_end: float
 
     ``replay(q, t, t_end, update)`` must take exactly one step of the solver's stepping
     kernel from ``q`` (a copy) at time ``t`` [s], with its state updates performed by
-    ``update(q, base, rate, dt, weight)`` (the kernel's ``_update``: ``q <- weight base +
-    (1 - weight) (q + dt rate)``, returning ``(max |mass rate|, ok)``). The recording
+    ``update(q, base, rate, dt, weight, lo, hi)`` (the kernel's ``_update``: ``q <-
+    weight base + (1 - weight) (q + dt rate)`` in cells ``lo..hi``, returning
+    ``(max |mass rate|, ok)``). The recording
     update here repeats that arithmetic in numpy and keeps the update that failed, so the
     step is recomputed exactly, stages and all, in plain Python.
 
@@ -120,12 +121,16 @@ def diagnose_blowup(pde: GranularPDE, q_good: np.ndarray, t: float, t_end: float
     records: list[dict[str, Any]] = []
 
     def update(q: np.ndarray, base: np.ndarray, rate: np.ndarray, dt: float,
-               weight: float) -> tuple[float, bool]:
+               weight: float, lo: int, hi: int) -> tuple[float, bool]:
+        v = q.copy()
+        cells = slice(lo, hi + 1)
         with np.errstate(all="ignore"):
-            v = weight * base + (1.0 - weight) * (q + dt * rate)
-            bad = ~np.isfinite(v)
-            bad[::2] |= v[::2] < -1e-12 * (1.0 + np.abs(q[::2]))
-            mass_rate = float(np.max(np.abs(rate[::2]))) if rate.size else 0.0
+            v[:, cells] = weight * base[:, cells] + (1.0 - weight) * (
+                q[:, cells] + dt * rate[:, cells])
+            bad = np.zeros(q.shape, dtype=bool)
+            bad[:, cells] = ~np.isfinite(v[:, cells])
+            bad[::2, cells] |= v[::2, cells] < -1e-12 * (1.0 + np.abs(q[::2, cells]))
+            mass_rate = float(np.max(np.abs(rate[::2, cells]))) if hi >= lo else 0.0
         records.append({"dt": float(dt), "after": v.copy(), "bad": bad})
         q[...] = v
         return mass_rate, not bool(bad.any())
