@@ -175,6 +175,9 @@ class Case:
             self._check_cells()
             check_range("grid.dx", self.dx, 0, self.length, low_open=True, unit="m")
             check_range("numerics.cfl", self.cfl, 0, 1, low_open=True)
+            if self.data.get("numerics", {}).get("reconstruction") == "muscl":
+                check_range("numerics.cfl (with reconstruction = 'muscl')", self.cfl, 0,
+                            0.5, low_open=True)
             if "dt" in self.data.get("numerics", {}):
                 check_range("numerics.dt", self.data["numerics"]["dt"], 0, math.inf,
                             low_open=True, unit="s")

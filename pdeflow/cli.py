@@ -389,6 +389,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     from .cases import CaseError
+    from .solvers.fv_split import SimulationBlowUp
     from .storage import StorageError
 
     argv = sys.argv[1:] if argv is None else list(argv)
@@ -403,6 +404,10 @@ def main(argv: list[str] | None = None) -> int:
     except (CaseError, StorageError) as err:
         print(f"pdeflow: error: {err}", file=sys.stderr)
         return 2
+    except SimulationBlowUp as err:
+        # the message says where, when and with which scheme; the traceback adds nothing
+        print(f"pdeflow: simulation failed: {err}", file=sys.stderr)
+        return 3
     except ValueError as err:
         from .trackers.live import MovieError
 

@@ -34,6 +34,13 @@ def test_bad_values_are_rejected_with_their_name(override, words):
         assert w in msg
 
 
+def test_muscl_case_above_cfl_one_half_is_rejected():
+    with pytest.raises(CaseError, match=r"numerics.cfl \(with reconstruction = 'muscl'\) "
+                                        r"must lie in \(0, 0.5\]"):
+        load_case(CASE, ["numerics.reconstruction='muscl'", "numerics.cfl=0.6"])
+    assert load_case(CASE, ["numerics.reconstruction='muscl'", "numerics.cfl=0.5"]).cfl == 0.5
+
+
 def test_case_files_are_data_not_code(tmp_path):
     p = tmp_path / "evil.toml"
     p.write_text('[case]\nname = "__import__(\'os\').system(\'echo hi\')"\n'
@@ -84,6 +91,24 @@ def test_cli_bad_override_is_a_clean_error(tmp_path, capsys):
     assert rc == 2
     assert "k must lie in" in capsys.readouterr().err
     assert not (tmp_path / "s.json").exists()
+
+
+def test_cli_blowup_is_a_clean_error_and_writes_nothing(tmp_path, capsys):
+    """IFCP is not positive in a strong rarefaction (docs/stability.md, finding 7)."""
+    np.savez(tmp_path / "init.npz", h=np.array([0.51182162, 0.9504637, 0.14415961]),
+             u=np.array([-5.36953235, 5.81118104, 3.64572396]))
+    p = tmp_path / "c.toml"
+    p.write_text('[case]\nmodels = ["single_layer"]\nt_end = 1.0\n[grid]\nlength = 1.0\n'
+                 'cells = 3\n[initial]\nshape = "file"\npath = "init.npz"\n'
+                 '[single_layer]\nphi_b_deg = 10.0\n[numerics]\nflux = "ifcp"\n'
+                 'cfl = 0.5\n')
+    rc = main(["run", str(p), "--summary", str(tmp_path / "s.json"), "--store",
+               str(tmp_path / "run.h5")])
+    assert rc == 3
+    err = capsys.readouterr().err
+    assert err.startswith("pdeflow: simulation failed: fv-split blew up in step")
+    assert "negative depth" in err and "Traceback" not in err
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["c.toml", "init.npz"]
 
 
 def test_cli_sweep_converge_compare(tmp_path):

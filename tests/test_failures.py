@@ -100,6 +100,17 @@ def test_cfl_outside_0_1_is_rejected_before_the_run(cfl):
         FVSplitSolver(eq, cfl="0.3")
 
 
+def test_muscl_above_cfl_one_half_is_rejected():
+    """SSP-RK2 with limited slopes is positive only up to CFL 1/2 (a single-layer run at
+    CFL 0.75 reached h = -2e-5 m in step 4, docs/stability.md)."""
+    eq = pdeflow.SingleLayerGranular(reconstruction="muscl")
+    with pytest.raises(ValueError, match=r"^cfl \(with reconstruction='muscl'\) must lie "
+                                         r"in \(0, 0.5\], got 0.75"):
+        FVSplitSolver(eq, cfl=0.75)
+    assert FVSplitSolver(eq, cfl=0.5).cfl == 0.5
+    assert FVSplitSolver(pdeflow.SingleLayerGranular(), cfl=0.75).cfl == 0.75
+
+
 # --- grids and states -------------------------------------------------------------------
 
 @pytest.mark.parametrize("bad_grid, words", [

@@ -55,7 +55,7 @@ class TwoLayerParameters(ParametersBase):
     c: float = 0.03
     """collisional (Voellmy) coefficient of eq. (17) [-] (calibrated)"""
     w: float = 1e-3
-    """threshold of criterion (34) on lambda3 - lambda2 [m/s]"""
+    """tolerance of the restoration (33)-(34) in du: restored |du| within w below F_c1 [m/s]"""
     dry_tolerance: float = 1e-6
     """layers thinner than this have zero velocity [m]"""
     film_depth: float = 1e-3

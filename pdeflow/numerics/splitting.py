@@ -401,7 +401,10 @@ def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int
     ``flux`` (layout.FLUX_*), ``order`` (1: first order with forward Euler; 2: MUSCL
     with the SSP-RK2/Heun integrator, see :func:`friction_predictor`) and ``limiter``
     (layout.LIMITER_*) choose the advection stage; ``strang`` applies half a source
-    step before and after it (else Lie, as in the paper).
+    step before and after it (else Lie, as in the paper). With Strang, dt is chosen
+    before the first half source step; if that half step makes the waves faster than
+    dt allows (erosion deepens the upper layer), it is undone and the step retried
+    with a shorter dt.
 
     Returns ``(t, steps, status)``: status :data:`STATUS_END`; :data:`STATUS_REST`
     (everything at rest and unchanged: stationary from ``t`` on); or
@@ -413,6 +416,8 @@ def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int
     rec = work[:2]
     q0 = work[2]
     fex = diag[L.N_DIAG:]
+    diag_keep = np.empty(L.N_DIAG)  # Strang: undo a half source step that broke the CFL
+    fex_keep = np.empty(n)
     # Cells outside the wet region plus the stencil are dry and at rest, which every
     # stage leaves unchanged: only the active cells are visited. The first step visits
     # all cells (the source stage cleans the initial state); the wet region then grows
@@ -448,16 +453,28 @@ def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int
                 dt = min(dt, 2.0 * cfl * dx / den)
         elif smax > 0.0:
             dt = min(dt, cfl * dx / smax)
-        t_new = t + dt if dt < t_end - t else t_end
         changed = 0.0
         if strang:
-            diag[L.D_DT] = 0.5 * dt
-            _sources(q, 0.5 * dt, t, P, diag, two_layer, b_lo if first else a_lo,
-                     b_hi if first else a_hi)
-            changed = diag[L.D_CHANGED]
-            # (a deposit can lift a cell of sub-dry layers above dry: search wider)
-            _, a_lo, a_hi = _rate(q, rate, rec, dx, bc_left, bc_right, P, two_layer,
-                                  flux, order, limiter, b_lo, b_hi)
+            h_lo = b_lo if first else a_lo
+            h_hi = b_hi if first else a_hi
+            diag_keep[:] = diag[:L.N_DIAG]
+            fex_keep[b_lo:b_hi + 1] = fex[b_lo:b_hi + 1]
+            for attempt in range(40):
+                diag[L.D_DT] = 0.5 * dt
+                _sources(q, 0.5 * dt, t, P, diag, two_layer, h_lo, h_hi)
+                changed = diag[L.D_CHANGED]
+                # (a deposit can lift a cell of sub-dry layers above dry: search wider)
+                smax2, a_lo, a_hi = _rate(q, rate, rec, dx, bc_left, bc_right, P,
+                                          two_layer, flux, order, limiter, b_lo, b_hi)
+                if smax2 * dt <= cfl * dx * (1.0 + 1e-9) or attempt == 39:
+                    break
+                # the half source step made the waves faster than dt allows (erosion
+                # can deepen the upper layer 1/r-fold): undo it and retry shorter
+                q[:, b_lo:b_hi + 1] = backup[:, b_lo:b_hi + 1]
+                diag[:L.N_DIAG] = diag_keep
+                fex[b_lo:b_hi + 1] = fex_keep[b_lo:b_hi + 1]
+                dt = min(0.5 * dt, cfl * dx / smax2)
+        t_new = t + dt if dt < t_end - t else t_end
         if order == 1:
             mass_rate, ok = _update(q, q, rate, dt, 0.0, a_lo, a_hi)
         else:

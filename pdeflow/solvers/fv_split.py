@@ -174,7 +174,8 @@ class FVSplitSolver(SolverBase):
                 :class:`~pdeflow.models.SingleLayerGranular` (its flux and reconstruction
                 choose the advection stage; MUSCL is advanced with SSP-RK2/Heun).
             backend: 'numba' (compiled loop) or 'numpy' (Python loop, for debugging).
-            cfl: Courant number in (0, 1] (paper: 0.3).
+            cfl: Courant number in (0, 1] (paper: 0.3); (0, 0.5] with MUSCL, whose
+                SSP-RK2 update keeps depths non-negative only up to 1/2.
             splitting: 'lie' (advection, then sources: the paper's) or 'strang' (half a
                 source step on each side of the advection step).
             stop_at_rest: end the run once nothing moves or changes any more.
@@ -186,6 +187,9 @@ class FVSplitSolver(SolverBase):
             raise ValueError(f"backend must be 'numba' or 'numpy', got {backend!r}")
         super().__init__(pde, backend="numba" if backend == "auto" else backend)
         self.cfl = check_range("cfl", cfl, 0, 1, low_open=True)
+        if pde.reconstruction == "muscl":
+            # SSP-RK2 with limited reconstructions keeps depths non-negative only up to 1/2
+            check_range("cfl (with reconstruction='muscl')", cfl, 0, 0.5, low_open=True)
         if splitting not in ("lie", "strang"):
             raise ValueError(f"splitting must be 'lie' or 'strang', got {splitting!r}")
         self.splitting = splitting
