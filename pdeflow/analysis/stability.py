@@ -15,8 +15,9 @@ name, the model's scheme options and parameters, the solver's options. To add on
 line there; everything else (runs, figures, tables) follows.
 
 * ``fv-split`` variants run the solver itself (CFL-limited steps). Its CFL number is
-  validated to (0, 1]; to find where the scheme really fails, CFL numbers above 1 are run
-  with that validation bypassed (the attribute is set after construction).
+  validated to (0, 1] ((0, 0.5] with MUSCL); to find where the scheme really fails,
+  larger CFL numbers are run with that validation bypassed (the attribute is set after
+  construction).
 * py-pde's generic solvers (``euler``, ``runge-kutta``) integrate the method-of-lines rate
   (HLL flux divergence plus regularised sources) with a fixed time step
   dt = CFL dx / s_ref, s_ref = the largest wave speed of the problem's reference solution
@@ -338,8 +339,8 @@ def _run_fv_split(variant: Variant, eq: Any, state: Any, problem: Problem, cfl: 
 
     from ..solvers.fv_split import FVSplitSolver, SimulationBlowUp
 
-    solver = FVSplitSolver(eq, cfl=min(cfl, 1.0), max_steps=max_steps, **variant.options)
-    solver.cfl = float(cfl)  # beyond 1: validation bypassed on purpose (module docstring)
+    solver = FVSplitSolver(eq, cfl=min(cfl, 0.5), max_steps=max_steps, **variant.options)
+    solver.cfl = float(cfl)  # validation bypassed on purpose (module docstring)
     stepper = solver.make_stepper(state)
     try:
         t = stepper(state, 0.0, problem.t_end)
