@@ -44,8 +44,9 @@ def _friction(b1, b2, h1, h2, dt, P, f):
     wet2 = h2 > dry
     if wet1 and wet2:
         m1 = r * h1
-        b1 = b1 - dt * f / m1
-        b2 = b2 + dt * f / h2
+        if f != 0.0:
+            b1 = b1 - dt * f / m1
+            b2 = b2 + dt * f / h2
         kdt = dt * P[L.K] * r * g * h1 * P[L.TAN_INT]
         bdt = dt * g * (r * h1 + h2) * P[L.TAN_B]
         return friction_two_layer(b1, b2, m1, h2, kdt, dt * P[L.C], bdt)
