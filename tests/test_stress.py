@@ -58,7 +58,6 @@ SCHEMES = [("hll", "first-order"), ("rusanov", "first-order"), ("ifcp", "first-o
 #: scheme for one layer, which is not positive in strong rarefactions (Einfeldt et al.
 #: 1991; test_ifcp_is_not_positive_in_a_strong_rarefaction)
 POSITIVE_SCHEMES = [s for s in SCHEMES if s[0] != "ifcp"]
-FIRST_ORDER = [s for s in SCHEMES if s[1] == "first-order"]
 
 
 # --- helpers -----------------------------------------------------------------------------
@@ -234,8 +233,7 @@ def rest_states(draw) -> Scenario:
     for i in range(1, n):
         e[i] = max(e[i - 1] + dx * rng.uniform(lo, hi), 0.0)
     kind = draw(st.sampled_from(["single", "lower only", "upper on flat lower"]))
-    # MUSCL does not hold every such heap (test_muscl_heap_with_a_kink_stays_at_rest)
-    flux, rec = draw(st.sampled_from(FIRST_ORDER))
+    flux, rec = draw(st.sampled_from(SCHEMES))
     params: dict[str, Any] = {"phi_b_deg": phi_b, "theta_deg": theta}
     if kind == "single":
         return Scenario(False, params, {"flux": flux, "reconstruction": rec}, splitting,
@@ -319,14 +317,13 @@ def test_strang_step_keeps_the_cfl_condition_under_erosion():
             check_step_invariants(eq, state.data, mass0, k)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "MUSCL (pdeflow/numerics/advection.py) overshoots the hydrostatic force at a kink of "
-    "a heap: cell 1 of h = [0.0291, 0.0252, 0.0419, 0.0580] m (dx = 0.1 m, wall on the "
-    "right) feels 0.5 (h_i^+ h_{i+1}^- - h_i^- h_{i-1}^+) / (h_i dx) = 0.24, steeper than "
-    "any slope of the data (<= 0.167 < tan 10 deg = 0.176), so friction_predictor does not "
-    "hold it and the heap slumps before stopping; first order keeps it exactly at rest"))
 def test_muscl_heap_with_a_kink_stays_at_rest():
-    """Found by test_states_at_rest_stay_at_rest (long profile) after the dry-edge fix."""
+    """Found by test_states_at_rest_stay_at_rest (long profile) after the dry-edge fix:
+    MUSCL overshot the hydrostatic force at a kink of a heap. Cell 1 of h = [0.0291,
+    0.0252, 0.0419, 0.0580] m (dx = 0.1 m, wall on the right) felt 0.5 (h_i^+ h_{i+1}^-
+    - h_i^- h_{i-1}^+) / (h_i dx) = 0.24, steeper than any slope of the data (<= 0.167 <
+    tan 10 deg = 0.176), and the heap slumped. Cells at rest with their neighbours are
+    now reconstructed at first order."""
     h = np.array([0.0290996, 0.02520256, 0.04186015, 0.05796915])
     assert np.abs(np.diff(h)).max() / 0.1 < 0.95 * math.tan(math.radians(10.0))
     for rec in ("first-order", "muscl"):

@@ -103,13 +103,18 @@ def reconstruct(q: np.ndarray, work: np.ndarray, lo: int, hi: int, bc_left: int,
                 # face depth weighting the hydrostatic jump is the cell's own depth
                 sh = 0.0
                 su = 0.0
+            elif m == 0.0 and q[k + 1, max(i - 1, 0)] == 0.0 and \
+                    q[k + 1, min(i + 1, n - 1)] == 0.0:
+                # at rest with its neighbours: first order as well. A limited slope of h
+                # can make the hydrostatic force at a kink of a heap steeper than any
+                # slope of the data, so that friction no longer holds a heap the
+                # first-order scheme keeps exactly at rest; nothing moves here to gain
+                # accuracy on
+                sh = 0.0
+                su = 0.0
             else:
                 sh = _limited(h - hl, hr - h, limiter)
-                if m == 0.0 and q[k + 1, max(i - 1, 0)] == 0.0 and \
-                        q[k + 1, min(i + 1, n - 1)] == 0.0:
-                    su = 0.0  # at rest with its neighbours: keep u = 0 on both faces
-                else:
-                    su = _limited(u - ul, ur - u, limiter)
+                su = _limited(u - ul, ur - u, limiter)
             hm = h - 0.5 * sh
             hp = h + 0.5 * sh
             work[0, k, i] = hm
