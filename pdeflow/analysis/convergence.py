@@ -205,7 +205,7 @@ briefly above basal friction where the lower layer is thin), and the time of the
 such event depends on the grid. The practical definition (|u| < 1 cm/s where
 h > 1 mm) is the robust one for the lower layer, as far as the parameters allow: with
 k = 0.8 the re-mobilisation exceeds 1 cm/s on fine grids and even the practical stop
-time changes by 13-21 % on dx/2 (calibration_relaxed.md).
+time changes by more than 10 % on dx/2 (calibration_relaxed.md).
 
 The maximum of F_extra/rho1 occurs at the toe of the initial column within the first
 few steps (its time halves with dx): a start-up transient at the corner of the
