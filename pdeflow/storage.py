@@ -140,6 +140,20 @@ def final_time(info: InfoDict | None) -> float | None:
     return None if t is None else float(t)
 
 
+def show_final_state(tracker: Any, info: InfoDict | None) -> float | None:
+    """At ``finalize``: hand the run's last state to ``tracker.handle`` unless the
+    tracker already saw it (its ``last_time``); returns the end time [s] of the run.
+
+    py-pde calls a tracker only at its interrupts, so a run that stops at rest or at
+    t_end between two interrupts would otherwise miss its final state. ``tracker``
+    keeps the last field it handled in ``_field``."""
+    t_end = final_time(info)
+    state = (info or {}).get("last_state", tracker._field)
+    if state is not None and t_end is not None and t_end > tracker.last_time + 1e-12:
+        tracker.handle(state, t_end)
+    return t_end
+
+
 def model_of(field_or_rows: Any) -> str:
     """'two_layer' for 4 state rows, 'single_layer' for 2."""
     rows = getattr(field_or_rows, "data", field_or_rows).shape[0]
@@ -276,10 +290,7 @@ class RunStorageTracker(TrackerBase):
         if self._storage is None:
             return
         info = info or {}
-        t_end = final_time(info)
-        state = info.get("last_state", self._field)
-        if state is not None and t_end is not None and t_end > self.last_time + 1e-12:
-            self.handle(state, t_end)
+        t_end = show_final_state(self, info)
         controller = info.get("controller", {})
         self._storage.info["pdeflow"].update(jsonable({
             "t_final": t_end,

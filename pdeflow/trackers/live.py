@@ -41,7 +41,7 @@ from pde.trackers import ProgressTracker
 from pde.trackers.base import InfoDict, TrackerBase
 
 from ..plotting import RunFigure, Series
-from ..storage import PendingFile, fextra_over_rho1, final_time, model_of
+from ..storage import PendingFile, fextra_over_rho1, model_of, show_final_state
 
 #: matplotlib backends that cannot show a window
 HEADLESS_BACKENDS = ("agg", "pdf", "ps", "svg", "pgf", "cairo", "template")
@@ -202,11 +202,7 @@ class LivePlotTracker(TrackerBase):
         super().finalize(info)
         if self.figure is None:
             return
-        info = info or {}
-        t_end = final_time(info)
-        state = info.get("last_state", self._field)
-        if state is not None and t_end is not None and t_end > self.last_time + 1e-12:
-            self.handle(state, t_end)
+        show_final_state(self, info)
         if self.movie is not None:
             self.movie.finish()
         if self.display != "window":
