@@ -51,3 +51,54 @@ def test_a_dirty_initial_state_is_cleaned_everywhere():
     st.data[2, 180] = -1e-14  # round-off below zero
     q, *_ = step(eq, st, 0.05)
     assert q[1, 150] == 0.0 and q[2, 180] == 0.0
+
+
+_ALLOC_SCRIPT = r"""
+import json, sys
+import numpy as np
+from numba.core.runtime import rtsys
+import pdeflow
+from tests.helpers import grid, step
+
+out = []
+for two, scheme, strang in ((True, {}, False), (True, {"reconstruction": "muscl"}, True),
+                            (False, {}, False), (False, {"reconstruction": "muscl"}, False)):
+    g = grid(200, 0.0, 10.0)
+    x = g.axes_coords[0]
+    col = np.where(x < 1.0, 1.0, 0.0)
+    if two:
+        eq = pdeflow.TwoLayerGranular(**scheme)
+        st = eq.make_state(g, h1=0.5 * col, h2=0.5 * col)
+    else:
+        eq = pdeflow.SingleLayerGranular(**scheme)
+        st = eq.make_state(g, h=col)
+    step(eq, st, 0.01, strang=strang)  # compile or load
+    counts = []
+    for t_end in (0.05, 0.5):
+        a0 = rtsys.get_allocation_stats()
+        steps = step(eq, st, t_end, strang=strang)[2]
+        counts.append((steps, rtsys.get_allocation_stats().alloc - a0.alloc))
+    out.append(counts)
+print(json.dumps(out))
+"""
+
+
+def test_the_stepping_loop_allocates_nothing_per_step():
+    """numba's runtime counts its allocations (NUMBA_NRT_STATS=1, set before numba is
+    imported, hence a subprocess): a run of ten times as many steps allocates exactly as
+    often as a short one."""
+    import json
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).parents[1]
+    env = {**os.environ, "NUMBA_NRT_STATS": "1"}
+    res = subprocess.run([sys.executable, "-c", _ALLOC_SCRIPT], cwd=root, env=env,
+                         capture_output=True, text=True, timeout=600)
+    assert res.returncode == 0, res.stderr[-2000:]
+    for (steps_short, allocs_short), (steps_long, allocs_long) in json.loads(
+            res.stdout.strip().splitlines()[-1]):
+        assert steps_long > 5 * steps_short
+        assert allocs_long == allocs_short
