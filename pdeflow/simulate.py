@@ -126,6 +126,8 @@ def summarize(res: RunResult, mass0: float, wall: float) -> dict[str, Any]:
         "stop_reason": res.info.get("controller", {}).get("stop_reason"),
     }
     if diag is not None and case.solver == "fv-split":
+        # steps that IFCP could not keep positive, redone with HLL (0 for other fluxes)
+        out["flux_fallback_steps"] = int(diag[L.D_FLUX_FALLBACKS])
         tf = res.t_final
         up = _stop_time(diag[L.D_MOVE_UPPER], tf, at_rest)
         if res.model == "two_layer":

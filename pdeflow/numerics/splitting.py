@@ -391,6 +391,75 @@ def friction_predictor(q: np.ndarray, dt: float, P: np.ndarray, two_layer: bool,
 
 
 @njit(cache=True)
+def _advect_step(q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, rec, q0,
+                 diag_keep, fex_keep, two_layer, flux, order, limiter, strang, first, lo,
+                 hi, b_lo, b_hi):
+    """The advection stage of one step of :func:`advance_split` (with Strang, the first
+    half source step before it), from the wet cells ``lo..hi``; ``b_lo..b_hi`` are the
+    cells the step may change, saved in ``backup`` (and, for Strang, the bookkeeping in
+    ``diag_keep``, ``fex_keep``).
+
+    Returns ``(dt, mass_rate, ok, a_lo, a_hi, changed)``: the step [s], the largest mass
+    rate, whether the state is finite and non-negative, the cells the update touched and
+    whether the half source step changed anything.
+    """
+    fex = diag[L.N_DIAG:]
+    smax, a_lo, a_hi = _rate(q, rate, rec, dx, bc_left, bc_right, P, two_layer,
+                             flux, order, limiter, lo, hi)
+    dt = t_end - t
+    if strang:
+        # the first half source step may accelerate a layer by up to dt/2 |g_x|
+        # (friction only brakes): choose dt with dt (smax + dt |g_x| / 2) = cfl dx
+        gx = abs(P[L.G_X])
+        den = smax + math.sqrt(smax * smax + 2.0 * gx * cfl * dx)
+        if den > 0.0:
+            dt = min(dt, 2.0 * cfl * dx / den)
+    elif smax > 0.0:
+        dt = min(dt, cfl * dx / smax)
+    changed = 0.0
+    if strang:
+        h_lo = b_lo if first else a_lo
+        h_hi = b_hi if first else a_hi
+        for attempt in range(40):
+            diag[L.D_DT] = 0.5 * dt
+            _sources(q, 0.5 * dt, t, P, diag, two_layer, h_lo, h_hi)
+            changed = diag[L.D_CHANGED]
+            # (a deposit can lift a cell of sub-dry layers above dry: search wider)
+            smax2, a_lo, a_hi = _rate(q, rate, rec, dx, bc_left, bc_right, P,
+                                      two_layer, flux, order, limiter, b_lo, b_hi)
+            if smax2 * dt <= cfl * dx * (1.0 + 1e-9) or attempt == 39:
+                break
+            # the half source step made the waves faster than dt allows (erosion
+            # can deepen the upper layer 1/r-fold): undo it and retry shorter
+            q[:, b_lo:b_hi + 1] = backup[:, b_lo:b_hi + 1]
+            diag[:L.N_DIAG] = diag_keep
+            fex[b_lo:b_hi + 1] = fex_keep[b_lo:b_hi + 1]
+            dt = min(0.5 * dt, cfl * dx / smax2)
+    if order == 1:
+        mass_rate, ok = _update(q, q, rate, dt, 0.0, a_lo, a_hi)
+    else:
+        q0[:, b_lo:b_hi + 1] = q[:, b_lo:b_hi + 1]
+        mass_rate, ok = _update(q, q0, rate, dt, 0.0, a_lo, a_hi)
+        if ok:
+            friction_predictor(q, dt, P, two_layer, a_lo, a_hi)
+            _, c_lo, c_hi = _rate(q, rate, rec, dx, bc_left, bc_right, P,
+                                  two_layer, flux, order, limiter, b_lo, b_hi)
+            # cells of the first stage that the second does not reach get rate 0
+            for i in range(a_lo, a_hi + 1):
+                if i < c_lo or i > c_hi:
+                    rate[:, i] = 0.0
+            if a_lo > a_hi:
+                a_lo = c_lo
+                a_hi = c_hi
+            elif c_lo <= c_hi:
+                a_lo = min(a_lo, c_lo)
+                a_hi = max(a_hi, c_hi)
+            mass2, ok = _update(q, q0, rate, dt, 0.5, a_lo, a_hi)
+            mass_rate = max(mass_rate, mass2)
+    return dt, mass_rate, ok, a_lo, a_hi, changed
+
+
+@njit(cache=True)
 def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int,
                   bc_right: int, P: np.ndarray, cfl: float, diag: np.ndarray,
                   rate: np.ndarray, backup: np.ndarray, work: np.ndarray, max_steps: int,
@@ -417,7 +486,8 @@ def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int
     rec = work[:2]
     q0 = work[2]
     fex = diag[L.N_DIAG:]
-    diag_keep = np.empty(L.N_DIAG)  # Strang: undo a half source step that broke the CFL
+    # to undo a Strang half source step that broke the CFL, or an IFCP step
+    diag_keep = np.empty(L.N_DIAG)
     fex_keep = np.empty(n)
     # Cells outside the wet region plus the stencil are dry and at rest, which every
     # stage leaves unchanged: only the active cells are visited. The first step visits
@@ -442,61 +512,25 @@ def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int
             b_lo = max(lo - 2, 0)
             b_hi = min(hi + 2, n - 1)
         backup[:, b_lo:b_hi + 1] = q[:, b_lo:b_hi + 1]
-        smax, a_lo, a_hi = _rate(q, rate, rec, dx, bc_left, bc_right, P, two_layer,
-                                 flux, order, limiter, lo, hi)
-        dt = t_end - t
-        if strang:
-            # the first half source step may accelerate a layer by up to dt/2 |g_x|
-            # (friction only brakes): choose dt with dt (smax + dt |g_x| / 2) = cfl dx
-            gx = abs(P[L.G_X])
-            den = smax + math.sqrt(smax * smax + 2.0 * gx * cfl * dx)
-            if den > 0.0:
-                dt = min(dt, 2.0 * cfl * dx / den)
-        elif smax > 0.0:
-            dt = min(dt, cfl * dx / smax)
-        changed = 0.0
-        if strang:
-            h_lo = b_lo if first else a_lo
-            h_hi = b_hi if first else a_hi
+        if strang or flux == L.FLUX_IFCP:
             diag_keep[:] = diag[:L.N_DIAG]
             fex_keep[b_lo:b_hi + 1] = fex[b_lo:b_hi + 1]
-            for attempt in range(40):
-                diag[L.D_DT] = 0.5 * dt
-                _sources(q, 0.5 * dt, t, P, diag, two_layer, h_lo, h_hi)
-                changed = diag[L.D_CHANGED]
-                # (a deposit can lift a cell of sub-dry layers above dry: search wider)
-                smax2, a_lo, a_hi = _rate(q, rate, rec, dx, bc_left, bc_right, P,
-                                          two_layer, flux, order, limiter, b_lo, b_hi)
-                if smax2 * dt <= cfl * dx * (1.0 + 1e-9) or attempt == 39:
-                    break
-                # the half source step made the waves faster than dt allows (erosion
-                # can deepen the upper layer 1/r-fold): undo it and retry shorter
-                q[:, b_lo:b_hi + 1] = backup[:, b_lo:b_hi + 1]
-                diag[:L.N_DIAG] = diag_keep
-                fex[b_lo:b_hi + 1] = fex_keep[b_lo:b_hi + 1]
-                dt = min(0.5 * dt, cfl * dx / smax2)
+        fl = flux
+        for _ in range(2):
+            dt, mass_rate, ok, a_lo, a_hi, changed = _advect_step(
+                q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, rec, q0,
+                diag_keep, fex_keep, two_layer, fl, order, limiter, strang, first, lo, hi,
+                b_lo, b_hi)
+            if ok or fl != L.FLUX_IFCP:
+                break
+            # IFCP is Roe's linearisation for one layer: not positive where cells move
+            # apart fast. Redo the step with HLL, which is, and count it.
+            q[:, b_lo:b_hi + 1] = backup[:, b_lo:b_hi + 1]
+            diag[:L.N_DIAG] = diag_keep
+            fex[b_lo:b_hi + 1] = fex_keep[b_lo:b_hi + 1]
+            diag[L.D_FLUX_FALLBACKS] += 1.0
+            fl = L.FLUX_HLL
         t_new = t + dt if dt < t_end - t else t_end
-        if order == 1:
-            mass_rate, ok = _update(q, q, rate, dt, 0.0, a_lo, a_hi)
-        else:
-            q0[:, b_lo:b_hi + 1] = q[:, b_lo:b_hi + 1]
-            mass_rate, ok = _update(q, q0, rate, dt, 0.0, a_lo, a_hi)
-            if ok:
-                friction_predictor(q, dt, P, two_layer, a_lo, a_hi)
-                _, c_lo, c_hi = _rate(q, rate, rec, dx, bc_left, bc_right, P,
-                                      two_layer, flux, order, limiter, b_lo, b_hi)
-                # cells of the first stage that the second does not reach get rate 0
-                for i in range(a_lo, a_hi + 1):
-                    if i < c_lo or i > c_hi:
-                        rate[:, i] = 0.0
-                if a_lo > a_hi:
-                    a_lo = c_lo
-                    a_hi = c_hi
-                elif c_lo <= c_hi:
-                    a_lo = min(a_lo, c_lo)
-                    a_hi = max(a_hi, c_hi)
-                mass2, ok = _update(q, q0, rate, dt, 0.5, a_lo, a_hi)
-                mass_rate = max(mass_rate, mass2)
         if not ok:
             q[:, b_lo:b_hi + 1] = backup[:, b_lo:b_hi + 1]
             return t, steps, STATUS_FAIL

@@ -131,7 +131,8 @@ def diagnose_blowup(pde: GranularPDE, q_good: np.ndarray, t: float, t_end: float
             bad[:, cells] = ~np.isfinite(v[:, cells])
             bad[::2, cells] |= v[::2, cells] < -1e-12 * (1.0 + np.abs(q[::2, cells]))
             mass_rate = float(np.max(np.abs(rate[::2, cells]))) if hi >= lo else 0.0
-        records.append({"dt": float(dt), "after": v.copy(), "bad": bad})
+        records.append({"dt": float(dt), "after": v.copy(), "bad": bad,
+                        "first_stage": weight == 0.0})
         q[...] = v
         return mass_rate, not bool(bad.any())
 
@@ -139,6 +140,9 @@ def diagnose_blowup(pde: GranularPDE, q_good: np.ndarray, t: float, t_end: float
         replay(q_good.copy(), t, t_end, update)
     except Exception as err:  # pragma: no cover - diagnostics must not mask the blow-up
         return {"cause": f"the failed step could not be replayed ({err!r})"}
+    # an IFCP step that fails is redone with HLL: the last attempt is the one that counts
+    starts = [k for k, rec in enumerate(records) if rec["first_stage"]]
+    records = records[starts[-1]:] if starts else records
     failed = [(k, rec) for k, rec in enumerate(records) if rec["bad"].any()]
     if not failed:
         return {"cause": "the replayed step did not fail (non-deterministic failure?)"}
@@ -234,9 +238,12 @@ class FVSplitSolver(SolverBase):
 
         def replay(q: np.ndarray, t0: float, t1: float, update: Any) -> None:
             # one step of the kernel's own Python code with an instrumented state update
-            py = advance_split.py_func
-            kernel = types.FunctionType(py.__code__, {**vars(_splitting), "_update": update},
-                                        py.__name__, py.__defaults__, py.__closure__)
+            scope = {**vars(_splitting), "_update": update}
+            for name in ("_advect_step", "advance_split"):
+                py = getattr(_splitting, name).py_func
+                scope[name] = types.FunctionType(py.__code__, scope, py.__name__,
+                                                 py.__defaults__, py.__closure__)
+            kernel = scope["advance_split"]
             run_kernel(kernel, q, t0, t1, diag.copy(), np.empty_like(q), np.empty_like(q),
                        np.empty_like(work), 1)
 
