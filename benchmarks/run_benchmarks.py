@@ -326,13 +326,15 @@ def _render_wp(wp: dict[str, Any]) -> str:
     if h:
         L.append("### Hyperbolicity modes on 5.1 (two layers, to rest)\n")
         L.append("| mode | cells | wall [ms] | steps | max F_extra/rho1 [m^2/s^2] | "
-                 "hyperbolicity events (cell-steps) | lower stop [s] | upper stop [s] | "
-                 "run-out [m] |")
-        L.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+                 "hyperbolicity events (cell-steps) | of which bisected | lower stop [s] | "
+                 "upper stop [s] | run-out [m] |")
+        L.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
         for r in h:
             L.append(f"| {r['mode']} | {r['cells']} | {r['wall_s'] * 1e3:.3g} | "
                      f"{r['steps']} | {_f(r['max_fextra_over_rho1'], '.3g')} | "
-                     f"{r['hyperbolicity_events']} | {_f(r['lower_stop_time'], '.3f')} | "
+                     f"{r['hyperbolicity_events']} | "
+                     f"{r.get('hyperbolicity_bisections', '-')} | "
+                     f"{_f(r['lower_stop_time'], '.3f')} | "
                      f"{_f(r['upper_stop_time'], '.3f')} | {_f(r['runout'], '.3f')} |")
         L.append("")
     return "\n".join(L)

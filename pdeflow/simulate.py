@@ -142,6 +142,7 @@ def summarize(res: RunResult, mass0: float, wall: float) -> dict[str, Any]:
                 "max_fextra_x": float(res.x[int(diag[L.D_FEXTRA_CELL])]),
                 "max_fextra_time": float(diag[L.D_FEXTRA_TIME]),
                 "hyperbolicity_events": int(diag[L.D_HYP_EVENTS]),
+                "hyperbolicity_bisections": int(diag[L.D_HYP_BISECTIONS]),
                 "deposited_volume": float(diag[L.D_DEPOSITED] * dx),
                 "eroded_volume": float(diag[L.D_ERODED] * dx),
                 "upper_volume_final": float(np.sum(d[0]) * dx),

@@ -181,7 +181,8 @@ def test_direct_restoration_is_the_bisection_limit(mode):
         v1, v2 = _friction(b1, b2, h1, h2, dt, P, 0.0)
         if is_hyperbolic(h1, h2, v1, v2, P[L.G_Z], P[L.R], mode):
             continue
-        f, u1, u2 = _restore_hyperbolicity(b1, b2, h1, h2, v1, v2, dt, P)
+        f, u1, u2, bisected = _restore_hyperbolicity(b1, b2, h1, h2, v1, v2, dt, P)
+        assert not bisected  # the direct solve found it
         assert is_hyperbolic(h1, h2, u1, u2, P[L.G_Z], P[L.R], mode)
         assert (u1, u2) == _friction(b1, b2, h1, h2, dt, P, f)
         f_w = _bisect_fextra(b1, b2, h1, h2, v1 - v2, dt, P)

@@ -618,7 +618,8 @@ def hyperbolicity_study(case_path: str | Path | Case,
     Each mode runs the case to rest (or t_end) with :func:`pdeflow.simulate.run_model`
     once to warm up and ``repeats`` times; rows give the median wall time [s], steps,
     ``max_fextra_over_rho1`` [m^2/s^2], ``hyperbolicity_events`` (cell-steps in which
-    F_extra was applied), stop times [s] and run-out [m].
+    F_extra was applied), ``hyperbolicity_bisections`` (of those, how many needed the
+    bisection fallback), stop times [s] and run-out [m].
     """
     from ..simulate import run_model
 
@@ -640,6 +641,7 @@ def hyperbolicity_study(case_path: str | Path | Case,
                    "steps": s["steps"], "t_final": s["t_final"],
                    "max_fextra_over_rho1": s["max_fextra_over_rho1"],
                    "hyperbolicity_events": s["hyperbolicity_events"],
+                   "hyperbolicity_bisections": s["hyperbolicity_bisections"],
                    "lower_stop_time": s["lower_stop_time"],
                    "upper_stop_time": s["upper_stop_time"], "runout": s["runout"]}
             if log is not None:

@@ -55,6 +55,7 @@ D_HYP_EVENTS = 11  #: number of cell-steps in which hyperbolicity was restored
 D_CHANGED = 12  #: 1 if the last source stage changed any depth or momentum
 D_STEPS = 13  #: number of source stages applied
 D_FLUX_FALLBACKS = 14  #: steps redone with HLL because the IFCP step was not positive
+D_HYP_BISECTIONS = 15  #: restorations that needed the bisection fallback (see splitting)
 N_DIAG = 16  #: the per-cell F_extra/rho1 of the last step follows at N_DIAG
 
 # --- boundary conditions ---------------------------------------------------------------

@@ -103,8 +103,8 @@ def _bisect_fextra(b1, b2, h1, h2, du0, dt, P):
 
 @njit(cache=True)
 def _restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P):
-    r"""Smallest F_extra/rho2 [m^2/s^2] making the post-friction state hyperbolic, and
-    the velocities (u1, u2) [m/s] it leads to.
+    r"""Smallest F_extra/rho2 [m^2/s^2] making the post-friction state hyperbolic, the
+    velocities (u1, u2) [m/s] it leads to, and whether the bisection fallback was used.
 
     The depths are frozen, so the target is a relative velocity: the lower band edge
     F_c1 (F_L in ``bound`` mode). Stage (32) with the extra exchange f = F_extra/rho2
@@ -153,10 +153,10 @@ def _restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P):
             v1, v2 = _friction(b1, b2, h1, h2, dt, P, f)
             # below the edge is hyperbolic down to F_L (the band is one interval)
             if edge - P[L.W] <= sgn * (v1 - v2) <= edge:
-                return f, v1, v2
+                return f, v1, v2, False
     f = _bisect_fextra(b1, b2, h1, h2, du0, dt, P)
     v1, v2 = _friction(b1, b2, h1, h2, dt, P, f)
-    return f, v1, v2
+    return f, v1, v2, True
 
 
 @njit(cache=True)
@@ -235,7 +235,10 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
             # --- (33)-(34) hyperbolicity --------------------------------------------------
             if mode > 0 and h1 > dry and h2 > dry:
                 if not is_hyperbolic(h1, h2, v1, v2, g, r, mode):
-                    f, v1, v2 = _restore_hyperbolicity(b1, b2, h1, h2, v1, v2, dt, P)
+                    f, v1, v2, bisected = _restore_hyperbolicity(b1, b2, h1, h2, v1, v2,
+                                                                 dt, P)
+                    if bisected:
+                        diag[L.D_HYP_BISECTIONS] += 1.0
                     fex[i] = abs(f) / r
                     diag[L.D_HYP_EVENTS] += 1.0
                     if fex[i] > diag[L.D_FEXTRA_MAX]:
