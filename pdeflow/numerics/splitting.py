@@ -119,8 +119,9 @@ def _restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P):
       = \mathrm{sgn}(du_0)\,(\Delta t K + m_1 d + \Delta t C d^2)`.
 
     The branch is not known beforehand: each candidate is checked by solving (32)
-    with it (hyperbolic, and |du| within w of the target); if none passes (round-off
-    at a branch boundary), bisection decides (:func:`_bisect_fextra`).
+    with it (|du| must land within w below the edge, where the state is hyperbolic);
+    if none passes (round-off at a branch boundary), bisection decides
+    (:func:`_bisect_fextra`).
     """
     g = P[L.G_Z]
     r = P[L.R]
