@@ -190,22 +190,23 @@ tried (the grid study below uses 1).
 """
 
 
-TARGETS_NOTE = """What the table says. The paper's closure drifts in everything tied to the
-upper layer (its volume halves with dx, see below). The relaxed closure removes that
-drift: V1(t) converges in both schemes. With the first-order scheme the run-out and
-the stop times still drift by a few per cent per level, as the single layer's run-out
-does: the front of a first-order Coulomb collapse creeps outwards with refinement
-(numerical diffusion), which is the scheme, not the closure. With MUSCL the run-out,
-the stop time of the run, the upper layer's stop times (both definitions) and the
-practical stop time of the lower layer change by 1.5 % or less, and the 5.2 exponent
-by less than 0.01. The one quantity that does not settle is the lower layer's *exact*
-stop time (u2 = 0 in every cell): after the lower layer has stopped (about 1.0 s), the
-upper layer still flowing over it re-mobilises single cells at mm/s (interface stress
-briefly above basal friction where the lower layer is thin), and the time of the last
-such event depends on the grid. The practical definition (|u| < 1 cm/s where
-h > 1 mm) is the robust one for the lower layer, as far as the parameters allow: with
-k = 0.8 the re-mobilisation exceeds 1 cm/s on fine grids and even the practical stop
-time changes by more than 10 % on dx/2 (calibration_relaxed.md).
+TARGETS_NOTE = """What the table says. The paper's closure drifts in everything tied
+to the upper layer (its volume halves with dx, see below). The relaxed closure removes
+that drift: V1(t) converges in both schemes. With the first-order scheme the run-out
+and the stop times still drift by a few per cent per level, as the single layer's
+run-out does: the front of a first-order Coulomb collapse creeps outwards with
+refinement (numerical diffusion), which is the scheme, not the closure. With MUSCL the
+run-out, the stop time of the run, the upper layer's stop times (both definitions) and
+the practical stop time of the lower layer change by less than 2 %, and the 5.2
+exponent by less than 0.01 (tests/test_validation.py checks both). The one quantity
+that does not settle is the lower layer's *exact* stop time (u2 = 0 in every cell):
+after the lower layer has stopped (about 1.0 s), the upper layer still flowing over it
+re-mobilises single cells at mm/s (interface stress briefly above basal friction where
+the lower layer is thin), and the time of the last such event depends on the grid. The
+practical definition (|u| < 1 cm/s where h > 1 mm) is the robust one for the lower
+layer, as far as the parameters allow: with k = 0.8 the re-mobilisation exceeds 1 cm/s
+on fine grids and even the practical stop time changes by more than 10 % on dx/2
+(calibration_relaxed.md).
 
 The maximum of F_extra/rho1 occurs at the toe of the initial column within the first
 few steps (its time halves with dx): a start-up transient at the corner of the

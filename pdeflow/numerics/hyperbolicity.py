@@ -82,16 +82,6 @@ def eigenvalues(h1: float, h2: float, u1: float, u2: float, g: float,
 
 
 @njit(cache=True)
-def inner_gap(h1: float, h2: float, u1: float, u2: float, g: float, r: float) -> float:
-    """lambda_3 - lambda_2 [m/s] if the inner roots are real, else -1."""
-    lam = eigenvalues(h1, h2, u1, u2, g, r)
-    scale = math.sqrt(g * (h1 + h2)) + abs(u1 - u2)
-    if abs(lam[1].imag) > 1e-7 * scale or abs(lam[2].imag) > 1e-7 * scale:
-        return -1.0
-    return lam[2].real - lam[1].real
-
-
-@njit(cache=True)
 def _quartic_in_a(h1: float, h2: float, r: float) -> tuple[float, float, float, float,
                                                               float]:
     r"""Coefficients (a4, a3, a2, a1, a0) of Delta/16 as a quartic in A = (du/2)^2/(g H).
