@@ -178,18 +178,52 @@ def test_direct_restoration_is_the_bisection_limit(mode):
         h1, h2 = rng.uniform(0.01, 1.5, 2)
         b1, b2 = rng.uniform(-8, 8, 2)
         dt = rng.uniform(1e-4, 1e-2)
-        v1, v2 = _friction(b1, b2, h1, h2, dt, P, 0.0)
+        kc = (P[L.K], P[L.C])  # the paper's interface stress t1 (no erosion this step)
+        v1, v2 = _friction(b1, b2, h1, h2, dt, P, 0.0, *kc)
         if is_hyperbolic(h1, h2, v1, v2, P[L.G_Z], P[L.R], mode):
             continue
-        f, u1, u2, bisected = _restore_hyperbolicity(b1, b2, h1, h2, v1, v2, dt, P)
+        f, u1, u2, bisected = _restore_hyperbolicity(b1, b2, h1, h2, v1, v2, dt, P, *kc)
         assert not bisected  # the direct solve found it
         assert is_hyperbolic(h1, h2, u1, u2, P[L.G_Z], P[L.R], mode)
-        assert (u1, u2) == _friction(b1, b2, h1, h2, dt, P, f)
-        f_w = _bisect_fextra(b1, b2, h1, h2, v1 - v2, dt, P)
+        assert (u1, u2) == _friction(b1, b2, h1, h2, dt, P, f, *kc)
+        f_w = _bisect_fextra(b1, b2, h1, h2, v1 - v2, dt, P, *kc)
         assert abs(f) <= abs(f_w) * (1 + 1e-12)
         P[L.W] = 1e-12
-        f_fine = _bisect_fextra(b1, b2, h1, h2, v1 - v2, dt, P)
-        du_fine = np.subtract(*_friction(b1, b2, h1, h2, dt, P, f_fine))
+        f_fine = _bisect_fextra(b1, b2, h1, h2, v1 - v2, dt, P, *kc)
+        du_fine = np.subtract(*_friction(b1, b2, h1, h2, dt, P, f_fine, *kc))
         assert abs((u1 - u2) - du_fine) <= 2e-8 * abs(du_fine)
         checked += 1
     assert checked > 30
+
+
+@pytest.mark.parametrize("h1, u1", [(1e-4, 0.2), (0.01, 0.3), (0.1, 1.0), (0.5, 2.0)])
+def test_erosion_from_a_stuck_lower_layer_creates_no_momentum(h1, u1):
+    """Eroded material enters the upper layer at the lower layer's velocity (upwind
+    exchange), so eroding a lower layer that basal friction holds at rest can only slow
+    the upper layer: on a flat bed the source stage never adds momentum. (Carrying u1
+    instead let the bed's reaction to the eroded mass's acceleration create momentum:
+    thin fast films then eroded and slid for ever at large c.)"""
+    eq = pdeflow.TwoLayerGranular(phi_b_deg=30, k=0.5, c=3.0)
+    r = eq.parameters.density_ratio
+    q = np.array([[h1], [h1 * u1], [0.5], [0.0]])
+    p0 = r * q[1, 0] + q[3, 0]
+    diag = eq.new_diagnostics(1)
+    eq.source_kernel()(q, 5e-3, 5e-3, eq.parameter_array(), diag)
+    assert diag[L.D_ERODED] > 0  # the closure erodes here
+    assert q[3, 0] == 0.0  # the lower layer stays stuck
+    assert r * q[1, 0] + q[3, 0] <= p0 * (1 + 1e-12)
+    # the velocity of a speck is diluted by what it erodes: it cannot keep sliding
+    assert q[1, 0] / q[0, 0] < u1 * h1 / (h1 + diag[L.D_ERODED]) + 1e-12
+
+
+def test_erosion_keeps_momentum_when_the_lower_layer_slides():
+    """With a frictionless bed the exchange and interface stresses only move momentum
+    between the layers, whichever velocity the exchanged mass carries."""
+    eq = pdeflow.TwoLayerGranular(phi_b_deg=1e-9, k=0.5, c=3.0, hyperbolicity="none")
+    r = eq.parameters.density_ratio
+    q = np.array([[0.05, 0.3], [0.05 * 1.5, 0.3 * 0.2], [0.5, 0.4], [0.5 * 0.3, 0.4 * 0.1]])
+    p0 = np.sum(r * q[1] + q[3])
+    diag = eq.new_diagnostics(2)
+    eq.source_kernel()(q, 5e-3, 5e-3, eq.parameter_array(), diag)
+    assert diag[L.D_ERODED] > 0
+    assert np.sum(r * q[1] + q[3]) == pytest.approx(p0, rel=1e-12)

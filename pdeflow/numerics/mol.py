@@ -7,7 +7,9 @@ eps = ``mol_eps``, and the closure's denominator is max(|du|, du_reg, eps). A st
 rest is therefore *not* held by static friction in this form: that is the price of
 the method of lines, and why the paper splits the sources.
 
-Kinematic form (divided by rho2), with the exchanged mass carrying u1:
+Kinematic form (divided by rho2), with the exchanged mass carrying u1 (as a rate this is
+(27) exactly; the split exchange stage carries the velocity of the layer the mass leaves,
+which is the same equation rewritten through (25), see :mod:`pdeflow.numerics.sources`):
 
 .. math::  \dot h_1 = M/r,\quad \dot h_2 = -M,\quad
            \dot m_1 = g_x h_1 + u_1 M / r - t_1/r,\quad

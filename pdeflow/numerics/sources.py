@@ -32,10 +32,23 @@ Exchange stage (31)
 h1 += dt M/rho1 and h2 -= dt M/rho2, with M limited so that h1 neither crosses h1_eq
 nor goes negative and h2 stays non-negative; an upper layer left thinner than
 ``film`` is deposited whole, in erosion as in deposition (a film of a few grains is no
-flowing layer, and left alone it can sit at h1_eq and creep for ever). The exchanged mass carries
-the upper layer's velocity u1 in both directions, which is what the momentum sources
-of (27) amount to once t2 is eliminated through (25) (t2 = t1 - M du); this keeps
-rho1 h1 u1 + rho2 h2 u2 conserved even when M is limited.
+flowing layer, and left alone it can sit at h1_eq and creep for ever).
+
+The exchanged mass carries the velocity of the layer it leaves (upwind): u1 when the
+upper layer deposits, u2 when it erodes. Through (25) the upper layer's momentum
+source of (27) can be written either way, u1 M - t1 = u2 M - (t1 - M du), so the
+friction stage (32) of an eroding cell uses the interface stress t1 - M du with the
+applied (limited) exchange M = phi M_25, 0 < phi <= 1:
+
+.. math::  t_1 - M\,du = \phi\, t_2 + (1 - \phi)\, t_1,
+
+i.e. (22) with k -> k + phi (1 - k) and c -> (1 - phi) c: the same convex friction law,
+solved exactly by :func:`friction_two_layer`. Carrying u1 when eroding made a lower
+layer held by basal friction pay the eroded mass's acceleration with explicit du while
+the stress t1 came back at the implicit (braked) du; the difference created momentum,
+and thin fast films eroded and slid for ever at large c (docs/model.md, "Coming to
+rest when the upper layer erodes"). Either way rho1 h1 u1 + rho2 h2 u2 is conserved,
+even when M is limited.
 
 Implicit friction (32)
 ----------------------

@@ -4,8 +4,10 @@ One step of length dt (Lie splitting, as in the paper):
 
 1. advection (29): q <- q + dt L_HLL(q), dt = CFL dx / max|S| over the faces;
 2. exchange (31): limited closure (25), see :func:`pdeflow.numerics.sources.exchange_depth`;
-3. implicit momentum sources (32): gravity along the bed, Voellmy interface stress,
-   Coulomb basal friction, solved for both layers together;
+   the exchanged mass carries the velocity of the layer it leaves;
+3. implicit momentum sources (32): gravity along the bed, Voellmy interface stress
+   (t1 - M du where the step eroded, see :mod:`pdeflow.numerics.sources`), Coulomb basal
+   friction, solved for both layers together;
 4. hyperbolicity (33)-(34): where the inner eigenvalues are complex, stage 3 is
    repeated with the smallest extra exchange F_extra that restores hyperbolicity.
 
@@ -26,7 +28,13 @@ from numba import njit
 from . import layout as L
 from .advection import advect_single, advect_two_layer, wet_cells
 from .hyperbolicity import band_lower_edge, is_hyperbolic, lower_bound_fl
-from .sources import _drag_root, coulomb_single, exchange_depth, friction_two_layer
+from .sources import (
+    _drag_root,
+    closure_rate,
+    coulomb_single,
+    exchange_depth,
+    friction_two_layer,
+)
 from .state import velocity
 
 STATUS_END = 0  #: reached t_end
@@ -35,8 +43,10 @@ STATUS_FAIL = 2  #: non-finite or negative state: the step was undone
 
 
 @njit(cache=True)
-def _friction(b1, b2, h1, h2, dt, P, f):
-    """Implicit stage (32) for one cell with extra exchange ``f`` = F_extra/rho2."""
+def _friction(b1, b2, h1, h2, dt, P, f, k, c):
+    """Implicit stage (32) for one cell with extra exchange ``f`` = F_extra/rho2 and the
+    interface law (22) with friction reduction ``k`` and collisional coefficient ``c``
+    (the parameters', or those of t1 - M du in a cell that eroded this step)."""
     r = P[L.R]
     g = P[L.G_Z]
     dry = P[L.DRY]
@@ -47,14 +57,14 @@ def _friction(b1, b2, h1, h2, dt, P, f):
         if f != 0.0:
             b1 = b1 - dt * f / m1
             b2 = b2 + dt * f / h2
-        kdt = dt * P[L.K] * r * g * h1 * P[L.TAN_INT]
+        kdt = dt * k * r * g * h1 * P[L.TAN_INT]
         bdt = dt * g * (r * h1 + h2) * P[L.TAN_B]
-        return friction_two_layer(b1, b2, m1, h2, kdt, dt * P[L.C], bdt)
+        return friction_two_layer(b1, b2, m1, h2, kdt, dt * c, bdt)
     if wet1:
         # no lower layer: the upper layer rubs on the bed with the interface law (22)
         m1 = r * h1
-        kdt = dt * P[L.K] * r * g * h1 * P[L.TAN_INT]
-        u1 = _drag_root(m1 * abs(b1) - kdt, m1, dt * P[L.C])
+        kdt = dt * k * r * g * h1 * P[L.TAN_INT]
+        u1 = _drag_root(m1 * abs(b1) - kdt, m1, dt * c)
         return (u1 if b1 > 0.0 else -u1), 0.0
     if wet2:
         mu_dt = dt * g * P[L.TAN_B] * (h2 + r * max(h1, 0.0)) / h2
@@ -63,7 +73,7 @@ def _friction(b1, b2, h1, h2, dt, P, f):
 
 
 @njit(cache=True)
-def _bisect_fextra(b1, b2, h1, h2, du0, dt, P):
+def _bisect_fextra(b1, b2, h1, h2, du0, dt, P, k, c):
     """F_extra/rho2 [m^2/s^2] by bracketing and bisection on the hyperbolicity test:
     the fallback of :func:`_restore_hyperbolicity`, stopping when the bracket in du is
     below w."""
@@ -79,7 +89,7 @@ def _bisect_fextra(b1, b2, h1, h2, du0, dt, P):
     du_lo = abs(du0)
     sgn = 1.0 if du0 > 0.0 else -1.0
     for _ in range(60):
-        v1, v2 = _friction(b1, b2, h1, h2, dt, P, f_hi)
+        v1, v2 = _friction(b1, b2, h1, h2, dt, P, f_hi, k, c)
         du_hi = sgn * (v1 - v2)
         if du_hi <= 0.0 or is_hyperbolic(h1, h2, v1, v2, g, r, mode):
             break
@@ -90,7 +100,7 @@ def _bisect_fextra(b1, b2, h1, h2, du0, dt, P):
         if du_lo - du_hi <= w or abs(f_hi - f_lo) <= 1e-12 * abs(f_hi):
             break
         f_mid = 0.5 * (f_lo + f_hi)
-        v1, v2 = _friction(b1, b2, h1, h2, dt, P, f_mid)
+        v1, v2 = _friction(b1, b2, h1, h2, dt, P, f_mid, k, c)
         du_mid = sgn * (v1 - v2)
         if du_mid <= 0.0 or is_hyperbolic(h1, h2, v1, v2, g, r, mode):
             f_hi = f_mid
@@ -102,7 +112,7 @@ def _bisect_fextra(b1, b2, h1, h2, du0, dt, P):
 
 
 @njit(cache=True)
-def _restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P):
+def _restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P, k, c):
     r"""Smallest F_extra/rho2 [m^2/s^2] making the post-friction state hyperbolic, the
     velocities (u1, u2) [m/s] it leads to, and whether the bisection fallback was used.
 
@@ -137,8 +147,8 @@ def _restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P):
         m1 = r * h1
         m2 = h2
         mt = m1 + m2
-        kdt = dt * P[L.K] * r * g * h1 * P[L.TAN_INT]
-        cdt = dt * P[L.C]
+        kdt = dt * k * r * g * h1 * P[L.TAN_INT]
+        cdt = dt * c
         bdt = dt * g * (r * h1 + h2) * P[L.TAN_B]
         s_first = 1.0 if u2 >= 0.0 else -1.0
         for branch in range(3):
@@ -151,12 +161,12 @@ def _restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P):
                      - sgn * (kdt + m1 * m2 / mt * d + cdt * d * d)) / dt
             if f * sgn <= 0.0:
                 continue
-            v1, v2 = _friction(b1, b2, h1, h2, dt, P, f)
+            v1, v2 = _friction(b1, b2, h1, h2, dt, P, f, k, c)
             # below the edge is hyperbolic down to F_L (the band is one interval)
             if edge - P[L.W] <= sgn * (v1 - v2) <= edge:
                 return f, v1, v2, False
-    f = _bisect_fextra(b1, b2, h1, h2, du0, dt, P)
-    v1, v2 = _friction(b1, b2, h1, h2, dt, P, f)
+    f = _bisect_fextra(b1, b2, h1, h2, du0, dt, P, k, c)
+    v1, v2 = _friction(b1, b2, h1, h2, dt, P, f, k, c)
     return f, v1, v2, True
 
 
@@ -204,14 +214,25 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
         u1 = velocity(h1, m1, dry)
         u2 = velocity(h2, m2, dry)
         if dt > 0.0:
-            # --- (31) mass exchange, carrying the upper layer's velocity -----------------
+            # interface stress of (32): the paper's t1 (22) unless erosion rewrites it
+            k_eff = P[L.K]
+            c_eff = P[L.C]
+            # --- (31) mass exchange; the exchanged mass carries the velocity of the layer
+            # it leaves (upwind): u1 when depositing, u2 when eroding ------------------
             if h1 > 0.0 and P[L.TAU_STAR] >= 0.0:
                 tau = P[L.TAU_STAR] * math.sqrt((h1 + h2) / g) if P[L.TAU_STAR] > 0.0 \
                     else 0.0
-                dh1 = exchange_depth(h1, h2, u1 - u2, dt, r, g, P[L.TAN_INT], P[L.K],
+                du = u1 - u2
+                dh1 = exchange_depth(h1, h2, du, dt, r, g, P[L.TAN_INT], P[L.K],
                                      P[L.C], P[L.DU_REG], P[L.FILM], tau)
                 if dh1 != 0.0:
                     mom = h2 * u2 + r * h1 * u1  # rho-weighted momentum / rho2
+                    phi = 0.0
+                    if dh1 > 0.0:
+                        u1 = (h1 * u1 + dh1 * u2) / (h1 + dh1)
+                        full = closure_rate(h1, du, r, g, P[L.TAN_INT], P[L.K], P[L.C],
+                                            P[L.DU_REG]) * dt / r
+                        phi = min(dh1 / full, 1.0) if full > 0.0 else 1.0
                     h1 = h1 + dh1
                     h2 = max(h2 - r * dh1, 0.0)
                     if h1 <= dry:
@@ -220,6 +241,10 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
                     # lower layer takes the rest of the (rho-weighted) momentum
                     if h2 > dry:
                         u2 = (mom - r * h1 * u1) / h2
+                        if phi > 0.0:
+                            # t1 - M du = phi t2 + (1 - phi) t1 (see the module docstring)
+                            k_eff = P[L.K] + phi * (1.0 - P[L.K])
+                            c_eff = (1.0 - phi) * P[L.C]
                     else:
                         u2 = 0.0
                         if h1 > dry:
@@ -232,12 +257,12 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
             # --- (32) implicit momentum sources ------------------------------------------
             b1 = u1 + dt * gx if h1 > dry else 0.0
             b2 = u2 + dt * gx if h2 > dry else 0.0
-            v1, v2 = _friction(b1, b2, h1, h2, dt, P, 0.0)
+            v1, v2 = _friction(b1, b2, h1, h2, dt, P, 0.0, k_eff, c_eff)
             # --- (33)-(34) hyperbolicity --------------------------------------------------
             if mode > 0 and h1 > dry and h2 > dry:
                 if not is_hyperbolic(h1, h2, v1, v2, g, r, mode):
                     f, v1, v2, bisected = _restore_hyperbolicity(b1, b2, h1, h2, v1, v2,
-                                                                 dt, P)
+                                                                 dt, P, k_eff, c_eff)
                     if bisected:
                         diag[L.D_HYP_BISECTIONS] += 1.0
                     fex[i] = abs(f) / r
@@ -379,7 +404,7 @@ def friction_predictor(q: np.ndarray, dt: float, P: np.ndarray, two_layer: bool,
                 continue
             b1 = velocity(h1, q[1, i], dry) + dt * P[L.G_X] if h1 > dry else 0.0
             b2 = velocity(h2, q[3, i], dry) + dt * P[L.G_X] if h2 > dry else 0.0
-            u1, u2 = _friction(b1, b2, h1, h2, dt, P, 0.0)
+            u1, u2 = _friction(b1, b2, h1, h2, dt, P, 0.0, P[L.K], P[L.C])
             if u1 == 0.0:
                 q[1, i] = 0.0
             if u2 == 0.0:
