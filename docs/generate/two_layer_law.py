@@ -67,6 +67,8 @@ QUICK = {"phi_b_deg": [30, 35, 41], "k": [0.5, 0.65], "c": [0.03, 0.3, 3.0],
 MAP = {"closure": ["relaxed, tau* 0.1", "paper, du_reg 0.2"], "phi_b_deg": [30, 41],
        "k": [0.5, 0.8], "c": [0.1, 1.0, 3.0], "wedge": [60]}
 MAP_DX = [0.0025, 0.00125]
+# sets that are sub-linear on the finest MAP_DX grid but not converged get one more level
+REFINE_DX = 0.000625
 MUSCL = ["numerics.reconstruction='muscl'", "numerics.limiter='mc'"]
 
 # Published planar-collapse laws, r = (R - L0)/L0 against a = H0/L0 (REFERENCE section 4)
@@ -130,17 +132,63 @@ def _map_task(task: tuple[dict, float]) -> dict:
             "sweep_at_rest": r["sweep_at_rest"], "wall": time.perf_counter() - t0}
 
 
-def converged_map(workers: int) -> list[dict]:
-    """Part C: the 5.2 fit of every MAP set on the MAP_DX grids, in worker processes."""
-    keys = list(MAP)
-    tasks = [(dict(zip(keys, values, strict=True)), dx)
-             for values in itertools.product(*(MAP[k] for k in keys)) for dx in MAP_DX]
+def _map_key(row: dict) -> tuple:
+    return (row["closure"], row["phi_b_deg"], row["k"], row["c"], row["wedge"])
+
+
+def _finest_two(levels: dict) -> tuple[dict, dict]:
+    """The rows of the two finest grids of one set (levels: dx -> row)."""
+    d = sorted(levels)
+    return levels[d[1]], levels[d[0]]
+
+
+def _change(levels: dict) -> float | None:
+    a, b = _finest_two(levels)
+    if a["exponent"] is None or b["exponent"] is None:
+        return None
+    return abs(b["exponent"] - a["exponent"])
+
+
+def _run_tasks(tasks: list[tuple[dict, float]], workers: int) -> list[dict]:
     # the finest (slowest) sweeps first, so that the pool ends evenly
-    tasks.sort(key=lambda t: t[1])
+    tasks = sorted(tasks, key=lambda t: t[1])
+    if not tasks:
+        return []
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        out = list(pool.map(_map_task, tasks))
-    print(f"converged map: {len(out)} sweeps", flush=True)
-    return out
+        return list(pool.map(_map_task, tasks))
+
+
+def converged_map(workers: int, done: list[dict]) -> list[dict]:
+    """Part C: the 5.2 fit of every MAP set on the MAP_DX grids, and on REFINE_DX for the
+    sets that are sub-linear but not converged there; sweeps already in ``done`` (rows of
+    the map CSV) are not rerun."""
+    have = {(_map_key(r), r["dx"]) for r in done}
+    keys = list(MAP)
+    sets = [dict(zip(keys, values, strict=True))
+            for values in itertools.product(*(MAP[k] for k in keys))]
+    rows = list(done)
+    rows += _run_tasks([(p, dx) for p in sets for dx in MAP_DX
+                        if (_map_key(p), dx) not in have], workers)
+    groups = _group(rows)
+    refine = []
+    for p in sets:
+        levels = groups[_map_key(p)]
+        change = _change(levels)
+        finest = levels[min(levels)]
+        if (change is not None and change >= 0.01 and finest["exponent"] < 0.95
+                and min(levels) > REFINE_DX):
+            refine.append((p, REFINE_DX))
+    rows += _run_tasks(refine, workers)
+    print(f"converged map: {len(rows) - len(done)} new sweeps", flush=True)
+    return rows
+
+
+def _group(rows: list[dict]) -> dict:
+    """Map rows by set: key -> {dx: row}."""
+    groups: dict = {}
+    for r in rows:
+        groups.setdefault(_map_key(r), {})[r["dx"]] = r
+    return groups
 
 
 def write_csv(rows: list[dict], path: Path) -> None:
@@ -238,7 +286,7 @@ def map_answer(groups: dict) -> list[str]:
         sets = [lv for key, lv in groups.items() if key[0] == closure]
         conv = []
         for lv in sets:
-            a, b = lv[MAP_DX[0]], lv[MAP_DX[1]]
+            a, b = _finest_two(lv)
             if (a["exponent"] is not None and b["exponent"] is not None
                     and a["sweep_at_rest"] and b["sweep_at_rest"]
                     and abs(b["exponent"] - a["exponent"]) < 0.01):
@@ -251,10 +299,9 @@ def map_answer(groups: dict) -> list[str]:
 
 def answers(groups: dict, conv: dict) -> list[str]:
     """The issue's questions of part C, answered from the numbers above."""
-    fine, finer = MAP_DX
     sub, conv_sets = [], []
     for key, lv in groups.items():
-        a, b = lv[fine], lv[finer]
+        a, b = _finest_two(lv)
         if a["exponent"] is None or b["exponent"] is None:
             continue
         change = abs(b["exponent"] - a["exponent"])
@@ -266,7 +313,7 @@ def answers(groups: dict, conv: dict) -> list[str]:
     out = ["**Answers (from the tables above).**", ""]
     if conv_sets:
         es = [e for _, e in conv_sets]
-        out.append(f"* Converged (exponent change < 0.01 between dx = {fine} and {finer} m): "
+        out.append("* Converged (exponent change < 0.01 between the two finest grids): "
                    f"{len(conv_sets)} of {len(groups)} map sets, exponents "
                    f"{min(es):.3f} - {max(es):.3f}; sub-linear among them: "
                    f"{sum(e < 0.95 for e in es)}.")
@@ -276,7 +323,7 @@ def answers(groups: dict, conv: dict) -> list[str]:
                    f"all with phi_B in {sorted({k[1] for k, _, _ in sub})} and c in "
                    f"{sorted({k[3] for k, _, _ in sub})}; their exponents still change by "
                    f"{min(c for _, _, c in sub):.3f} - {max(c for _, _, c in sub):.3f} "
-                   "between the two finest grids.")
+                   "between their two finest grids.")
     else:
         out.append("* No map set is sub-linear on the finest grid.")
     for label, (_, levels) in conv.items():
@@ -327,13 +374,10 @@ def figure_laws(curves: dict, path: Path) -> None:
 
 def figure_convergence(conv: dict, map_rows: list[dict], path: Path) -> None:
     """Exponent against dx: the representative sets on four grids, the map's sets on
-    the two finest."""
+    the grids they were run on."""
     fig, ax = plt.subplots(figsize=(7, 4.5))
-    groups: dict = {}
-    for r in map_rows:
-        groups.setdefault((r["closure"], r["phi_b_deg"], r["k"], r["c"]), []).append(r)
-    for key, lv in groups.items():
-        lv = sorted(lv, key=lambda r: r["dx"])
+    for key, levels in _group(map_rows).items():
+        lv = [levels[dx] for dx in sorted(levels)]
         color = "tab:blue" if key[0].startswith("relaxed") else "tab:red"
         ax.plot([r["dx"] for r in lv], [r["exponent"] for r in lv], color=color, lw=0.8,
                 alpha=0.5, marker=".")
@@ -347,7 +391,7 @@ def figure_convergence(conv: dict, map_rows: list[dict], path: Path) -> None:
     ax.axhspan(TARGET_E - TOL_E, TARGET_E + TOL_E, color="0.85", label="0.84 +- 0.05")
     ax.axhline(1.06, color="0.5", ls="--", lw=1, label="paper, one layer: 1.06")
     ax.set_xscale("log")
-    ax.xaxis.set_major_locator(FixedLocator([0.01, 0.005, 0.0025, 0.00125]))
+    ax.xaxis.set_major_locator(FixedLocator([0.01, 0.005, 0.0025, 0.00125, REFINE_DX]))
     ax.xaxis.set_major_formatter(ScalarFormatter())
     ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_xlabel("dx [m]")
@@ -397,8 +441,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--docs", type=Path, default=ROOT / "docs", help="docs directory")
     ap.add_argument("--quick", action="store_true", help="coarse search grid (~3 min)")
     ap.add_argument("--reuse", action="store_true",
-                    help="read the search and the converged-grid map from their CSV files "
-                    "in the docs directory instead of rerunning them")
+                    help="read the search from its CSV file in the docs directory instead "
+                    "of rerunning it, and run only the map sweeps missing from the map CSV")
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                     help="worker processes for the converged-grid map (default: all cores)")
     args = ap.parse_args(argv)
@@ -440,11 +484,12 @@ def main(argv: list[str] | None = None) -> int:
     map_path = docs / "two_layer_law_map.csv"
     if args.quick:
         map_rows = []
-    elif args.reuse:
-        with open(map_path) as fh:
-            map_rows = [_parse(r) for r in csv.DictReader(fh)]
     else:
-        map_rows = converged_map(args.workers)
+        done = []
+        if args.reuse and map_path.exists():
+            with open(map_path) as fh:
+                done = [_parse(r) for r in csv.DictReader(fh)]
+        map_rows = converged_map(args.workers, done)
         write_csv(map_rows, map_path)
 
     single = run_52({}, models="single_layer")
@@ -540,34 +585,37 @@ def main(argv: list[str] | None = None) -> int:
         lines.append(f"| {label}{' (MUSCL)' if muscl else ''} | " + " | ".join(cells)
                      + f" | {change} |")
     if map_rows:
+        dxs_all = [*MAP_DX, REFINE_DX]
         lines += ["", f"Map over phi_B {MAP['phi_b_deg']} x k {MAP['k']} x c {MAP['c']} "
-                  f"(wedge {MAP['wedge'][0]} deg) for the two regularised closures, MUSCL/mc "
-                  f"on dx = {MAP_DX[0]} and {MAP_DX[1]} m ('*': a sweep with a run not at "
-                  "rest by t_end = 30 s; the fit leaves such runs out):", "",
-                  f"| closure | phi_B | k | c | fit, dx {MAP_DX[0]} | fit, dx {MAP_DX[1]} | "
-                  "change of the exponent | converged (< 0.01)? | sub-linear (< 0.95)? |",
-                  "|---|---|---|---|---|---|---|---|---|"]
-        keyf = lambda r: (r["closure"], r["phi_b_deg"], r["k"], r["c"])  # noqa: E731
-        groups: dict = {}
-        for r in map_rows:
-            groups.setdefault(keyf(r), {})[r["dx"]] = r
+                  f"(wedge {MAP['wedge'][0]} deg) for the regularised closures, MUSCL/mc on "
+                  f"dx = {MAP_DX[0]} and {MAP_DX[1]} m, and on {REFINE_DX} m for the sets "
+                  "that are sub-linear there but not converged ('*': a sweep with a run not "
+                  "at rest by t_end = 30 s; the fit leaves such runs out):", "",
+                  "| closure | phi_B | k | c | "
+                  + " | ".join(f"fit, dx {d}" for d in dxs_all)
+                  + " | change of the exponent, finest two | converged (< 0.01)? | "
+                  "sub-linear (< 0.95)? |", "|---|---|---|---|" + "---|" * (len(dxs_all) + 3)]
+        groups = _group(map_rows)
+
+        def fit(r: dict | None) -> str:
+            if r is None:
+                return ""
+            if r["exponent"] is None:
+                return "-"
+            star = "" if r["sweep_at_rest"] else "*"
+            return f"{r['prefactor']:.2f} a^{r['exponent']:.3f}{star}"
+
         for key, lv in groups.items():
-            a, b = lv[MAP_DX[0]], lv[MAP_DX[1]]
-
-            def fit(r: dict) -> str:
-                if r["exponent"] is None:
-                    return "-"
-                star = "" if r["sweep_at_rest"] else "*"
-                return f"{r['prefactor']:.2f} a^{r['exponent']:.3f}{star}"
-
-            if a["exponent"] is None or b["exponent"] is None:
+            d = _change(lv)
+            finest = lv[min(lv)]
+            if d is None:
                 ch, conv_ok, sub = "-", "-", "-"
             else:
-                d = abs(b["exponent"] - a["exponent"])
                 ch, conv_ok = f"{d:.3f}", "yes" if d < 0.01 else "no"
-                sub = "yes" if b["exponent"] < 0.95 else "no"
-            lines.append(f"| {key[0]} | {key[1]} | {key[2]} | {key[3]} | {fit(a)} | "
-                         f"{fit(b)} | {ch} | {conv_ok} | {sub} |")
+                sub = "yes" if finest["exponent"] < 0.95 else "no"
+            lines.append(f"| {key[0]} | {key[1]} | {key[2]} | {key[3]} | "
+                         + " | ".join(fit(lv.get(dx)) for dx in dxs_all)
+                         + f" | {ch} | {conv_ok} | {sub} |")
         walls = [r["wall"] for r in map_rows]
         lines += ["", f"({len(map_rows)} sweeps, {sum(walls) / 60:.0f} CPU-minutes, "
                   f"{args.workers} worker processes.)"]

@@ -3,7 +3,9 @@ r"""Source terms (26)-(27) as a method-of-lines rate (for py-pde's generic solve
 The splitting scheme treats the sources implicitly and limits the exchange; a generic
 ODE integrator needs them as a plain rate instead. Two regularisations make that rate
 finite (both documented parameters): sgn(v) is replaced by v / max(|v|, eps) with
-eps = ``mol_eps``, and the closure's denominator is max(|du|, du_reg, eps). A state at
+eps = ``mol_eps``, and the closure's denominator is max(|du|, du_reg, eps). With
+``exchange_closure = "relaxed"`` the rate is bounded by the relaxation towards h1_eq
+(:func:`pdeflow.numerics.sources.relaxed_rate`), the rate form of the relaxed stage. A state at
 rest is therefore *not* held by static friction in this form: that is the price of
 the method of lines, and why the paper splits the sources.
 
@@ -18,11 +20,13 @@ which is the same equation rewritten through (25), see :mod:`pdeflow.numerics.so
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
 from . import layout as L
-from .sources import closure_rate
+from .sources import closure_rate, relaxed_rate
 from .state import velocity
 
 
@@ -49,6 +53,9 @@ def source_rate_two_layer(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> Non
             m = closure_rate(h1, du, r, g, P[L.TAN_INT], P[L.K], P[L.C], du_reg)
             if (m > 0.0 and not wet2) or P[L.TAU_STAR] < 0.0:
                 m = 0.0
+            elif P[L.TAU_STAR] > 0.0:
+                tau = P[L.TAU_STAR] * math.sqrt((h1 + h2) / g)
+                m = relaxed_rate(m, h1, h2, du, r, g, P[L.TAN_INT], P[L.K], P[L.C], tau)
             t1 = (P[L.K] * r * g * h1 * P[L.TAN_INT] + P[L.C] * du * du) * du / max(
                 abs(du), eps)
             rate[0, i] += m / r

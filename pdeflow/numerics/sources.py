@@ -151,6 +151,23 @@ def closure_rate(h1: float, du: float, r: float, g: float, tan_int: float, k: fl
 
 
 @njit(cache=True)
+def relaxed_rate(m: float, h1: float, h2: float, du: float, r: float, g: float,
+                 tan_int: float, k: float, c: float, tau: float) -> float:
+    """Rate form of the relaxed closure: the kinematic mass flux ``m`` = M/rho2 [m/s]
+    of (25), bounded by the relaxation towards h1_eq on the time scale ``tau`` [s]
+    (the dt -> 0 limit of the relaxed exchange stage of :func:`exchange_depth`):
+    deposition no faster than r (h1 - h1_eq)/tau, erosion no faster than
+    r (min(h1_eq, h1 + h2/r) - h1)/tau."""
+    denom = (1.0 - k) * r * g * tan_int
+    h1_eq = c * du * du / denom if denom > 0.0 else math.inf
+    if m < 0.0:
+        return max(m, r * (min(h1_eq, h1) - h1) / tau)
+    if m > 0.0:
+        return min(m, max(r * (min(h1_eq, h1 + h2 / r) - h1) / tau, 0.0))
+    return m
+
+
+@njit(cache=True)
 def exchange_depth(h1: float, h2: float, du: float, dt: float, r: float, g: float,
                    tan_int: float, k: float, c: float, du_reg: float,
                    film: float, tau: float) -> float:

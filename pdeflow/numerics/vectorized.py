@@ -118,6 +118,14 @@ def source_rate(q: np.ndarray, P: np.ndarray, two_layer: bool) -> np.ndarray:
     du = u1 - u2
     num = P[L.C] * du * du - (1.0 - P[L.K]) * r * g * h1 * P[L.TAN_INT]
     m = num / np.maximum(np.abs(du), max(P[L.DU_REG], eps))
+    if P[L.TAU_STAR] > 0:
+        # relaxed closure: bounded by the relaxation towards h1_eq on tau
+        tau = P[L.TAU_STAR] * np.sqrt(np.maximum(h1 + h2, 1e-300) / g)
+        denom = (1.0 - P[L.K]) * r * g * P[L.TAN_INT]
+        h1_eq = P[L.C] * du * du / denom if denom > 0 else np.full_like(h1, np.inf)
+        dep = r * (np.minimum(h1_eq, h1) - h1) / tau
+        ero = np.maximum(r * (np.minimum(h1_eq, h1 + h2 / r) - h1) / tau, 0.0)
+        m = np.where(m < 0, np.maximum(m, dep), np.where(m > 0, np.minimum(m, ero), m))
     m = np.where(wet1 & ((m <= 0) | wet2) & (P[L.TAU_STAR] >= 0), m, 0.0)
     sgn_du = du / np.maximum(np.abs(du), eps)
     t1 = np.where(wet1, (P[L.K] * r * g * h1 * P[L.TAN_INT] + P[L.C] * du * du) * sgn_du,
