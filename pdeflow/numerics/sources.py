@@ -179,8 +179,17 @@ def exchange_depth(h1: float, h2: float, du: float, dt: float, r: float, g: floa
     integrated relaxation towards h1_eq with time scale tau,
     (h1_eq - h1)(1 - exp(-dt/tau)); ``tau`` = 0 is the paper's closure.
     """
+    return exchange_step(h1, h2, du, dt, r, g, tan_int, k, c, du_reg, film, tau)[0]
+
+
+@njit(cache=True)
+def exchange_step(h1: float, h2: float, du: float, dt: float, r: float, g: float,
+                  tan_int: float, k: float, c: float, du_reg: float, film: float,
+                  tau: float) -> tuple[float, float]:
+    """:func:`exchange_depth` and the unlimited explicit change of the closure,
+    rate dt / r [m] (their ratio is the phi of the erosion stress above)."""
     if h1 <= 0.0:
-        return 0.0
+        return 0.0, 0.0
     rate = closure_rate(h1, du, r, g, tan_int, k, c, du_reg)
     denom = (1.0 - k) * r * g * tan_int
     h1_eq = c * du * du / denom if denom > 0.0 else math.inf
@@ -199,4 +208,4 @@ def exchange_depth(h1: float, h2: float, du: float, dt: float, r: float, g: floa
         # a film thinner than a few grains is no flowing layer: deposit it whole,
         # whatever the closure says (otherwise it can sit at h1_eq and creep forever)
         dh1 = -h1
-    return dh1
+    return dh1, rate * dt / r

@@ -28,13 +28,7 @@ from numba import njit
 from . import layout as L
 from .advection import advect_single, advect_two_layer, wet_cells
 from .hyperbolicity import band_lower_edge, is_hyperbolic, lower_bound_fl
-from .sources import (
-    _drag_root,
-    closure_rate,
-    coulomb_single,
-    exchange_depth,
-    friction_two_layer,
-)
+from .sources import _drag_root, coulomb_single, exchange_step, friction_two_layer
 from .state import velocity
 
 STATUS_END = 0  #: reached t_end
@@ -223,15 +217,13 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
                 tau = P[L.TAU_STAR] * math.sqrt((h1 + h2) / g) if P[L.TAU_STAR] > 0.0 \
                     else 0.0
                 du = u1 - u2
-                dh1 = exchange_depth(h1, h2, du, dt, r, g, P[L.TAN_INT], P[L.K],
-                                     P[L.C], P[L.DU_REG], P[L.FILM], tau)
+                dh1, full = exchange_step(h1, h2, du, dt, r, g, P[L.TAN_INT], P[L.K],
+                                          P[L.C], P[L.DU_REG], P[L.FILM], tau)
                 if dh1 != 0.0:
                     mom = h2 * u2 + r * h1 * u1  # rho-weighted momentum / rho2
                     phi = 0.0
                     if dh1 > 0.0:
                         u1 = (h1 * u1 + dh1 * u2) / (h1 + dh1)
-                        full = closure_rate(h1, du, r, g, P[L.TAN_INT], P[L.K], P[L.C],
-                                            P[L.DU_REG]) * dt / r
                         phi = min(dh1 / full, 1.0) if full > 0.0 else 1.0
                     h1 = h1 + dh1
                     h2 = max(h2 - r * dh1, 0.0)
