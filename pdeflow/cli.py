@@ -377,6 +377,14 @@ def build_parser() -> argparse.ArgumentParser:
                     help="CASE.toml|ritter|mangeney [--variants V ...] [--grids N|DX ...] "
                     "[--reference auto|exact|fine|fine:VARIANT] [--out-dir DIR] ...")
     cp.set_defaults(func=cmd_compare)
+
+    # --- study ----------------------------------------------------------------------------
+    from .study import command as study_cmd
+
+    st = sub.add_parser("study", help="parameter study, sensitivity or calibration on Dask",
+                        description=study_cmd.__doc__, formatter_class=raw)
+    study_cmd.add_arguments(st)
+    st.set_defaults(func=study_cmd.cmd_study)
     return parser
 
 

@@ -102,6 +102,20 @@ def _stop_time(last_moving: float, t_final: float, at_rest: bool) -> float | Non
     return float(last_moving)
 
 
+_COMMON_KEYS = ("model", "solver", "t_final", "at_rest", "front_position", "runout",
+                "mass_relative_error", "steps", "wall_time_s", "stop_reason", "stop_time",
+                "max_fextra_over_rho1", "flux_fallback_steps")
+SUMMARY_KEYS: dict[str, tuple[str, ...]] = {
+    "two_layer": (*_COMMON_KEYS, "lower_stop_time", "upper_stop_time", "lower_slow_time",
+                  "upper_slow_time", "max_fextra_x", "max_fextra_time",
+                  "hyperbolicity_events", "hyperbolicity_bisections", "deposited_volume",
+                  "eroded_volume", "upper_volume_final", "lower_volume_final"),
+    "single_layer": (*_COMMON_KEYS, "slow_time"),
+}
+"""Keys of :func:`summarize` per model with the fv-split solver (other py-pde solvers
+give the common keys; stop times are then None)."""
+
+
 def summarize(res: RunResult, mass0: float, wall: float) -> dict[str, Any]:
     """The per-model summary written to the JSON summary file."""
     case = res.case

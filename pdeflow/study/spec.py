@@ -1,0 +1,454 @@
+"""The study file: what to vary, how to sample it, what to measure.
+
+A study file is TOML, read and checked once; every error names the key (exit 2)::
+
+    [study]
+    name = "smoke"                    # optional; default: the file name
+    case = "paper_5_1_dam_break.toml" # base case, relative to this file ([base_case]
+                                      # holds one inline instead; or function = "mod:f")
+    set = ["grid.dx=0.05"]            # fixed overrides of the base (and sweep) case
+    sweep_case = "collapse_sweep.toml"  # only for sweep.* quantities (paper 5.2 fit)
+    design = "lhs"                    # grid | lhs | sobol | optimize
+    samples = 32                      # lhs: points; sobol: N (N (D + 2) runs);
+                                      # optimize: trials (population: generation size)
+    seed = 1
+    quantities = ["two_layer.runout"] # <model>.<summary key>, sweep.<model>.exponent|
+                                      # prefactor|all_at_rest; or the function's outputs
+    [parameters]                      # any case key "section.key"
+    "two_layer.c" = { range = [0.01, 3], scale = "log", points = 4 }
+    "two_layer.k" = { values = [0.3, 0.5, 0.8] }
+    "two_layer.exchange_closure" = { choices = ["paper", "relaxed"] }
+    [derived]                         # expressions of quantities, e.g.
+    runout_ratio = "two_layer.runout / single_layer.runout"
+    [objectives]                      # expressions to minimise (Pareto front)
+    exponent = "abs(sweep.two_layer.exponent - 0.84)"
+
+Expressions are arithmetic (+ - * / ** and unary minus) over numbers, quantities,
+derived names and the functions abs, min, max, sqrt, log, log10, exp and
+``fill(x, default)`` (``default`` where x is missing, e.g. a layer that never stopped).
+Quantities used in an expression are computed even if not listed.
+"""
+
+from __future__ import annotations
+
+import ast
+import hashlib
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+from ..cases import Case, CaseError, load_case
+from ..simulate import SUMMARY_KEYS
+
+DESIGNS = ("grid", "lhs", "sobol", "optimize")
+SWEEP_KEYS = ("prefactor", "exponent", "all_at_rest")
+STUDY_KEYS = {"name", "description", "case", "set", "sweep_case", "function", "design",
+              "samples", "seed", "population", "batch", "quantities"}
+SECTIONS = {"study", "base_case", "parameters", "derived", "objectives"}
+PARAMETER_KEYS = {"range", "values", "choices", "scale", "type", "points"}
+
+
+class StudyError(ValueError):
+    """An invalid study file or study directory; the message names the key."""
+
+
+# --- expressions ----------------------------------------------------------------------------
+def _fill(x: float, default: float) -> float:
+    return default if x is None or (isinstance(x, float) and math.isnan(x)) else x
+
+
+FUNCTIONS = {"abs": abs, "min": min, "max": max, "sqrt": math.sqrt, "log": math.log,
+             "log10": math.log10, "exp": math.exp, "fill": _fill}
+_NODES = (ast.Expression, ast.BinOp, ast.UnaryOp, ast.Call, ast.Name, ast.Attribute,
+          ast.Constant, ast.Load, ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow, ast.USub,
+          ast.UAdd)
+
+
+def _dotted(node: ast.AST) -> str | None:
+    """``a.b.c`` of an Attribute/Name chain, else None."""
+    if isinstance(node, ast.Name):
+        return node.id
+    if isinstance(node, ast.Attribute):
+        head = _dotted(node.value)
+        return None if head is None else f"{head}.{node.attr}"
+    return None
+
+
+@dataclass(frozen=True)
+class Expression:
+    """An arithmetic expression of quantities, checked on construction."""
+
+    name: str
+    text: str
+    code: Any = field(repr=False, compare=False)
+    names: tuple[str, ...] = ()
+    """the dotted quantity names and plain (derived) names it reads"""
+
+    @classmethod
+    def parse(cls, name: str, text: Any) -> Expression:
+        if not isinstance(text, str):
+            raise StudyError(f"{name} must be an expression string, got {text!r}")
+        try:
+            tree = ast.parse(text, mode="eval")
+        except SyntaxError as err:
+            raise StudyError(f"{name}: not an expression: {text!r} ({err.msg})") from None
+        for node in ast.walk(tree):
+            if not isinstance(node, _NODES):
+                raise StudyError(f"{name}: {type(node).__name__} is not allowed in "
+                                 f"{text!r} (arithmetic, quantities and "
+                                 f"{sorted(FUNCTIONS)} only)")
+            if isinstance(node, ast.Call):
+                if not (isinstance(node.func, ast.Name) and node.func.id in FUNCTIONS) \
+                        or node.keywords:
+                    raise StudyError(f"{name}: only the functions {sorted(FUNCTIONS)} "
+                                     f"may be called in {text!r}")
+            if isinstance(node, ast.Constant) and not isinstance(node.value, (int, float)):
+                raise StudyError(f"{name}: only numbers may appear as constants in "
+                                 f"{text!r}")
+        names: list[str] = []
+
+        def collect(node: ast.AST) -> None:
+            # a maximal a.b.c chain is one name; a called function is not
+            if isinstance(node, (ast.Attribute, ast.Name)):
+                dotted = _dotted(node)
+                if dotted is None:
+                    raise StudyError(f"{name}: {text!r} reads an attribute of a value")
+                names.append(dotted)
+                return
+            children = node.args if isinstance(node, ast.Call) else ast.iter_child_nodes(node)
+            for child in children:
+                collect(child)
+
+        collect(tree)
+        return cls(name, text, compile(tree, name, "eval"), tuple(dict.fromkeys(names)))
+
+    def __call__(self, values: dict[str, Any]) -> float:
+        """Value for one row of ``values`` (missing or None quantities read as NaN)."""
+        scope: dict[str, Any] = {"__builtins__": {}, **FUNCTIONS}
+        for n in self.names:
+            v = values.get(n)
+            v = math.nan if v is None else float(v)
+            parts = n.split(".")
+            ns = scope
+            for p in parts[:-1]:
+                ns = (ns.setdefault(p, SimpleNamespace()) if isinstance(ns, dict)
+                      else ns.__dict__.setdefault(p, SimpleNamespace()))
+            if isinstance(ns, dict):
+                ns[parts[-1]] = v
+            else:
+                setattr(ns, parts[-1], v)
+        try:
+            return float(eval(self.code, scope))  # noqa: S307 - checked AST, no builtins
+        except (ZeroDivisionError, ValueError, OverflowError, TypeError):
+            return math.nan
+
+
+# --- parameters -----------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Parameter:
+    """One varied key: a range (linear or log, float or int), values, or choices."""
+
+    key: str
+    low: float | None = None
+    high: float | None = None
+    scale: str = "linear"
+    kind: str = "float"
+    """'float', 'int' or 'choice' (values and choices are both 'choice')"""
+    values: tuple[Any, ...] = ()
+    points: int | None = None
+
+    @classmethod
+    def parse(cls, key: str, spec: Any) -> Parameter:
+        where = f"parameters.{key!r}"
+        if not isinstance(spec, dict):
+            raise StudyError(f"{where} must be a table such as {{ range = [0, 1] }}")
+        unknown = set(spec) - PARAMETER_KEYS
+        if unknown:
+            raise StudyError(f"{where}: unknown key {sorted(unknown)[0]!r}; allowed: "
+                             f"{sorted(PARAMETER_KEYS)}")
+        given = [k for k in ("range", "values", "choices") if k in spec]
+        if len(given) != 1:
+            raise StudyError(f"{where} needs exactly one of range, values, choices")
+        if given[0] in ("values", "choices"):
+            vals = spec[given[0]]
+            if not isinstance(vals, list) or not vals:
+                raise StudyError(f"{where}.{given[0]} must be a non-empty list")
+            return cls(key, kind="choice", values=tuple(vals))
+        rng = spec["range"]
+        if (not isinstance(rng, list) or len(rng) != 2
+                or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                           and math.isfinite(v) for v in rng)):
+            raise StudyError(f"{where}.range must be [low, high] (two finite numbers), "
+                             f"got {rng!r}")
+        low, high = float(rng[0]), float(rng[1])
+        if not low < high:
+            raise StudyError(f"{where}.range is empty: low {rng[0]} must be below high "
+                             f"{rng[1]}")
+        scale = spec.get("scale", "linear")
+        if scale not in ("linear", "log"):
+            raise StudyError(f"{where}.scale must be 'linear' or 'log', got {scale!r}")
+        if scale == "log" and low <= 0:
+            raise StudyError(f"{where}: a log range must lie above 0, got {rng!r}")
+        kind = spec.get("type", "float")
+        if kind not in ("float", "int"):
+            raise StudyError(f"{where}.type must be 'float' or 'int', got {kind!r}")
+        points = spec.get("points")
+        if points is not None and (not isinstance(points, int) or isinstance(points, bool)
+                                   or points < 2):
+            raise StudyError(f"{where}.points must be an integer >= 2, got {points!r}")
+        return cls(key, low, high, scale, kind, (), points)
+
+    def grid_values(self) -> list[Any]:
+        """The values of a full-grid design."""
+        if self.kind == "choice":
+            return list(self.values)
+        if self.points is None:
+            raise StudyError(f"parameters.{self.key!r}.points is needed by the grid "
+                             "design (or give values = [...])")
+        u = [i / (self.points - 1) for i in range(self.points)]
+        return list(dict.fromkeys(self.from_unit(x, endpoint=True) for x in u))
+
+    def from_unit(self, u: float, endpoint: bool = False) -> Any:
+        """Map u in [0, 1) (or [0, 1] with ``endpoint``) onto the parameter's values."""
+        u = min(max(float(u), 0.0), 1.0)
+        if self.kind == "choice":
+            n = len(self.values)
+            return self.values[min(int(u * n), n - 1)]
+        assert self.low is not None and self.high is not None
+        if self.kind == "int" and not endpoint:
+            # equal cells for every integer, both ends included
+            return int(min(math.floor(self.low + u * (self.high - self.low + 1)),
+                           self.high))
+        if self.scale == "log":
+            x = math.exp(math.log(self.low) + u * (math.log(self.high) - math.log(self.low)))
+        else:
+            x = self.low + u * (self.high - self.low)
+        return int(round(x)) if self.kind == "int" else float(x)
+
+    def middle(self) -> Any:
+        return self.from_unit(0.5)
+
+
+# --- the study ------------------------------------------------------------------------------
+@dataclass
+class StudySpec:
+    """A checked study file (see the module docstring)."""
+
+    path: Path
+    text: str
+    name: str
+    design: str
+    parameters: list[Parameter]
+    quantities: tuple[str, ...]
+    derived: dict[str, Expression] = field(default_factory=dict)
+    objectives: dict[str, Expression] = field(default_factory=dict)
+    case: Case | None = None
+    case_path: Path | None = None
+    """the base case file (None for an inline [base_case] or a function)"""
+    overrides: list[str] = field(default_factory=list)
+    """study.set: fixed overrides of the base and sweep case"""
+    sweep_case: Case | None = None
+    function: str | None = None
+    samples: int = 0
+    seed: int = 0
+    population: int = 16
+    batch: int = 0
+    description: str = ""
+    fingerprint: str = ""
+    """sha256 of the study file and the case files it reads"""
+
+    @property
+    def keys(self) -> list[str]:
+        return [p.key for p in self.parameters]
+
+    def models(self) -> list[str]:
+        """Models whose summaries a point needs (only those are run)."""
+        return [m for m in SUMMARY_KEYS if any(q.startswith(m + ".")
+                                                for q in self.quantities)]
+
+    def sweep_models(self) -> list[str]:
+        return [m for m in SUMMARY_KEYS if any(q.startswith(f"sweep.{m}.")
+                                                for q in self.quantities)]
+
+    def columns(self) -> list[str]:
+        """Quantity columns of the results table: measured, derived, objectives."""
+        return [*self.quantities, *self.derived, *self.objectives]
+
+    def case_for(self, base: Case, point: dict[str, Any], models: list[str]) -> Case:
+        """``base`` with the point's values set, only ``models`` run, no snapshots."""
+        case = base.copy()
+        for key, value in point.items():
+            section, name = key.split(".", 1)
+            case.data.setdefault(section, {})[name] = value
+        case.data.setdefault("case", {})["models"] = list(models)
+        case.data.setdefault("output", {})["snapshot_times"] = []
+        case.validate()
+        return case
+
+
+def _study_err(path: Path, msg: str) -> StudyError:
+    return StudyError(f"{path}: {msg}")
+
+
+def _case(path: Path, raw: Any, overrides: list[str], key: str) -> Case:
+    if not isinstance(raw, str):
+        raise StudyError(f"study.{key} must be a case file name, got {raw!r}")
+    try:
+        return load_case(path.parent / raw, overrides)
+    except CaseError as err:
+        raise StudyError(f"study.{key}: {err}") from None
+
+
+def _check_quantity(q: str, function: str | None) -> None:
+    if function is not None:
+        return
+    parts = q.split(".")
+    if parts[0] == "sweep":
+        if len(parts) == 3 and parts[1] in SUMMARY_KEYS and parts[2] in SWEEP_KEYS:
+            return
+        raise StudyError(f"unknown quantity {q!r}: a sweep quantity is "
+                         f"sweep.<{'|'.join(SUMMARY_KEYS)}>.<{'|'.join(SWEEP_KEYS)}>")
+    if len(parts) == 2 and parts[0] in SUMMARY_KEYS:
+        if parts[1] in SUMMARY_KEYS[parts[0]]:
+            return
+        raise StudyError(f"unknown quantity {q!r}: {parts[0]}'s run summary has "
+                         f"{', '.join(SUMMARY_KEYS[parts[0]])}")
+    raise StudyError(f"unknown quantity {q!r}: use <model>.<summary key> with model "
+                     f"{' or '.join(SUMMARY_KEYS)}, or sweep.<model>.exponent")
+
+
+def load_study(path: str | Path) -> StudySpec:
+    """Read and check a study file; raise :class:`StudyError` naming the key."""
+    path = Path(path)
+    if not path.is_file():
+        raise StudyError(f"study file {path} does not exist")
+    text = path.read_text()
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise _study_err(path, f"not valid TOML: {err}") from None
+    try:
+        return _build(path, text, data)
+    except StudyError as err:
+        raise _study_err(path, str(err)) from None
+
+
+def _build(path: Path, text: str, data: dict[str, Any]) -> StudySpec:
+    for section in data:
+        if section not in SECTIONS:
+            raise StudyError(f"unknown section [{section}]; allowed: {sorted(SECTIONS)}")
+    st = data.get("study", {})
+    for key in st:
+        if key not in STUDY_KEYS:
+            raise StudyError(f"unknown key study.{key}; allowed: {sorted(STUDY_KEYS)}")
+    design = st.get("design", "grid")
+    if design not in DESIGNS:
+        raise StudyError(f"study.design must be one of {', '.join(DESIGNS)}; got "
+                         f"{design!r}")
+    ints = {}
+    for key, default, low in (("samples", 0, 1), ("seed", 0, 0), ("population", 16, 2),
+                              ("batch", 0, 0)):
+        v = st.get(key, default)
+        if not isinstance(v, int) or isinstance(v, bool) or (v < low and key in st):
+            raise StudyError(f"study.{key} must be an integer >= {low}, got {v!r}")
+        ints[key] = v
+    if design != "grid" and ints["samples"] < 1:
+        raise StudyError(f"study.samples (>= 1) is needed by the {design} design")
+    if design == "sobol" and ints["samples"] & (ints["samples"] - 1):
+        raise StudyError(f"study.samples must be a power of 2 for the sobol design "
+                         f"(Saltelli/Sobol' sequence), got {ints['samples']}")
+    overrides = st.get("set", [])
+    if not isinstance(overrides, list) or not all(isinstance(s, str) for s in overrides):
+        raise StudyError("study.set must be a list of 'section.key=value' strings")
+
+    function = st.get("function")
+    sources = [k for k in ("case", "function") if k in st] + (
+        ["base_case"] if "base_case" in data else [])
+    if len(sources) != 1:
+        raise StudyError("give exactly one of study.case, [base_case] or study.function")
+    files = [text]
+    case = sweep_case = None
+    if "case" in st:
+        case = _case(path, st["case"], overrides, "case")
+        files.append((path.parent / st["case"]).read_text())
+    elif "base_case" in data:
+        try:
+            case = Case(dict(data["base_case"]), f"{path} [base_case]",
+                        path.resolve().parent)
+            for item in overrides:
+                case.set(item)
+            case.validate()
+        except CaseError as err:
+            raise StudyError(str(err)) from None
+    elif not (isinstance(function, str) and ":" in function):
+        raise StudyError(f"study.function must be 'module:callable', got {function!r}")
+    if "sweep_case" in st:
+        sweep_case = _case(path, st["sweep_case"], overrides, "sweep_case")
+        files.append((path.parent / st["sweep_case"]).read_text())
+
+    params_raw = data.get("parameters", {})
+    if not params_raw:
+        raise StudyError("[parameters] must name at least one parameter")
+    parameters = [Parameter.parse(k, v) for k, v in params_raw.items()]
+
+    derived = {k: Expression.parse(f"derived.{k}", v)
+               for k, v in data.get("derived", {}).items()}
+    objectives = {k: Expression.parse(f"objectives.{k}", v)
+                  for k, v in data.get("objectives", {}).items()}
+    if design == "optimize" and not objectives:
+        raise StudyError("the optimize design needs [objectives] (expressions to minimise)")
+    listed = st.get("quantities", [])
+    if not isinstance(listed, list) or not all(isinstance(q, str) for q in listed):
+        raise StudyError("study.quantities must be a list of names")
+    quantities = list(dict.fromkeys(listed))
+    for exprs in (derived, objectives):
+        for expr in exprs.values():
+            for n in expr.names:
+                if n in derived or n in quantities:
+                    continue
+                if "." not in n and function is None:
+                    raise StudyError(f"{expr.name}: unknown name {n!r} (not a quantity or "
+                                     f"a name in [derived])")
+                quantities.append(n)
+    for q in quantities:
+        try:
+            _check_quantity(q, function)
+        except StudyError as err:
+            raise StudyError(f"study.quantities: {err}") from None
+    if not quantities:
+        raise StudyError("study.quantities is empty (and no expression reads a quantity)")
+    spec = StudySpec(
+        path=path, text=text, name=str(st.get("name", path.stem)), design=design,
+        parameters=parameters, quantities=tuple(quantities), derived=derived,
+        objectives=objectives, case=case, sweep_case=sweep_case, function=function,
+        case_path=path.parent / st["case"] if "case" in st else None, overrides=overrides,
+        description=str(st.get("description", "")),
+        fingerprint=hashlib.sha256("\0".join(files).encode()).hexdigest(), **ints)
+    if any(q.startswith("sweep.") for q in quantities) and sweep_case is None:
+        raise StudyError("sweep.* quantities need study.sweep_case (a case with [sweep])")
+    if case is not None or sweep_case is not None:
+        # every key must be a case key that takes every value of its range: try the ends
+        for p in parameters:
+            probes = (p.values if p.kind == "choice" else (p.from_unit(0.0),
+                                                           p.from_unit(1.0)))
+            for value in probes:
+                for base in (case, sweep_case):
+                    if base is None:
+                        continue
+                    if "." not in p.key:
+                        raise StudyError(f"parameters.{p.key!r}: a case key is "
+                                         "'section.key', e.g. 'two_layer.c'")
+                    try:
+                        spec.case_for(base, {p.key: value}, base.models)
+                    except CaseError as err:
+                        raise StudyError(f"parameters.{p.key!r} = {value!r}: {err}") \
+                            from None
+    return spec

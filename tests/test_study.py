@@ -1,0 +1,292 @@
+"""The study engine (pdeflow study): study files, Dask execution, resume, analysis."""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("distributed")
+
+from pdeflow.cli import main  # noqa: E402
+from pdeflow.study import load_study  # noqa: E402
+from pdeflow.study.designs import design_points  # noqa: E402
+from pdeflow.study.testfunctions import ishigami, ishigami_indices  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+CASE_51 = (ROOT / "cases" / "paper_5_1_dam_break.toml").as_posix()
+SMOKE = ROOT / "cases" / "study_smoke.toml"
+ENV = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+
+
+def _study(tmp_path: Path, text: str, name: str = "s.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def _frame(directory: Path):
+    """The results table without the wall times (which differ from run to run)."""
+    import pandas as pd
+
+    df = pd.read_csv(directory / "results.csv", keep_default_na=False, na_values=[""])
+    return df.drop(columns="wall_s").sort_values("id").reset_index(drop=True)
+
+
+# --- bad study files ------------------------------------------------------------------------
+BASE = f"""
+[study]
+case = "{CASE_51}"
+design = "lhs"
+samples = 4
+quantities = ["two_layer.runout"]
+"""
+
+
+@pytest.mark.parametrize("extra, named", [
+    ('[parameters]\n"two_layer.not_a_key" = { range = [0, 1] }', "not_a_key"),
+    ('[parameters]\n"grid.dxx" = { range = [0.01, 0.1] }', "grid.dxx"),
+    ('[parameters]\n"two_layer.k" = { range = [0.8, 0.3] }', "two_layer.k"),
+    ('[parameters]\n"two_layer.c" = { range = [0, 3], scale = "log" }', "two_layer.c"),
+    ('[parameters]\n"two_layer.k" = { range = [0.3, 0.8] }\n'
+     '[objectives]\nx = "two_layer.no_such_summary_key"', "no_such_summary_key"),
+    ('[parameters]\n"two_layer.k" = { range = [0.3, 0.8] }\n'
+     '[objectives]\nx = "__import__(1)"', "objectives.x"),
+])
+def test_bad_study_file_is_a_one_line_error(tmp_path, capsys, extra, named):
+    path = _study(tmp_path, BASE + extra)
+    assert main(["study", str(path), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and named in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_unknown_design_and_bad_workers(tmp_path, capsys):
+    path = _study(tmp_path, BASE.replace('"lhs"', '"random"')
+                  + '[parameters]\n"two_layer.k" = { range = [0.3, 0.8] }')
+    assert main(["study", str(path), "--out", str(tmp_path / "o")]) == 2
+    assert "study.design" in capsys.readouterr().err
+    assert main(["study", str(SMOKE), "--out", str(tmp_path / "o"), "--workers", "0"]) == 2
+    assert "--workers" in capsys.readouterr().err
+
+
+# --- designs ---------------------------------------------------------------------------------
+def test_designs_cover_ranges_and_kinds(tmp_path):
+    text = """
+[study]
+function = "pdeflow.study.testfunctions:ishigami"
+design = "grid"
+quantities = ["y"]
+[parameters]
+x1 = { range = [0.01, 1], scale = "log", points = 3 }
+x2 = { range = [1, 4], type = "int", points = 4 }
+x3 = { choices = [0.5, 1.5] }
+"""
+    pts = design_points(load_study(_study(tmp_path, text)))
+    assert len(pts) == 3 * 4 * 2
+    assert sorted({p["x1"] for p in pts}) == pytest.approx([0.01, 0.1, 1.0])
+    assert sorted({p["x2"] for p in pts}) == [1, 2, 3, 4]
+    lhs = load_study(_study(tmp_path, text.replace('"grid"', '"lhs"\nsamples = 400')))
+    pts = design_points(lhs)
+    x1 = np.array([p["x1"] for p in pts])
+    # uniform in log10 x1: about a quarter of the points in each quarter-decade band
+    counts = np.histogram(np.log10(x1), bins=4, range=(-2, 0))[0]
+    assert counts.min() >= 95 and counts.max() <= 105
+    assert {p["x2"] for p in pts} == {1, 2, 3, 4}
+    assert {p["x3"] for p in pts} == {0.5, 1.5}
+
+
+# --- execution -------------------------------------------------------------------------------
+def test_smoke_study_same_results_with_one_and_two_workers(tmp_path, capsys):
+    one, two = tmp_path / "one", tmp_path / "two"
+    assert main(["study", str(SMOKE), "--out", str(one), "--workers", "1", "-q"]) == 0
+    assert main(["study", str(SMOKE), "--out", str(two), "--workers", "2", "-q"]) == 0
+    a, b = _frame(one), _frame(two)
+    assert len(a) == 32 and list(a["id"]) == list(range(32))
+    assert (a["status"] == "ok").all()
+    assert a.equals(b)
+    report = (two / "report.md").read_text()
+    assert "## Pareto front" in report and "pdeflow run " in report
+    assert (two / "pareto.png").stat().st_size > 0 and (two / "scatter.png").exists()
+    # rerunning computes nothing; a changed study file is refused
+    capsys.readouterr()
+    assert main(["study", str(SMOKE), "--out", str(two), "--workers", "2"]) == 0
+    assert "all 32 evaluations done" in capsys.readouterr().out
+    assert _frame(two).equals(b)
+    changed = _study(tmp_path, SMOKE.read_text().replace("seed = 1", "seed = 2").replace(
+        '"paper_5_1_dam_break.toml"', f'"{CASE_51}"'), "changed.toml")
+    assert main(["study", str(changed), "--out", str(two)]) == 2
+    assert "another version of the study" in capsys.readouterr().err
+
+
+def test_failed_evaluation_is_recorded_not_fatal(tmp_path):
+    # each value is valid alone; MUSCL with CFL 0.9 is not (checked per evaluation)
+    text = f"""
+[study]
+case = "{CASE_51}"
+set = ["grid.dx=0.1"]
+design = "grid"
+quantities = ["single_layer.runout"]
+[parameters]
+"numerics.reconstruction" = {{ choices = ["first-order", "muscl"] }}
+"numerics.cfl" = {{ values = [0.3, 0.9] }}
+"""
+    out = tmp_path / "out"
+    assert main(["study", str(_study(tmp_path, text)), "--out", str(out), "--workers",
+                 "1", "-q"]) == 0
+    df = _frame(out)
+    assert list(df["status"]) == ["ok", "ok", "ok", "failed"]
+    assert "numerics.cfl" in df["message"][3]
+    assert "## Failed evaluations" in (out / "report.md").read_text()
+
+
+def test_sobol_indices_of_ishigami_through_the_pipeline(tmp_path):
+    text = """
+[study]
+function = "pdeflow.study.testfunctions:ishigami"
+design = "sobol"
+samples = 2048
+seed = 3
+quantities = ["y"]
+[parameters]
+x1 = { range = [-3.141592653589793, 3.141592653589793] }
+x2 = { range = [-3.141592653589793, 3.141592653589793] }
+x3 = { range = [-3.141592653589793, 3.141592653589793] }
+"""
+    out = tmp_path / "out"
+    assert main(["study", str(_study(tmp_path, text)), "--out", str(out), "--workers",
+                 "1", "-q"]) == 0
+    df = _frame(out)
+    assert len(df) == 2048 * 5
+    spec = load_study(out / "study.toml")
+    from pdeflow.study.designs import sobol_indices
+
+    s = sobol_indices(spec, df["y"].to_numpy())
+    exact = ishigami_indices()
+    for key in ("S1", "ST"):
+        assert np.abs(s[key] - exact[key]).max() < 0.04, (key, s[key], exact[key])
+    assert "## Sensitivity: Sobol indices" in (out / "report.md").read_text()
+    assert (out / "sobol.png").exists()
+
+
+def test_pareto_front_of_schaffer_by_nsga2(tmp_path):
+    text = """
+[study]
+function = "pdeflow.study.testfunctions:schaffer"
+design = "optimize"
+samples = 96
+population = 16
+seed = 5
+quantities = ["f1", "f2"]
+[parameters]
+x = { range = [-10, 10] }
+[objectives]
+f1 = "f1"
+f2 = "f2"
+"""
+    out = tmp_path / "out"
+    assert main(["study", str(_study(tmp_path, text)), "--out", str(out), "--workers",
+                 "2", "-q"]) == 0
+    df = _frame(out)
+    assert len(df) == 96 and df["id"].is_unique
+    from pdeflow.study.report import pareto_mask
+
+    front = df[pareto_mask(df[["f1", "f2"]].to_numpy())]
+    # the Pareto set is [0, 2]: the sampled front lies on it up to the sampling's gaps
+    assert len(front) >= 8
+    assert front["x"].between(-0.5, 2.5).all()
+    assert front["x"].between(0, 2).mean() >= 0.8
+    assert front["x"].min() < 0.3 and front["x"].max() > 1.7
+
+
+def test_killed_study_resumes_without_duplicates(tmp_path):
+    text = """
+[study]
+function = "pdeflow.study.testfunctions:ishigami"
+design = "lhs"
+samples = 60
+seed = 7
+quantities = ["y"]
+[parameters]
+x1 = { range = [-3, 3] }
+x2 = { range = [-3, 3] }
+x3 = { range = [-3, 3] }
+delay = { values = [0.1] }
+"""
+    study, out = _study(tmp_path, text), tmp_path / "out"
+    cmd = [sys.executable, "-m", "pdeflow", "study", str(study), "--out", str(out),
+           "--workers", "2", "-q"]
+    proc = subprocess.Popen(cmd, env=ENV, start_new_session=True)
+    csv = out / "results.csv"
+    try:
+        t0 = time.time()
+        while time.time() - t0 < 120:
+            if csv.exists() and csv.read_text().count("\n") > 11:
+                break
+            time.sleep(0.05)
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL)  # the client and its worker processes
+        proc.wait()
+    partial = _frame(out)
+    assert 10 <= len(partial) < 60
+    assert subprocess.run(cmd, env=ENV).returncode == 0
+    df = _frame(out)
+    assert list(df["id"]) == list(range(60))
+    pts = design_points(load_study(study))
+    expect = [ishigami(p["x1"], p["x2"], p["x3"])["y"] for p in pts]
+    assert df["y"].to_numpy() == pytest.approx(expect, rel=1e-12)
+    assert (df.iloc[partial.index]["y"].to_numpy()
+            == df.set_index("id").loc[partial["id"], "y"].to_numpy()).all()
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_study_runs_unchanged_on_a_real_scheduler(tmp_path):
+    port = _free_port()
+    addr = f"tcp://127.0.0.1:{port}"
+    dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
+    procs = [subprocess.Popen([*dask, "--host", "127.0.0.1", "--port", str(port),
+                               "--dashboard-address", ":0"], env=ENV,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        for _ in range(2):
+            procs.append(subprocess.Popen(
+                [sys.executable, "-m", "distributed.cli.dask_worker", addr, "--nthreads",
+                 "1", "--nworkers", "1", "--no-dashboard"], env=ENV, cwd=tmp_path,
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        from distributed import Client
+
+        with Client(addr, timeout="30s") as client:
+            client.wait_for_workers(2, timeout=60)
+        remote, local = tmp_path / "remote", tmp_path / "local"
+        assert main(["study", str(SMOKE), "--out", str(remote), "--scheduler", addr,
+                     "-q"]) == 0
+        assert main(["study", str(SMOKE), "--out", str(local), "--workers", "1",
+                     "-q"]) == 0
+        assert _frame(remote).equals(_frame(local))
+    finally:
+        for p in procs:
+            p.terminate()
+        for p in procs:
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "cases").glob("study_*.toml")),
+                         ids=lambda p: p.stem)
+def test_shipped_study_files_load(path):
+    spec = load_study(path)
+    assert spec.parameters and spec.quantities
