@@ -1,27 +1,23 @@
-"""Grid search for the parameters of the paper's lost Table 1 against test 5.1.
+"""Calibration of the paper's lost Table 1 against test 5.1: the robustness stage, and the
+relaxed-closure recalibration on converged grids.
 
-Usage::
+The grid search itself is a study (``cases/study_calibration_5_1.toml``, run by
+``pdeflow study``; its score is written there). This module takes its results table and
+re-runs the best candidates with the paper's closure under perturbed numerics::
 
-    python -m pdeflow.analysis.calibration [--case cases/paper_5_1_dam_break.toml]
-        [--out calibration.jsonl] [--top 15]
+    pdeflow study cases/study_calibration_5_1.toml --out docs/studies/calibration_5_1
+    python -m pdeflow.analysis.calibration \
+        --results docs/studies/calibration_5_1/results.csv > docs/calibration_5_1.md
 
-Every combination of the grid below is run on the 5.1 case (two-layer model only) and
-scored against what the paper reports: lower layer at rest at about 0.7 s, upper layer
-just before 1.5 s, F_extra/rho1 below 2 m^2/s^2, run-out clearly shorter than the
-single-layer one. The score is
-
-    (t_lower - 0.7)^2 + (t_upper - 1.45)^2 + max(0, F - 2)^2 + max(0, R - 4.2)^2
-
-with stop times in s (10 s if a layer never stops), F = max F_extra/rho1 and R the
-run-out in m (4.2 m is 85 % of the single-layer run-out at phi_B = 30 deg). The best
-rows are printed as a Markdown table; all rows go to ``--out`` (JSON lines).
+``--study-relaxed`` instead runs the recalibration with the relaxed closure
+(docs/calibration_relaxed.md), whose second stage (rerun the best on dx/2, sweep the
+best four) is not a single design.
 """
 
 from __future__ import annotations
 
 import argparse
 import itertools
-import json
 import math
 from pathlib import Path
 from typing import Any
@@ -29,20 +25,13 @@ from typing import Any
 from ..cases import load_case
 from ..simulate import run_model
 
-GRID: dict[str, list[float]] = {
-    "phi_b_deg": [30, 34, 38, 40, 41, 42, 46],
-    "k": [0.2, 0.5, 0.65, 0.8],
-    "c": [0.003, 0.01, 0.03, 0.1],
-    "du_reg": [0.0, 0.1, 0.3],
-    "film_depth": [1e-4, 1e-3, 5e-3],
-    "wedge_angle_deg": [60, 75],
-}
-
 TARGET_LOWER = 0.7
 TARGET_UPPER = 1.45
+CASE_51 = "cases/paper_5_1_dam_break.toml"
 
 
 def score(s: dict[str, Any]) -> float:
+    """The study's score (cases/study_calibration_5_1.toml) of a run summary."""
     lo = s["lower_stop_time"] if s["lower_stop_time"] is not None else 10.0
     up = s["upper_stop_time"] if s["upper_stop_time"] is not None else 10.0
     return ((lo - TARGET_LOWER) ** 2 + (up - TARGET_UPPER) ** 2
@@ -50,70 +39,22 @@ def score(s: dict[str, Any]) -> float:
             + max(0.0, (s["runout"] or 0.0) - 4.2) ** 2)
 
 
-def scan(case_path: str | Path, grid: dict[str, list[float]] = GRID) -> list[dict]:
-    rows = []
-    keys = list(grid)
-    for values in itertools.product(*grid.values()):
-        over = ["case.models=['two_layer']", "output.snapshot_times=[]"]
-        for k, v in zip(keys, values, strict=True):
-            section = "initial" if k == "wedge_angle_deg" else "two_layer"
-            over.append(f"{section}.{k}={v}")
-        s = run_model(load_case(case_path, over), "two_layer").summary
-        row = dict(zip(keys, values, strict=True))
-        row.update({k: s[k] for k in ("lower_stop_time", "upper_stop_time",
-                                      "lower_slow_time", "upper_slow_time", "runout",
-                                      "max_fextra_over_rho1", "max_fextra_x")})
-        row["score"] = score(s)
-        rows.append(row)
-    rows.sort(key=lambda r: r["score"])
-    return rows
-
-
-def robustness(case_path: str | Path, row: dict) -> dict[str, float]:
+def robustness(case_path: str | Path, params: dict[str, Any]) -> dict[str, float]:
     """Worst case of the scored quantities over CFL 0.28-0.32, with and without the
-    case's snapshot interrupts (which shorten a few time steps)."""
+    case's snapshot interrupts (which shorten a few time steps); ``params`` maps case
+    keys (``two_layer.k``, ``initial.wedge_angle_deg``) to values."""
     worst = {"lower_max": 0.0, "upper_max": 0.0, "fextra_max": 0.0, "score_max": 0.0}
     for cfl in (0.28, 0.29, 0.3, 0.31, 0.32):
         for snaps in (True, False):
             over = ["case.models=['two_layer']", f"numerics.cfl={cfl}"]
             over += [] if snaps else ["output.snapshot_times=[]"]
-            for k in GRID:
-                section = "initial" if k == "wedge_angle_deg" else "two_layer"
-                over.append(f"{section}.{k}={row[k]}")
+            over += [f"{k}={v}" for k, v in params.items()]
             s = run_model(load_case(case_path, over), "two_layer").summary
             worst["lower_max"] = max(worst["lower_max"], s["lower_stop_time"] or 10.0)
             worst["upper_max"] = max(worst["upper_max"], s["upper_stop_time"] or 10.0)
             worst["fextra_max"] = max(worst["fextra_max"], s["max_fextra_over_rho1"])
             worst["score_max"] = max(worst["score_max"], score(s))
     return worst
-
-
-STUDY_52 = {"c": [0.03, 0.3, 0.5, 1.0], "k": [0.2, 0.5, 0.65], "phi_b_deg": [38, 40, 41]}
-
-
-def study_52(case_51: str | Path, case_52: str | Path,
-             grid: dict[str, list[float]] = STUDY_52) -> list[dict]:
-    """Paper 5.2 fit (two layers) next to the 5.1 figures over a parameter grid.
-
-    Shows what the run-out exponent responds to and that the sets which bring it near
-    0.84 do not reproduce 5.1 (and vice versa)."""
-    from ..sweep import run_sweep
-
-    rows = []
-    keys = list(grid)
-    for values in itertools.product(*grid.values()):
-        over = [f"two_layer.{k}={v}" for k, v in zip(keys, values, strict=True)]
-        over.append("case.models=['two_layer']")
-        s2 = run_sweep(load_case(case_52, over))["models"]["two_layer"]
-        s1 = run_model(load_case(case_51, over + ["output.snapshot_times=[]"]),
-                       "two_layer").summary
-        row = dict(zip(keys, values, strict=True))
-        row.update({"prefactor_52": s2["prefactor"], "exponent_52": s2["exponent"],
-                    "lower_stop_51": s1["lower_stop_time"],
-                    "upper_stop_51": s1["upper_stop_time"], "runout_51": s1["runout"],
-                    "fextra_51": s1["max_fextra_over_rho1"]})
-        rows.append(row)
-    return rows
 
 
 RELAXED_GRID = {"phi_b_deg": [36, 38, 41, 44], "k": [0.3, 0.5, 0.8],
@@ -199,15 +140,33 @@ def markdown(rows: list[dict], top: int) -> str:
     return "\n".join(out)
 
 
+def _study_rows(path: str | Path) -> list[dict[str, Any]]:
+    """Rows of the calibration study's results, best score first, keys shortened."""
+    import pandas as pd
+
+    df = pd.read_csv(path, keep_default_na=False, na_values=[""])
+    df = df[df["status"] == "ok"].sort_values("score")
+    rows = []
+    for rec in df.to_dict("records"):
+        rows.append({k.split(".", 1)[1] if "." in k else k: (None if isinstance(v, float)
+                                                              and math.isnan(v) else v)
+                     for k, v in rec.items()
+                     if k not in ("id", "status", "message", "wall_s")})
+        rows[-1]["_params"] = {k: rec[k] for k in rec if k.startswith(("two_layer.",
+                                                                          "initial."))
+                               and k.split(".", 1)[1] in PARAMS}
+    return rows
+
+
+PARAMS = ("phi_b_deg", "k", "c", "du_reg", "film_depth", "wedge_angle_deg")
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--case", default="cases/paper_5_1_dam_break.toml")
-    ap.add_argument("--out", default=None, help="write all rows as JSON lines")
-    ap.add_argument("--top", type=int, default=15)
-    ap.add_argument("--study-52", action="store_true",
-                    help="instead: the 5.2 run-out fit against the 5.1 figures over a "
-                    "parameter grid (docs/calibration_5_2.md)")
+    ap.add_argument("--case", default=CASE_51)
+    ap.add_argument("--results", default="docs/studies/calibration_5_1/results.csv",
+                    help="results.csv of cases/study_calibration_5_1.toml")
     ap.add_argument("--study-relaxed", action="store_true",
                     help="instead: recalibration with the relaxed closure on refined grids "
                     "(docs/calibration_relaxed.md)")
@@ -231,36 +190,26 @@ def main(argv: list[str] | None = None) -> None:
               f"{len(rows)} sets; the best 20:\n")
         print(markdown(rows, 20))
         return
-    if args.study_52:
-        rows = study_52(args.case, "cases/collapse_sweep.toml")
-        print("# Test 5.2 (two layers) against test 5.1 over the lost parameters\n")
-        print("Generated by `python -m pdeflow.analysis.calibration --study-52 > "
-              "docs/calibration_5_2.md`: for each set, the run-out fit r = p a^e of the")
-        print("5.2 sweep (dx = 0.01 m, paper closure) and the 5.1 figures (dx = 0.05 m). "
-              "Paper: p = 1.61, e = 0.84; 5.1: lower rest ~0.7 s, upper just before 1.5 s, "
-              "F_extra/rho1 < 2. '-' = not at rest by t_end.\n")
-        print(markdown(rows, len(rows)))
-        return
-    rows = scan(args.case)
-    if args.out:
-        Path(args.out).write_text("".join(json.dumps(r) + "\n" for r in rows))
+    rows = _study_rows(args.results)
     print("# Calibration of the lost Table-1 parameters on test 5.1\n")
-    print("Generated by `python -m pdeflow.analysis.calibration > docs/calibration_5_1.md`")
-    print("(see the module docstring for the score). Stop times in s, run-out in m,")
-    print("F_extra/rho1 in m^2/s^2; '-' = the layer did not stop by t_end.\n")
-    print(f"{len(rows)} parameter sets; best {args.top} by score:\n")
-    print(markdown(rows, args.top))
+    print("The grid search is the study `cases/study_calibration_5_1.toml`: "
+          f"{len(rows)} parameter sets, its score, the whole table and the best sets in "
+          "[studies/calibration_5_1/report.md](studies/calibration_5_1/report.md) "
+          "(`pdeflow study cases/study_calibration_5_1.toml --out "
+          "docs/studies/calibration_5_1`). This page is its second stage, generated by "
+          "`python -m pdeflow.analysis.calibration > docs/calibration_5_1.md`.\n")
     # robust candidates: the paper's closure, both stop-time definitions agreeing
     paper = [r for r in rows if r["du_reg"] == 0 and r["upper_slow_time"] is not None
              and r["upper_stop_time"] is not None
              and abs(r["upper_stop_time"] - r["upper_slow_time"]) < 0.1][:30]
     for r in paper:
-        r.update(robustness(args.case, r))
+        r.update(robustness(args.case, r.pop("_params")))
     paper = [r for r in paper if r["fextra_max"] < 1.95]
     paper.sort(key=lambda r: r["score_max"])
-    print("\nParameter sets with the paper's closure (du_reg = 0), exact and practical upper")
+    print("Parameter sets with the paper's closure (du_reg = 0), exact and practical upper")
     print("stop times within 0.1 s, and F_extra/rho1 < 1.95 for CFL 0.28-0.32 with and")
-    print("without snapshots, by worst-case score (the first is the default):\n")
+    print("without snapshots, by worst-case score (the first is the default). Stop times")
+    print("in s, run-out in m, F_extra/rho1 in m^2/s^2:\n")
     print(markdown(paper, 5))
 
 

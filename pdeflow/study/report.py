@@ -128,7 +128,13 @@ def write_report(table: ResultsTable, command: str) -> Path:
         good = ok[np.all(np.isfinite(f), axis=1)]
         if len(good):
             if len(obj) == 1:
-                best, how = good.sort_values(obj[0]).head(5), f"The five lowest `{obj[0]}`"
+                ranked = good.sort_values(obj[0])
+                out += [f"## The {min(15, len(ranked))} lowest `{obj[0]}`", ""]
+                out += _table(["id", *spec.keys, *cols],
+                              [[r["id"], *(r[k] for k in spec.keys), *(r[c] for c in cols)]
+                               for _, r in ranked.head(15).iterrows()])
+                out.append("")
+                best, how = ranked.head(5), f"The five lowest `{obj[0]}`"
             else:
                 front = good[pareto_mask(good[obj].to_numpy(dtype=float))]
                 best = front.sort_values(obj[0]).head(5)
