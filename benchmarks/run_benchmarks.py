@@ -5,6 +5,7 @@ Usage (from the repository root)::
     python benchmarks/run_benchmarks.py                 # everything (~15-25 min)
     python benchmarks/run_benchmarks.py --only wp       # work precision only
     python benchmarks/run_benchmarks.py --only bench    # benchmark suite only
+    python benchmarks/run_benchmarks.py --only studies  # pdeflow study on Dask (~25 min)
     python benchmarks/run_benchmarks.py --render        # re-render the doc from JSON
     python benchmarks/run_benchmarks.py --quick         # smoke run into TMPDIR, ~3 min
 
@@ -33,6 +34,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 sys.path.insert(0, str(ROOT))
 
+import study_scaling  # noqa: E402
 import suite  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "measurements"  # not "results/": git-ignored
@@ -198,7 +200,8 @@ def _best(rows: list[dict[str, Any]], model: str) -> str:
             f"({base_wall / best['wall_s']:.3g}x less wall time).")
 
 
-def render(wp: dict[str, Any] | None, bench: dict[str, Any] | None) -> str:
+def render(wp: dict[str, Any] | None, bench: dict[str, Any] | None,
+           studies: dict[str, Any] | None = None) -> str:
     """docs/performance.md from the stored measurements."""
     L: list[str] = []
     a = L.append
@@ -243,6 +246,9 @@ def render(wp: dict[str, Any] | None, bench: dict[str, Any] | None) -> str:
         a(_render_wp(wp))
     if bench:
         a(_render_bench(bench))
+    if studies:
+        a(f"Studies conditions: {_cond(studies['conditions'])}.\n")
+        a(study_scaling.render(studies))
     a(_findings(wp, bench))
     return "\n".join(L) + "\n"
 
@@ -538,7 +544,9 @@ def _findings(wp: dict[str, Any] | None, b: dict[str, Any] | None) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--only", choices=("wp", "bench"), default=None)
+    p.add_argument("--only", choices=("wp", "bench", "studies"), default=None)
+    p.add_argument("--sweeps", type=int, default=20,
+                   help="5.2 sweeps at dx = 0.0025 m in the studies benchmark")
     p.add_argument("--render", action="store_true", help="only re-render the doc")
     p.add_argument("--quick", action="store_true", help="small smoke run")
     p.add_argument("--repeats", type=int, default=None, help="repeats (default 5; 2 quick)")
@@ -552,6 +560,7 @@ def main(argv: list[str] | None = None) -> int:
     results.mkdir(parents=True, exist_ok=True)
     doc = args.doc or str(results / "performance.md" if args.quick else DOC)
     wp_path, bench_path = results / "workprecision.json", results / "bench.json"
+    studies_path = results / "studies.json"
     if not args.render:
         import pyclaw_run
 
@@ -561,13 +570,18 @@ def main(argv: list[str] | None = None) -> int:
         if args.only in (None, "bench"):
             b = measure_bench(args.quick, repeats, not args.no_pyclaw)
             bench_path.write_text(json.dumps(b, indent=1, default=str))
+        if args.only in (None, "studies"):
+            st = study_scaling.measure(args.quick, max(3, repeats // 2 + 1), args.sweeps)
+            st["conditions"] = conditions()
+            studies_path.write_text(json.dumps(st, indent=1, default=str))
         if args.only in (None, "wp"):
             w = measure_wp(args.quick, max(3, repeats) if not args.quick else repeats,
                            results)
             wp_path.write_text(json.dumps(w, indent=1, default=str))
     wp = json.loads(wp_path.read_text()) if wp_path.exists() else None
     bench = json.loads(bench_path.read_text()) if bench_path.exists() else None
-    Path(doc).write_text(render(wp, bench))
+    studies = json.loads(studies_path.read_text()) if studies_path.exists() else None
+    Path(doc).write_text(render(wp, bench, studies))
     _log(f"written {doc}")
     return 0
 

@@ -75,6 +75,32 @@ def evaluate(spec: StudySpec, row_id: int, point: dict[str, Any]) -> dict[str, A
     return row
 
 
+def warm(spec: StudySpec) -> float:
+    """Load what the study's evaluations use into this worker process: the modules and
+    the numba kernels (from the disk cache; compiled if absent), by a run of each needed
+    model on a 16-cell grid for a few steps. Returns the time it took [s]. Run once per
+    worker when the cluster starts, so that the loop's timing holds only evaluations."""
+    from ..simulate import run_model
+
+    t0 = time.perf_counter()
+    if spec.function is not None:
+        importlib.import_module(spec.function.split(":", 1)[0])
+    for base, models in ((spec.case, spec.models()), (spec.sweep_case, spec.sweep_models())):
+        if base is None or not models:
+            continue
+        tiny = base.copy()
+        tiny.data["grid"].pop("dx", None)
+        tiny.data["grid"]["cells"] = 16
+        tiny.data.setdefault("case", {})["t_end"] = 0.01
+        tiny.data.pop("sweep", None)
+        for model in models:
+            try:
+                run_model(spec.case_for(tiny, {}, [model]), model)
+            except Exception:  # noqa: BLE001, S112 - warming only; evaluations report errors
+                continue
+    return time.perf_counter() - t0
+
+
 def evaluate_batch(spec: StudySpec, items: list[tuple[int, dict[str, Any]]]
                    ) -> list[dict[str, Any]]:
     """Rows of a batch of (id, point); one Dask task, so scheduling costs once per batch."""

@@ -22,7 +22,7 @@ from collections.abc import Callable
 from typing import Any
 
 from .designs import Optimiser, design_points
-from .evaluate import evaluate_batch
+from .evaluate import evaluate_batch, warm
 from .results import ResultsTable
 from .spec import StudySpec
 
@@ -88,6 +88,7 @@ def run_study(spec: StudySpec, out: str, *, workers: int | None = None,
     log(f"{spec.name}: {total} evaluations to run ({len(done)} already in {table.csv})")
     t_start = time.perf_counter()
     client, cluster, n_workers = _client(workers, scheduler)
+    client.run(warm, spec)  # every worker loads the kernels once, before the clock
     t_ready = time.perf_counter()
     log(f"Dask: {n_workers} workers, dashboard {client.dashboard_link}")
     walls: deque[float] = deque(maxlen=200)
