@@ -259,6 +259,10 @@ class Case:
                 check_range("initial.upper_fraction", ini["upper_fraction"], 0, 1)
         except ValueError as err:
             raise self._err(str(err)) from None
+        if shape == "column" and ini["L0"] > self.length:
+            raise self._err(f"initial.L0 = {ini['L0']:g} m is longer than the domain "
+                            f"(grid.length = {self.length:g} m): the column must lie in "
+                            f"(0, {self.length:g}] m; lengthen the domain or shorten the column")
         if shape == "file" and not (self.base_dir / ini["path"]).is_file():
             raise self._err(f"initial.path: file {ini['path']} not found next to "
                             "the case file")

@@ -118,13 +118,15 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
 
 def cmd_run(args: argparse.Namespace) -> int:
     from .cases import load_case
-    from .io import write_json, write_npz
+    from .io import check_output, write_json, write_npz
     from .plotting import case_figures, deposit_figure, save
-    from .simulate import run_model
+    from .simulate import load_case_kernels, run_model
 
     case = load_case(args.case, args.set)
     for name in ("live_every", "store_every", "fps"):
         _positive(f"--{name.replace('_', '-')}", getattr(args, name))
+    for name in ("summary", "final", "plot", "outdir", "store", "movie", "frames"):
+        check_output(getattr(args, name), f"--{name}")
     if args.movie:
         from .trackers.live import check_movie_path
 
@@ -142,6 +144,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             print("pdeflow: warning: --live needs a display (matplotlib backend "
                   "is non-interactive); use --movie or --frames on a headless machine",
                   file=sys.stderr)
+    load_case_kernels(case, None if args.quiet else sys.stderr)
     results = {}
     stores: dict[str, Any] = {}
     all_trackers: list[Any] = []
@@ -225,6 +228,10 @@ def cmd_plot(args: argparse.Namespace) -> int:
     from .storage import open_run
 
     _positive("--fps", args.fps)
+    from .io import check_output
+
+    check_output(args.out, "--out")
+    check_output(args.movie, "--movie")
     if args.movie:
         from .trackers.live import check_movie_path
 
@@ -270,8 +277,10 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
 
 def cmd_export(args: argparse.Namespace) -> int:
+    from .io import check_output
     from .storage import open_run
 
+    check_output(args.out, "OUT")
     run = open_run(args.run)
     out = run.export(args.out)
     if not args.quiet:
@@ -318,9 +327,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="draw the layers, velocities and F_extra/rho1 in a window "
                        "while the run goes (needs a display; close it to finish)")
     watch.add_argument("--movie", metavar="OUT.mp4",
-                       help="write the live plot as a movie, headless: .mp4 (needs "
-                       "ffmpeg, e.g. pip install imageio-ffmpeg) or .gif; further "
-                       "models go to OUT.<model>.mp4")
+                       help="write the live plot as a movie, headless: .mp4 (also "
+                       ".m4v, .mov, .mkv, .avi; H.264, needs ffmpeg, e.g. pip install "
+                       "imageio-ffmpeg) or .gif; further models go to OUT.<model>.mp4")
     watch.add_argument("--frames", metavar="DIR",
                        help="write the live plot as PNG frames DIR/<model>/frame_*.png")
     watch.add_argument("--live-every", type=float, metavar="DT",
@@ -340,7 +349,8 @@ def build_parser() -> argparse.ArgumentParser:
     plot.add_argument("--out", metavar="FIG.png",
                       help="write the figure here (default: the first RUN with .png)")
     plot.add_argument("--movie", metavar="OUT.mp4",
-                      help="write a movie over all stored frames (.mp4 or .gif)")
+                      help="write a movie over all stored frames (.mp4, .m4v, .mov, "
+                      ".mkv, .avi: needs ffmpeg; or .gif)")
     plot.add_argument("--fps", type=float, default=10.0,
                       help="frames per second of --movie (default 10)")
     plot.add_argument("--title", help="figure title (default: the case name)")
@@ -368,11 +378,13 @@ def build_parser() -> argparse.ArgumentParser:
                         description=convergence.__doc__, formatter_class=raw)
     convergence.add_arguments(cv)
     cv.set_defaults(func=convergence.cmd_converge)
-    cp = sub.add_parser("compare", help="work-precision comparison of solver variants",
-                        description="Runs every variant on a sequence of grids against an "
-                        "exact solution or a fine-grid reference; writes a work-precision "
-                        "diagram and table (pdeflow.analysis.workprecision).",
-                        formatter_class=raw)
+    cp = sub.add_parser("compare", help="work-precision study: error against wall time "
+                        "of solver variants (to compare runs, use plot)",
+                        description="Work-precision study: runs every variant on a sequence "
+                        "of grids against an exact solution or a fine-grid reference; "
+                        "writes a work-precision diagram and table "
+                        "(pdeflow.analysis.workprecision). `pdeflow compare --help` lists "
+                        "its options.", formatter_class=raw)
     cp.add_argument("args", nargs=argparse.REMAINDER,
                     help="CASE.toml|ritter|mangeney [--variants V ...] [--grids N|DX ...] "
                     "[--reference auto|exact|fine|fine:VARIANT] [--out-dir DIR] ...")
@@ -397,7 +409,7 @@ def main(argv: list[str] | None = None) -> int:
         # the work-precision harness parses its own options (and its own --help)
         from .analysis import workprecision
 
-        return int(workprecision.main(argv[1:]) or 0)
+        return int(workprecision.main(argv[1:], prog="pdeflow compare") or 0)
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
@@ -409,9 +421,10 @@ def main(argv: list[str] | None = None) -> int:
         print(f"pdeflow: simulation failed: {err}", file=sys.stderr)
         return 3
     except ValueError as err:
+        from .io import OutputError
         from .trackers.live import MovieError
 
-        if not isinstance(err, MovieError):
+        if not isinstance(err, (MovieError, OutputError)):
             raise
         print(f"pdeflow: error: {err}", file=sys.stderr)
         return 2

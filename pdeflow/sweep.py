@@ -15,14 +15,15 @@ of Lacaze et al. (2008) gives the exponent 0.83 +- 0.03.
 
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .cases import Case, load_case
-from .simulate import run_model
+from .cases import Case, CaseError, load_case
+from .simulate import load_case_kernels, run_model
 
 PAPER_FITS = {"single_layer": (2.25, 1.06), "two_layer": (1.61, 0.84)}
 DEM_EXPONENT = 0.83
@@ -39,16 +40,29 @@ def fit_power_law(a: np.ndarray, r: np.ndarray) -> tuple[float, float]:
     return float(np.exp(logp)), float(e)
 
 
+def sweep_ratios(case: Case) -> list[float]:
+    """The case's ``sweep.aspect_ratios``; CaseError if it has none or no column."""
+    ratios = case.data.get("sweep", {}).get("aspect_ratios", [])
+    if not ratios:
+        raise CaseError(f"{case.source}: a sweep needs a [sweep] section with "
+                        "aspect_ratios = [a, ...] (a = H0/L0 > 0), as in "
+                        "cases/collapse_sweep.toml, or --set 'sweep.aspect_ratios=[2, 4]'")
+    if any(isinstance(a, bool) or not isinstance(a, (int, float)) or not a > 0
+           for a in ratios):
+        raise CaseError(f"{case.source}: sweep.aspect_ratios must be numbers > 0, got "
+                        f"{ratios!r}")
+    if case.L0 is None:
+        raise CaseError(f"{case.source}: a sweep needs initial.L0 (shape = 'column')")
+    return [float(a) for a in ratios]
+
+
 def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
               models: list[str] | None = None) -> dict[str, Any]:
     """Run every model at every aspect ratio; return the sweep summary."""
-    ratios = aspect_ratios or [float(a) for a in case.data.get("sweep", {}).get(
-        "aspect_ratios", [])]
-    if not ratios:
-        raise ValueError(f"{case.source}: sweep.aspect_ratios is empty")
+    ratios = aspect_ratios or sweep_ratios(case)
     L0 = case.L0
     if L0 is None:
-        raise ValueError(f"{case.source}: a sweep needs initial.L0 (a column)")
+        raise CaseError(f"{case.source}: a sweep needs initial.L0 (shape = 'column')")
     models = models or case.models
     out: dict[str, Any] = {"case": case.name, "L0": L0, "dx": case.dx,
                            "front_threshold": case.front_threshold, "models": {}}
@@ -143,9 +157,14 @@ def add_arguments(ap: Any) -> None:
 
 def cmd_sweep(args: Any, write_json: Any = None) -> int:
     """Run the sweep described by parsed ``args``; print the fits."""
-    if write_json is None:
-        from .io import write_json
+    from . import io
+
+    write_json = write_json or io.write_json
+    io.check_output(args.summary, "--summary")
+    io.check_output(args.plot, "--plot")
     case = load_case(args.case, args.set)
+    sweep_ratios(case)  # before any run
+    load_case_kernels(case, None if args.quiet else sys.stderr)
     summary = run_sweep(case)
     if args.summary:
         write_json(args.summary, summary)
@@ -163,6 +182,4 @@ def cmd_sweep(args: Any, write_json: Any = None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    import sys
-
     sys.exit(main())

@@ -20,14 +20,15 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..cases import Case, load_case
-from ..simulate import run_model
+from ..cases import Case, CaseError, load_case
+from ..simulate import load_case_kernels, run_model
 
 QOI_KEYS = ("lower_stop_time", "upper_stop_time", "lower_slow_time", "upper_slow_time",
             "stop_time", "runout", "max_fextra_over_rho1")
@@ -316,16 +317,19 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
 
 
 def cmd_converge(args: argparse.Namespace) -> int:
-    from ..io import write_json
+    from ..io import check_output, write_json
 
     if args.report:
         print(f"wrote {report(args.report)}")
         return 0
     if not args.case:
-        raise SystemExit("pdeflow converge: a case file (or --report DIR) is required")
-    case = load_case(args.case, args.set)
+        raise CaseError("pdeflow converge: a case file (or --report DIR) is required")
     if args.levels < 2:
-        raise SystemExit("pdeflow converge: --levels must be at least 2")
+        raise CaseError(f"--levels must be an integer >= 2 (the number of grids), got "
+                        f"{args.levels}")
+    check_output(args.summary, "--summary")
+    case = load_case(args.case, args.set)
+    load_case_kernels(case, sys.stderr)
     if case.data.get("sweep"):
         res = converge_sweep(case, args.levels, args.model)
         print(table(res, ["dx", "prefactor", "exponent", "all_at_rest", "wall_time_s"]))
@@ -345,6 +349,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    import sys
-
     sys.exit(main())
