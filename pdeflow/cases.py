@@ -140,6 +140,7 @@ class Case:
 
     def validate(self) -> None:
         """Check sections, keys, types and ranges; raise CaseError naming the key."""
+        from .checks import check_memory
         from .models import SingleLayerParameters, TwoLayerParameters
 
         for section, content in self.data.items():
@@ -207,6 +208,10 @@ class Case:
             raise self._err(f"initial.shape must be one of {list(SHAPES)}, got "
                             f"{self.initial['shape']!r}")
         self._check_initial()
+        try:
+            check_memory(self)
+        except ValueError as err:
+            raise self._err(str(err)) from None
 
     def _check_finite(self, key: str, value: Any) -> None:
         """Numbers (also inside lists) must be finite: TOML allows nan and inf."""

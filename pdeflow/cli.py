@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -65,8 +66,16 @@ def print_summary(summary: dict[str, Any], out: Any = None) -> None:
     print(f"case {summary['case']}", file=out)
     print(f"{'':18}" + "".join(f"{m:>16}" for m in models), file=out)
     for label, key, unit in rows:
-        print(f"{label:18}" + "".join(f"{_fmt(models[m].get(key), unit):>16}"
+        print(f"{label:18}" + "".join(f"{_cell(models[m], key, unit):>16}"
                                       for m in models), file=out)
+
+
+def _cell(model_summary: dict[str, Any], key: str, unit: str) -> str:
+    """A table cell; a front or run-out cut off by the end of the domain reads '>= ...'."""
+    text = _fmt(model_summary.get(key), unit)
+    if key in ("front_position", "runout") and model_summary.get("runout_lower_bound"):
+        return ">= " + text
+    return text
 
 
 def _model_path(path: str | Path, model: str, first: bool) -> Path:
@@ -87,8 +96,11 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
     """The trackers that the run options ask for (progress, live plot, storage)."""
     trackers: list[Any] = []
     interval = case.t_end / 100
-    progress = (args.progress if args.progress is not None
-                else sys.stdout.isatty() and not args.quiet)
+    progress = args.progress
+    if progress is None:  # default: on a terminal, and for long runs (the bar is stderr)
+        from .checks import run_cost
+
+        progress = not args.quiet and (sys.stdout.isatty() or run_cost(case, model).long)
     if progress:
         from .trackers.live import ProgressBar
 
@@ -321,8 +333,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="simulation time between stored frames [s] (default t_end/100)")
     watch = run.add_argument_group("watching the run")
     watch.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
-                       help="show a progress bar (default: only when stdout is a "
-                       "terminal)")
+                       help="show a progress bar on stderr (default: when stdout is a "
+                       "terminal, or when the run is estimated to be long)")
     watch.add_argument("--live", action="store_true",
                        help="draw the layers, velocities and F_extra/rho1 in a window "
                        "while the run goes (needs a display; close it to finish)")
@@ -400,6 +412,27 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """``pdeflow COMMAND ...``: the exit code; warnings about a run or its results
+    (:class:`pdeflow.checks.RunWarning`) are printed as one line each, once."""
+    from .checks import RunWarning
+
+    original = warnings.showwarning
+    shown: set[str] = set()
+
+    def show(message: Any, category: type, *args: Any, **kwargs: Any) -> None:
+        if not issubclass(category, RunWarning):
+            original(message, category, *args, **kwargs)
+        elif str(message) not in shown:  # e.g. the solver's, once for all models
+            shown.add(str(message))
+            print(f"pdeflow: warning: {message}", file=sys.stderr, flush=True)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", RunWarning)
+        warnings.showwarning = show
+        return _main(argv)
+
+
+def _main(argv: list[str] | None = None) -> int:
     from .cases import CaseError
     from .solvers.fv_split import SimulationBlowUp
     from .storage import StorageError

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -11,6 +12,7 @@ from pde import FieldCollection
 
 from .analysis.metrics import front_position, mass
 from .cases import Case
+from .checks import RunWarning, cost_warning, domain_ends, result_warnings, solver_warning
 from .numerics import layout as L
 from .solvers.fv_split import load_kernels
 from .trackers import SnapshotTracker
@@ -68,10 +70,14 @@ def run_model(case: Case, model: str, *, tracker: Any = None,
     Snapshots are stored at ``output.snapshot_times`` through a py-pde
     ``MemoryStorage`` tracker; ``tracker`` adds user trackers (e.g. a live plot).
     """
+    for message in (solver_warning(case), cost_warning(case, model)):
+        if message:
+            warnings.warn(message, RunWarning, stacklevel=2)
     eq, state = case.make_state(model)
     dx = case.dx
     r = eq.parameters.density_ratio if model == "two_layer" else None
     mass0 = mass(state.data, dx, r)
+    initial = state.data.copy()
     snaps = SnapshotTracker(interrupts=sorted(case.snapshot_times))
     trackers: list[Any] = [snaps] if case.snapshot_times else []
     if tracker is not None:
@@ -103,7 +109,9 @@ def run_model(case: Case, model: str, *, tracker: Any = None,
         t_final = float(diag[L.D_T])
     result = RunResult(model, case, final, t_final, diag, info)
     result.snapshots = snaps.snapshots
-    result.summary = summarize(result, mass0, wall)
+    result.summary = summarize(result, mass0, wall, initial)
+    for message in result.summary["warnings"]:
+        warnings.warn(message, RunWarning, stacklevel=2)
     return result
 
 
@@ -114,8 +122,10 @@ def _stop_time(last_moving: float, t_final: float, at_rest: bool) -> float | Non
     return float(last_moving)
 
 
-def summarize(res: RunResult, mass0: float, wall: float) -> dict[str, Any]:
-    """The per-model summary written to the JSON summary file."""
+def summarize(res: RunResult, mass0: float, wall: float,
+              initial: np.ndarray | None = None) -> dict[str, Any]:
+    """The per-model summary written to the JSON summary file; ``initial`` (the initial
+    state data) lets it tell where material reached an end of the domain."""
     case = res.case
     dx = case.dx
     d = res.state.data
@@ -133,6 +143,7 @@ def summarize(res: RunResult, mass0: float, wall: float) -> dict[str, Any]:
         "runout": (front - case.x_start - case.L0) if (front is not None and case.L0)
         else None,
         "mass_relative_error": abs(mass(d, dx, r) - mass0) / mass0 if mass0 else 0.0,
+        "mass_change": (mass(d, dx, r) - mass0) / mass0 if mass0 else 0.0,
         "steps": int(res.info.get("solver", {}).get("steps", 0)),
         "wall_time_s": wall,
         "stop_reason": res.info.get("controller", {}).get("stop_reason"),
@@ -168,4 +179,8 @@ def summarize(res: RunResult, mass0: float, wall: float) -> dict[str, Any]:
             })
     else:
         out.update({"stop_time": None, "max_fextra_over_rho1": None})
+    if initial is not None:
+        out["domain_ends"] = domain_ends(case, initial, d, out["mass_change"])
+        out["runout_lower_bound"] = out["domain_ends"]["runout_lower_bound"]
+    out["warnings"] = result_warnings(case, res.model, out)
     return out

@@ -38,6 +38,9 @@ def _one_line_error(capsys, *words: str) -> str:
     # a column longer than the domain
     (["run", str(CASE_51), "--set", "initial.L0=5", "--set", "grid.length=1"],
      ["initial.L0 = 5 m", "grid.length = 1 m", "(0, 1] m"]),
+    # a grid no machine holds: refused before any array is made
+    (["run", str(CASE_51), "--set", "grid.cells=100000000000"],
+     ["100,000,000,000 cells", "memory", "grid.dx >="]),
     (["run", str(RITTER), "--movie", "x.webm"], ["x.webm", ".mp4", ".avi", ".gif"]),
 ])
 def test_usage_errors_exit_2_with_one_line(argv, words, capsys):
