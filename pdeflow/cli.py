@@ -235,6 +235,28 @@ def _describe(run: Any) -> str:
             f"max stored F_extra/rho1 {fmax:.3g} m2/s2")
 
 
+def _plot_labels(runs: list[Any]) -> list[str]:
+    """Legend names of stored runs: none where their models differ (the model names
+    them), else the file names (their paths where the names repeat)."""
+    if len({r.model for r in runs}) == len(runs):
+        return [""] * len(runs)
+    if len({r.path.stem for r in runs}) == len(runs):
+        return [r.path.stem for r in runs]
+    return [str(r.path) for r in runs]
+
+
+def _say_nearest_frames(runs: list[Any], idx: list[int], t: float | None) -> None:
+    """Tell which stored frame is shown where a run has none at the asked time."""
+    if t is None:
+        return
+    for r, i in zip(runs, idx, strict=True):
+        shown = float(r.times[i])
+        if abs(shown - t) > 1e-9 * max(1.0, abs(t)):
+            last = " (its last frame)" if i == len(r.times) - 1 else ""
+            print(f"pdeflow: note: {r.path.name} has no frame at t = {t:g} s; showing "
+                  f"the nearest, t = {shown:.4g} s{last}", file=sys.stderr)
+
+
 def cmd_plot(args: argparse.Namespace) -> int:
     from .plotting import RunFigure, Series
     from .storage import open_run
@@ -249,10 +271,8 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
         check_movie_path(args.movie)
     runs = [open_run(p) for p in args.runs]
-    labels = [r.label for r in runs]
-    if len({r.path.name for r in runs}) < len(runs):
-        labels = [f"{r.path} ({r.model.replace('_', ' ')})" for r in runs]
-    series = [Series(r.x, r.model, lab) for r, lab in zip(runs, labels, strict=True)]
+    series = [Series(r.x, r.model, lab) for r, lab in zip(runs, _plot_labels(runs),
+                                                           strict=True)]
     title = args.title if args.title is not None else runs[0].metadata.get(
         "case_name", runs[0].path.stem)
     written = []
@@ -268,13 +288,21 @@ def cmd_plot(args: argparse.Namespace) -> int:
     if args.out or not args.movie:
         idx = [r.index(args.time) for r in runs]
         times = [float(r.times[i]) for r, i in zip(runs, idx, strict=True)]
-        if len({round(t, 9) for t in times}) > 1:  # show each run's own time
-            for s, t in zip(series, times, strict=True):
-                s.label = f"{s.label}, t = {t:.3g} s"
-        fig = RunFigure(series, title=title)
+        if not args.quiet:
+            _say_nearest_frames(runs, idx, args.time)
+        # deposits at rest: velocities and F_extra are zero, so only the depths are drawn
+        deposits = args.time is None and all(r.metadata.get("at_rest") for r in runs)
+        if len({round(t, 9) for t in times}) > 1 and not deposits:
+            for s, t in zip(series, times, strict=True):  # show each run's own time
+                s.label = f"{s.label or s.model.replace('_', ' ')}, t = {t:.3g} s"
+        fig = RunFigure(series, title=title, panels=1 if deposits else 3)
         fig.update(times[0], [r.data[i] for r, i in zip(runs, idx, strict=True)],
                    [r.fextra[i] for r, i in zip(runs, idx, strict=True)])
-        if len({round(t, 9) for t in times}) > 1:
+        if deposits:
+            fig.set_title("final deposits (at rest: " + ", ".join(
+                f"{fig.name(s)} t = {t:.3g} s" for s, t in zip(series, times, strict=True))
+                + ")")
+        elif len({round(t, 9) for t in times}) > 1:
             fig.set_title("(times in the legend)" if args.time is None
                           else f"(nearest stored times to t = {args.time:g} s)")
         out = args.out or runs[0].path.with_suffix(".png")

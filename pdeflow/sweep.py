@@ -99,18 +99,20 @@ def sweep_figure(summary: dict[str, Any], path: str | Path) -> Path:
     """Log-log plot of r against a with the fits, the paper's fits and the DEM slope."""
     import matplotlib.pyplot as plt
 
-    from .plotting import save
+    from .plotting import ASPECT_TICKS, log_ticks, save
 
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
     styles = {"single_layer": ("k", "o", "single layer"),
               "two_layer": ("tab:orange", "s", "two layers")}
     amin, amax = np.inf, 0.0
+    rs: list[float] = []
     for model, res in summary["models"].items():
         color, marker, label = styles[model]
         pts = np.array([p for p in res["points"] if p[1]], dtype=float)
         if pts.size == 0:
             continue
         amin, amax = min(amin, pts[:, 0].min()), max(amax, pts[:, 0].max())
+        rs.extend(pts[:, 1])
         ax.loglog(pts[:, 0], pts[:, 1], marker, color=color, label=f"{label}")
         aa = np.geomspace(pts[:, 0].min(), pts[:, 0].max(), 50)
         if res["prefactor"]:
@@ -124,6 +126,10 @@ def sweep_figure(summary: dict[str, Any], path: str | Path) -> Path:
         anchor = (two.get("prefactor") or 1.0) * amin ** (two.get("exponent") or DEM_EXPONENT)
         ax.loglog(aa, anchor * (aa / amin) ** DEM_EXPONENT, "--", color="gray", lw=1,
                   label=f"DEM slope a^{DEM_EXPONENT} (Lacaze et al.)")
+    if amax > 0:
+        log_ticks(ax.xaxis, [a for a in ASPECT_TICKS if amin <= a <= amax] or [amin, amax])
+        decades = 10.0 ** np.arange(np.floor(np.log10(min(rs))), np.log10(max(rs)) + 1)
+        log_ticks(ax.yaxis, [m * d for d in decades for m in (1, 2, 5)])
     ax.set_xlabel("aspect ratio a = H0/L0")
     ax.set_ylabel("normalised run-out r = (R - L0)/L0")
     ax.legend(fontsize=7)
