@@ -258,12 +258,11 @@ def _say_nearest_frames(runs: list[Any], idx: list[int], t: float | None) -> Non
 
 
 def cmd_plot(args: argparse.Namespace) -> int:
+    from .io import check_output
     from .plotting import RunFigure, Series
     from .storage import open_run
 
     _positive("--fps", args.fps)
-    from .io import check_output
-
     check_output(args.out, "--out")
     check_output(args.movie, "--movie")
     if args.movie:

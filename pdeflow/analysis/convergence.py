@@ -108,11 +108,12 @@ def richardson(values: list[float | None]) -> dict[str, float | None]:
         if d1 != 0 and d2 != 0:
             p = math.log2(abs(d1) / abs(d2))
             out["order"] = p
-            estimate = v[-1] + d2 / (2**p - 1) if p > 0 else math.nan
-            lo, hi = min(v[-3:]), max(v[-3:])
-            same_sign = (lo >= 0 and estimate >= 0) or (hi <= 0 and estimate <= 0)
-            if p > 0 and d1 * d2 > 0 and (same_sign or lo < 0 < hi):
-                out["extrapolated"] = estimate
+            if p > 0 and d1 * d2 > 0:  # converging and monotone
+                estimate = v[-1] + d2 / (2**p - 1)
+                lo, hi = min(v[-3:]), max(v[-3:])
+                if (lo < 0 < hi or (lo >= 0 and estimate >= 0)
+                        or (hi <= 0 and estimate <= 0)):
+                    out["extrapolated"] = estimate
     return out
 
 

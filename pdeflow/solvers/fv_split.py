@@ -50,8 +50,10 @@ logging.getLogger("pde.solvers.controller").addFilter(_RestProfilerFilter())
 
 
 def kernels_ready() -> bool:
-    """True if the ``fv-split`` stepping kernel is compiled (or loaded) in this process."""
-    return bool(advance_split.signatures)
+    """True if the ``fv-split`` stepping kernel is compiled (or loaded) in this process
+    (always with NUMBA_DISABLE_JIT=1: nothing to compile)."""
+    signatures = getattr(advance_split, "signatures", None)
+    return True if signatures is None else bool(signatures)
 
 
 def kernels_cached() -> bool:
