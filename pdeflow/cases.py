@@ -140,6 +140,7 @@ class Case:
 
     def validate(self) -> None:
         """Check sections, keys, types and ranges; raise CaseError naming the key."""
+        from .checks import check_memory
         from .models import SingleLayerParameters, TwoLayerParameters
 
         for section, content in self.data.items():
@@ -207,6 +208,10 @@ class Case:
             raise self._err(f"initial.shape must be one of {list(SHAPES)}, got "
                             f"{self.initial['shape']!r}")
         self._check_initial()
+        try:
+            check_memory(self)
+        except ValueError as err:
+            raise self._err(str(err)) from None
 
     def _check_finite(self, key: str, value: Any) -> None:
         """Numbers (also inside lists) must be finite: TOML allows nan and inf."""
@@ -259,6 +264,10 @@ class Case:
                 check_range("initial.upper_fraction", ini["upper_fraction"], 0, 1)
         except ValueError as err:
             raise self._err(str(err)) from None
+        if shape == "column" and ini["L0"] > self.length:
+            raise self._err(f"initial.L0 = {ini['L0']:g} m is longer than the domain "
+                            f"(grid.length = {self.length:g} m): the column must lie in "
+                            f"(0, {self.length:g}] m; lengthen the domain or shorten the column")
         if shape == "file" and not (self.base_dir / ini["path"]).is_file():
             raise self._err(f"initial.path: file {ini['path']} not found next to "
                             "the case file")

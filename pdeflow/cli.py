@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -65,8 +66,16 @@ def print_summary(summary: dict[str, Any], out: Any = None) -> None:
     print(f"case {summary['case']}", file=out)
     print(f"{'':18}" + "".join(f"{m:>16}" for m in models), file=out)
     for label, key, unit in rows:
-        print(f"{label:18}" + "".join(f"{_fmt(models[m].get(key), unit):>16}"
+        print(f"{label:18}" + "".join(f"{_cell(models[m], key, unit):>16}"
                                       for m in models), file=out)
+
+
+def _cell(model_summary: dict[str, Any], key: str, unit: str) -> str:
+    """A table cell; a front or run-out cut off by the end of the domain reads '>= ...'."""
+    text = _fmt(model_summary.get(key), unit)
+    if key in ("front_position", "runout") and model_summary.get("runout_lower_bound"):
+        return ">= " + text
+    return text
 
 
 def _model_path(path: str | Path, model: str, first: bool) -> Path:
@@ -87,8 +96,11 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
     """The trackers that the run options ask for (progress, live plot, storage)."""
     trackers: list[Any] = []
     interval = case.t_end / 100
-    progress = (args.progress if args.progress is not None
-                else sys.stdout.isatty() and not args.quiet)
+    progress = args.progress
+    if progress is None:  # default: on a terminal, and for long runs (the bar is stderr)
+        from .checks import run_cost
+
+        progress = not args.quiet and (sys.stdout.isatty() or run_cost(case, model).long)
     if progress:
         from .trackers.live import ProgressBar
 
@@ -118,13 +130,15 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
 
 def cmd_run(args: argparse.Namespace) -> int:
     from .cases import load_case
-    from .io import write_json, write_npz
+    from .io import check_output, write_json, write_npz
     from .plotting import case_figures, deposit_figure, save
-    from .simulate import run_model
+    from .simulate import load_case_kernels, run_model
 
     case = load_case(args.case, args.set)
     for name in ("live_every", "store_every", "fps"):
         _positive(f"--{name.replace('_', '-')}", getattr(args, name))
+    for name in ("summary", "final", "plot", "outdir", "store", "movie", "frames"):
+        check_output(getattr(args, name), f"--{name}")
     if args.movie:
         from .trackers.live import check_movie_path
 
@@ -142,6 +156,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             print("pdeflow: warning: --live needs a display (matplotlib backend "
                   "is non-interactive); use --movie or --frames on a headless machine",
                   file=sys.stderr)
+    load_case_kernels(case, None if args.quiet else sys.stderr)
     results = {}
     stores: dict[str, Any] = {}
     all_trackers: list[Any] = []
@@ -220,20 +235,43 @@ def _describe(run: Any) -> str:
             f"max stored F_extra/rho1 {fmax:.3g} m2/s2")
 
 
+def _plot_labels(runs: list[Any]) -> list[str]:
+    """Legend names of stored runs: none where their models differ (the model names
+    them), else the file names (their paths where the names repeat)."""
+    if len({r.model for r in runs}) == len(runs):
+        return [""] * len(runs)
+    if len({r.path.stem for r in runs}) == len(runs):
+        return [r.path.stem for r in runs]
+    return [str(r.path) for r in runs]
+
+
+def _say_nearest_frames(runs: list[Any], idx: list[int], t: float | None) -> None:
+    """Tell which stored frame is shown where a run has none at the asked time."""
+    if t is None:
+        return
+    for r, i in zip(runs, idx, strict=True):
+        shown = float(r.times[i])
+        if abs(shown - t) > 1e-9 * max(1.0, abs(t)):
+            last = " (its last frame)" if i == len(r.times) - 1 else ""
+            print(f"pdeflow: note: {r.path.name} has no frame at t = {t:g} s; showing "
+                  f"the nearest, t = {shown:.4g} s{last}", file=sys.stderr)
+
+
 def cmd_plot(args: argparse.Namespace) -> int:
+    from .io import check_output
     from .plotting import RunFigure, Series
     from .storage import open_run
 
     _positive("--fps", args.fps)
+    check_output(args.out, "--out")
+    check_output(args.movie, "--movie")
     if args.movie:
         from .trackers.live import check_movie_path
 
         check_movie_path(args.movie)
     runs = [open_run(p) for p in args.runs]
-    labels = [r.label for r in runs]
-    if len({r.path.name for r in runs}) < len(runs):
-        labels = [f"{r.path} ({r.model.replace('_', ' ')})" for r in runs]
-    series = [Series(r.x, r.model, lab) for r, lab in zip(runs, labels, strict=True)]
+    series = [Series(r.x, r.model, lab) for r, lab in zip(runs, _plot_labels(runs),
+                                                           strict=True)]
     title = args.title if args.title is not None else runs[0].metadata.get(
         "case_name", runs[0].path.stem)
     written = []
@@ -249,13 +287,21 @@ def cmd_plot(args: argparse.Namespace) -> int:
     if args.out or not args.movie:
         idx = [r.index(args.time) for r in runs]
         times = [float(r.times[i]) for r, i in zip(runs, idx, strict=True)]
-        if len({round(t, 9) for t in times}) > 1:  # show each run's own time
-            for s, t in zip(series, times, strict=True):
-                s.label = f"{s.label}, t = {t:.3g} s"
-        fig = RunFigure(series, title=title)
+        if not args.quiet:
+            _say_nearest_frames(runs, idx, args.time)
+        # deposits at rest: velocities and F_extra are zero, so only the depths are drawn
+        deposits = args.time is None and all(r.metadata.get("at_rest") for r in runs)
+        if len({round(t, 9) for t in times}) > 1 and not deposits:
+            for s, t in zip(series, times, strict=True):  # show each run's own time
+                s.label = f"{s.label or s.model.replace('_', ' ')}, t = {t:.3g} s"
+        fig = RunFigure(series, title=title, panels=1 if deposits else 3)
         fig.update(times[0], [r.data[i] for r, i in zip(runs, idx, strict=True)],
                    [r.fextra[i] for r, i in zip(runs, idx, strict=True)])
-        if len({round(t, 9) for t in times}) > 1:
+        if deposits:
+            fig.set_title("final deposits (at rest: " + ", ".join(
+                f"{fig.name(s)} t = {t:.3g} s" for s, t in zip(series, times, strict=True))
+                + ")")
+        elif len({round(t, 9) for t in times}) > 1:
             fig.set_title("(times in the legend)" if args.time is None
                           else f"(nearest stored times to t = {args.time:g} s)")
         out = args.out or runs[0].path.with_suffix(".png")
@@ -270,8 +316,10 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
 
 def cmd_export(args: argparse.Namespace) -> int:
+    from .io import check_output
     from .storage import open_run
 
+    check_output(args.out, "OUT")
     run = open_run(args.run)
     out = run.export(args.out)
     if not args.quiet:
@@ -312,15 +360,15 @@ def build_parser() -> argparse.ArgumentParser:
                      help="simulation time between stored frames [s] (default t_end/100)")
     watch = run.add_argument_group("watching the run")
     watch.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
-                       help="show a progress bar (default: only when stdout is a "
-                       "terminal)")
+                       help="show a progress bar on stderr (default: when stdout is a "
+                       "terminal, or when the run is estimated to be long)")
     watch.add_argument("--live", action="store_true",
                        help="draw the layers, velocities and F_extra/rho1 in a window "
                        "while the run goes (needs a display; close it to finish)")
     watch.add_argument("--movie", metavar="OUT.mp4",
-                       help="write the live plot as a movie, headless: .mp4 (needs "
-                       "ffmpeg, e.g. pip install imageio-ffmpeg) or .gif; further "
-                       "models go to OUT.<model>.mp4")
+                       help="write the live plot as a movie, headless: .mp4 (also "
+                       ".m4v, .mov, .mkv, .avi; H.264, needs ffmpeg, e.g. pip install "
+                       "imageio-ffmpeg) or .gif; further models go to OUT.<model>.mp4")
     watch.add_argument("--frames", metavar="DIR",
                        help="write the live plot as PNG frames DIR/<model>/frame_*.png")
     watch.add_argument("--live-every", type=float, metavar="DT",
@@ -340,7 +388,8 @@ def build_parser() -> argparse.ArgumentParser:
     plot.add_argument("--out", metavar="FIG.png",
                       help="write the figure here (default: the first RUN with .png)")
     plot.add_argument("--movie", metavar="OUT.mp4",
-                      help="write a movie over all stored frames (.mp4 or .gif)")
+                      help="write a movie over all stored frames (.mp4, .m4v, .mov, "
+                      ".mkv, .avi: needs ffmpeg; or .gif)")
     plot.add_argument("--fps", type=float, default=10.0,
                       help="frames per second of --movie (default 10)")
     plot.add_argument("--title", help="figure title (default: the case name)")
@@ -368,11 +417,13 @@ def build_parser() -> argparse.ArgumentParser:
                         description=convergence.__doc__, formatter_class=raw)
     convergence.add_arguments(cv)
     cv.set_defaults(func=convergence.cmd_converge)
-    cp = sub.add_parser("compare", help="work-precision comparison of solver variants",
-                        description="Runs every variant on a sequence of grids against an "
-                        "exact solution or a fine-grid reference; writes a work-precision "
-                        "diagram and table (pdeflow.analysis.workprecision).",
-                        formatter_class=raw)
+    cp = sub.add_parser("compare", help="work-precision study: error against wall time "
+                        "of solver variants (to compare runs, use plot)",
+                        description="Work-precision study: runs every variant on a sequence "
+                        "of grids against an exact solution or a fine-grid reference; "
+                        "writes a work-precision diagram and table "
+                        "(pdeflow.analysis.workprecision). `pdeflow compare --help` lists "
+                        "its options.", formatter_class=raw)
     cp.add_argument("args", nargs=argparse.REMAINDER,
                     help="CASE.toml|ritter|mangeney [--variants V ...] [--grids N|DX ...] "
                     "[--reference auto|exact|fine|fine:VARIANT] [--out-dir DIR] ...")
@@ -396,6 +447,27 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """``pdeflow COMMAND ...``: the exit code; warnings about a run or its results
+    (:class:`pdeflow.checks.RunWarning`) are printed as one line each, once."""
+    from .checks import RunWarning
+
+    original = warnings.showwarning
+    shown: set[str] = set()
+
+    def show(message: Any, category: type, *args: Any, **kwargs: Any) -> None:
+        if not issubclass(category, RunWarning):
+            original(message, category, *args, **kwargs)
+        elif str(message) not in shown:  # e.g. the solver's, once for all models
+            shown.add(str(message))
+            print(f"pdeflow: warning: {message}", file=sys.stderr, flush=True)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", RunWarning)
+        warnings.showwarning = show
+        return _main(argv)
+
+
+def _main(argv: list[str] | None = None) -> int:
     from .cases import CaseError
     from .solvers.fv_split import SimulationBlowUp
     from .storage import StorageError
@@ -405,7 +477,7 @@ def main(argv: list[str] | None = None) -> int:
         # the work-precision harness parses its own options (and its own --help)
         from .analysis import workprecision
 
-        return int(workprecision.main(argv[1:]) or 0)
+        return int(workprecision.main(argv[1:], prog="pdeflow compare") or 0)
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
@@ -417,9 +489,10 @@ def main(argv: list[str] | None = None) -> int:
         print(f"pdeflow: simulation failed: {err}", file=sys.stderr)
         return 3
     except ValueError as err:
+        from .io import OutputError
         from .trackers.live import MovieError
 
-        if not isinstance(err, MovieError):
+        if not isinstance(err, (MovieError, OutputError)):
             raise
         print(f"pdeflow: error: {err}", file=sys.stderr)
         return 2

@@ -13,6 +13,21 @@ from typing import Any
 import numpy as np
 
 
+class OutputError(ValueError):
+    """An output path that cannot be written as given (names the option and the path)."""
+
+
+def check_output(path: str | Path | None, option: str) -> None:
+    """Raise :class:`OutputError` unless the directory that ``path`` goes into exists
+    (as ``cp`` does: a mistyped path must not create directories anywhere)."""
+    if path is None:
+        return
+    parent = Path(path).expanduser().parent
+    if not parent.is_dir():
+        raise OutputError(f"{option} {path}: directory {parent} does not exist (create it "
+                          "first)")
+
+
 @contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
     """Yield a temporary path next to ``path``; rename it onto ``path`` on success.

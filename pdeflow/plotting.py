@@ -85,6 +85,20 @@ def deposit_figure(x: np.ndarray, two: np.ndarray | None, single: np.ndarray | N
     return fig
 
 
+ASPECT_TICKS = (2, 4, 8, 16, 30)
+"""Ticks of aspect-ratio axes (a = 2 .. 30 in the paper's test 5.2)."""
+
+
+def log_ticks(axis: Any, ticks: Sequence[float]) -> None:
+    """Label a logarithmic axis at ``ticks`` only, in plain numbers (matplotlib labels
+    minor ticks too on short log ranges, and they overlap)."""
+    from matplotlib.ticker import FixedLocator, NullFormatter, ScalarFormatter
+
+    axis.set_major_locator(FixedLocator(list(ticks)))
+    axis.set_major_formatter(ScalarFormatter())
+    axis.set_minor_formatter(NullFormatter())
+
+
 def save(fig: Any, path: str | Path) -> Path:
     """Save a figure atomically (complete file or none) and close it."""
     path = Path(path)
@@ -129,6 +143,12 @@ def case_figures(results: dict[str, Any], outdir: str | Path,
 LINE_COLOURS = ("tab:blue", "tab:green", "tab:purple", "tab:olive", "tab:cyan", "tab:gray")
 
 
+def _set(lines: dict[str, Any], key: str, y: np.ndarray) -> None:
+    """Set the data of a line if the figure has it (one-panel figures have no u, F)."""
+    if key in lines:
+        lines[key].set_ydata(y)
+
+
 @dataclass
 class Series:
     """One run drawn in a :class:`RunFigure`: its cell centres, model and legend label."""
@@ -148,11 +168,17 @@ class RunFigure:
     lower layer filled from the bed, the upper layer filled on top of it, the interface
     and the free surface. Panel 2: the velocities of the layers [m/s] (gaps where a
     layer is dry). Panel 3: F_extra/rho1 [m^2/s^2], the momentum exchange added to keep
-    the two-layer system hyperbolic. The simulation time is in the title.
+    the two-layer system hyperbolic. The simulation time is in the title. With
+    ``panels=1`` only the depths are drawn (deposits at rest: nothing moves, and
+    F_extra is zero).
 
-    The first run is drawn filled; further runs (comparisons) as lines: free surface
-    solid, interface dashed. Axis limits only ever grow, so that a sequence of frames
-    (a live plot, a movie) does not jitter.
+    The first run is drawn filled, in the colours of the run's own figures (lower layer
+    brown, upper layer orange, a single layer tan with a black surface); further runs
+    (comparisons) as lines: the first single layer among them black, as in the run's
+    figures, the others in :data:`LINE_COLOURS`; free surface solid, interface dashed.
+    Legend entries name a run only where two runs of the same model need telling apart
+    (by their labels). Axis limits only ever grow, so that a sequence of frames (a live
+    plot, a movie) does not jitter.
 
     Args:
         series: the runs to draw (their grids may differ).
@@ -161,21 +187,28 @@ class RunFigure:
             frame drawn.
         pyplot: create the figure through pyplot (needed for a desktop window); else a
             plain :class:`matplotlib.figure.Figure` that no GUI or notebook shows by itself.
-        figsize: figure size [inch].
+        figsize: figure size [inch] (default (7, 7.5) for three panels, (7, 3.4) for one).
+        panels: 3 (depths, velocities, F_extra) or 1 (depths only).
     """
 
     def __init__(self, series: Sequence[Series], *, title: str = "",
                  depth_max: float | None = None, pyplot: bool = False,
-                 figsize: tuple[float, float] = (7.0, 7.5)):
+                 figsize: tuple[float, float] | None = None, panels: int = 3):
         from matplotlib.figure import Figure
 
         if not series:
             raise ValueError("RunFigure needs at least one series")
+        if panels not in (1, 3):
+            raise ValueError(f"panels must be 1 or 3, got {panels!r}")
         self.series = list(series)
         self.title = title
+        figsize = figsize or ((7.0, 7.5) if panels == 3 else (7.0, 3.4))
         self.fig = (plt.figure(figsize=figsize, layout="constrained") if pyplot
                     else Figure(figsize=figsize, layout="constrained"))
-        self.ax_h, self.ax_u, self.ax_f = self.fig.subplots(3, 1, sharex=True)
+        axes = np.atleast_1d(self.fig.subplots(panels, 1, sharex=True))
+        self.ax_h = axes[0]
+        self.ax_u = axes[1] if panels == 3 else None
+        self.ax_f = axes[2] if panels == 3 else None
         self._fills: list[Any] = []
         self._depth_max = depth_max
         self._u_lim = [0.0, 0.0]
@@ -188,63 +221,86 @@ class RunFigure:
         self.ax_h.set_xlim(lo, hi)
         self.ax_h.axhline(0.0, color="0.3", lw=1.0)
         self._bed = None
-        n_lines = 0
+        # a run is named in the legend only where another run has the same model
+        self._named = len({s.model for s in self.series}) < len(self.series)
+        free = list(LINE_COLOURS)
+        self._black_free = True
         for i, s in enumerate(self.series):
-            label = s.label or s.model.replace("_", " ")
-            two = s.model == "two_layer"
-            filled = i == 0
-            col = None if filled else LINE_COLOURS[n_lines % len(LINE_COLOURS)]
-            n_lines += 0 if filled else 1
-            c_up = "tab:orange" if filled and two else col or "k"
-            c_lo = "tab:brown" if filled and two else col or "k"
-            ln: dict[str, Any] = {}
-            nan = np.full(s.x.size, np.nan)
-            if two:
-                ln["surface"], = self.ax_h.plot(s.x, nan, color="k" if filled else col,
-                                                lw=1.0, label=f"{label}: free surface")
-                ln["interface"], = self.ax_h.plot(s.x, nan, color=c_lo, lw=1.0,
-                                                  ls="-" if filled else "--",
-                                                  label=f"{label}: interface")
-                ln["u1"], = self.ax_u.plot(s.x, nan, color=c_up, lw=1.2,
-                                           label=f"{label}: $u_1$ (upper)")
-                ln["u2"], = self.ax_u.plot(s.x, nan, color=c_lo, lw=1.2, ls="--",
-                                           label=f"{label}: $u_2$ (lower)")
-                ln["fextra"], = self.ax_f.plot(s.x, nan, color="tab:red" if filled
-                                               else col, lw=1.2, label=label)
-            else:
-                ln["surface"], = self.ax_h.plot(s.x, nan, color="k" if filled else col,
-                                                lw=1.2, label=f"{label}: surface")
-                ln["u"], = self.ax_u.plot(s.x, nan, color="k" if filled else col,
-                                          lw=1.2, label=f"{label}: $u$")
-            self._lines.append(ln)
+            self._lines.append(self._add_lines(s, filled=i == 0, free=free))
         self.ax_h.set_ylabel("depth normal to bed [m]")
-        self.ax_u.set_ylabel("velocity [m/s]")
-        self.ax_f.set_ylabel(r"$F_{extra}/\rho_1$ [m$^2$/s$^2$]")
-        self.ax_f.set_xlabel("x [m]")
-        if not any(s.model == "two_layer" for s in self.series):
-            self.ax_f.text(0.5, 0.5, "single layer: no F_extra", ha="center",
-                           va="center", transform=self.ax_f.transAxes, color="0.4")
-        for ax in (self.ax_h, self.ax_u, self.ax_f):
+        self.ax_h.set_xlabel("x [m]")
+        if self.ax_u is not None and self.ax_f is not None:
+            self.ax_h.set_xlabel("")
+            self.ax_u.set_ylabel("velocity [m/s]")
+            self.ax_f.set_ylabel(r"$F_{extra}/\rho_1$ [m$^2$/s$^2$]")
+            self.ax_f.set_xlabel("x [m]")
+            if not any(s.model == "two_layer" for s in self.series):
+                self.ax_f.text(0.5, 0.5, "single layer: no F_extra", ha="center",
+                               va="center", transform=self.ax_f.transAxes, color="0.4")
+            self.ax_u.axhline(0.0, color="0.5", lw=0.6)
+        for ax in axes:
             ax.grid(alpha=0.3)
-        self.ax_u.axhline(0.0, color="0.5", lw=0.6)
         self._title = self.fig.suptitle(title)
         self.t: float | None = None
+
+    def name(self, s: Series) -> str:
+        """A run's name: its label, else its model ('two layers', 'single layer')."""
+        return s.label or ("two layers" if s.model == "two_layer" else "single layer")
+
+    def _prefix(self, s: Series) -> str:
+        return f"{self.name(s)}: " if self._named else ""
+
+    def _add_lines(self, s: Series, *, filled: bool, free: list[str]) -> dict[str, Any]:
+        """The (empty) lines of one run; ``free``: line colours not taken yet."""
+        name, pre = self.name(s), self._prefix(s)
+        nan = np.full(s.x.size, np.nan)
+        ln: dict[str, Any] = {}
+        if s.model == "two_layer":
+            if filled:  # the fills carry the legend; the lines are their edges
+                c_up, c_lo, hide = "tab:orange", "tab:brown", "_"
+                up, lo = f"{pre}$u_1$ (upper)", f"{pre}$u_2$ (lower)"
+            else:
+                c_up = c_lo = free.pop(0) if free else "0.5"
+                hide = ""
+                up, lo = f"{name}: $u_1$ (upper)", f"{name}: $u_2$ (lower)"
+            ln["surface"], = self.ax_h.plot(s.x, nan, color=c_up, lw=1.0,
+                                            label=f"{hide}{name}: free surface")
+            ln["interface"], = self.ax_h.plot(s.x, nan, color=c_lo, lw=1.0,
+                                              ls="-" if filled else "--",
+                                              label=f"{hide}{name}: interface")
+            if self.ax_u is not None and self.ax_f is not None:
+                ln["u1"], = self.ax_u.plot(s.x, nan, color=c_up, lw=1.2, label=up)
+                ln["u2"], = self.ax_u.plot(s.x, nan, color=c_lo, lw=1.2,
+                                           ls="-" if filled else "--", label=lo)
+                ln["fextra"], = self.ax_f.plot(s.x, nan, color="tab:red" if filled
+                                               else c_up, lw=1.2, label=name)
+        else:
+            # black, as in the run's figures, for the first single layer only
+            color = "k" if self._black_free else (free.pop(0) if free else "0.5")
+            self._black_free = False
+            label = f"_{name}" if filled else name  # a filled layer: its patch
+            ln["surface"], = self.ax_h.plot(s.x, nan, color=color, lw=1.2, label=label)
+            if self.ax_u is not None:
+                ln["u"], = self.ax_u.plot(s.x, nan, color=color, lw=1.2, label=name)
+        return ln
 
     def _legend(self) -> None:
         from matplotlib.patches import Patch
 
         first = self.series[0]
-        label = first.label or first.model.replace("_", " ")
+        pre = self._prefix(first)
         if first.model == "two_layer":
-            patches = [Patch(color="tab:orange", alpha=0.5, label=f"{label}: upper layer $h_1$"),
-                       Patch(color="tab:brown", alpha=0.6, label=f"{label}: lower layer $h_2$")]
+            patches = [Patch(color="tab:brown", alpha=0.6, label=f"{pre}lower layer $h_2$"),
+                       Patch(color="tab:orange", alpha=0.5, label=f"{pre}upper layer $h_1$")]
         else:
-            patches = [Patch(color="tan", alpha=0.7, label=f"{label}: layer $h$")]
-        handles = patches + list(self.ax_h.get_lines()[1:])  # [0] is the bed line
-        self.ax_h.legend(handles=handles, loc="upper right", fontsize=7)
-        self.ax_u.legend(loc="upper right", fontsize=7)
-        if len(self.series) > 1 and any(s.model == "two_layer" for s in self.series):
-            self.ax_f.legend(loc="upper right", fontsize=7)
+            patches = [Patch(color="tan", alpha=0.7, label=self.name(first))]
+        lines = [ln for ln in self.ax_h.get_lines()[1:]  # [0] is the bed line
+                 if not ln.get_label().startswith("_")]
+        self.ax_h.legend(handles=patches + lines, loc="upper right", fontsize=7)
+        if self.ax_u is not None and self.ax_f is not None:
+            self.ax_u.legend(loc="upper right", fontsize=7)
+            if sum(s.model == "two_layer" for s in self.series) > 1:
+                self.ax_f.legend(loc="upper right", fontsize=7)
 
     def update(self, t: float, states: Sequence[np.ndarray | None],
                fextras: Sequence[np.ndarray | None] | None = None) -> None:
@@ -281,11 +337,11 @@ class RunFigure:
                 ln["surface"].set_ydata(np.where(top > DRY, top, np.nan))
                 ln["interface"].set_ydata(np.where(h2 > DRY, h2, np.nan))
                 u1, u2 = _velocity(h1, d[1]), _velocity(h2, d[3])
-                ln["u1"].set_ydata(u1)
-                ln["u2"].set_ydata(u2)
+                _set(ln, "u1", u1)
+                _set(ln, "u2", u2)
                 us = [u1, u2]
                 f = np.zeros_like(h1) if fx is None else np.asarray(fx)
-                ln["fextra"].set_ydata(f)
+                _set(ln, "fextra", f)
                 self._f_max = max(self._f_max, float(np.max(f)) if f.size else 0.0)
                 if i == 0:
                     self._fills.append(self.ax_h.fill_between(
@@ -296,7 +352,7 @@ class RunFigure:
                 h = d[0]
                 ln["surface"].set_ydata(np.where(h > DRY, h, np.nan))
                 u = _velocity(h, d[1])
-                ln["u"].set_ydata(u)
+                _set(ln, "u", u)
                 us = [u]
                 if i == 0:
                     self._fills.append(self.ax_h.fill_between(
@@ -308,9 +364,10 @@ class RunFigure:
         span = max(self._u_lim[1] - self._u_lim[0], 0.1)  # at least 0.1 m/s shown
         mid = 0.5 * (self._u_lim[0] + self._u_lim[1])
         lo, hi = min(self._u_lim[0], mid - span / 2), max(self._u_lim[1], mid + span / 2)
-        self.ax_u.set_ylim(lo - 0.08 * span, hi + 0.08 * span)
-        f_top = max(self._f_max, 0.1)
-        self.ax_f.set_ylim(-0.05 * f_top, 1.1 * f_top)
+        if self.ax_u is not None and self.ax_f is not None:
+            self.ax_u.set_ylim(lo - 0.08 * span, hi + 0.08 * span)
+            f_top = max(self._f_max, 0.1)
+            self.ax_f.set_ylim(-0.05 * f_top, 1.1 * f_top)
         self.t = float(t)
         self.set_title(f"t = {t:.3f} s")
         if first:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -11,7 +12,9 @@ from pde import FieldCollection
 
 from .analysis.metrics import front_position, mass
 from .cases import Case
+from .checks import RunWarning, cost_warning, domain_ends, result_warnings, solver_warning
 from .numerics import layout as L
+from .solvers.fv_split import load_kernels
 from .trackers import SnapshotTracker
 
 
@@ -53,6 +56,13 @@ class RunResult:
         return out
 
 
+def load_case_kernels(case: Case, log: Any = None) -> float:
+    """Compile or load the compiled kernels that ``case`` needs, before its runs, so
+    that neither its wall times nor its progress bars include it; ``log`` (a stream) is
+    told when they are compiled (the first run on a machine). Returns seconds spent."""
+    return load_kernels(log) if case.solver == "fv-split" else 0.0
+
+
 def run_model(case: Case, model: str, *, tracker: Any = None,
               backend: str = "numba") -> RunResult:
     """Run ``model`` ('two_layer' or 'single_layer') of ``case`` to rest or t_end.
@@ -60,10 +70,14 @@ def run_model(case: Case, model: str, *, tracker: Any = None,
     Snapshots are stored at ``output.snapshot_times`` through a py-pde
     ``MemoryStorage`` tracker; ``tracker`` adds user trackers (e.g. a live plot).
     """
+    for message in (solver_warning(case), cost_warning(case, model)):
+        if message:
+            warnings.warn(message, RunWarning, stacklevel=2)
     eq, state = case.make_state(model)
     dx = case.dx
     r = eq.parameters.density_ratio if model == "two_layer" else None
     mass0 = mass(state.data, dx, r)
+    initial = state.data.copy()
     snaps = SnapshotTracker(interrupts=sorted(case.snapshot_times))
     trackers: list[Any] = [snaps] if case.snapshot_times else []
     if tracker is not None:
@@ -72,6 +86,10 @@ def run_model(case: Case, model: str, *, tracker: Any = None,
     kwargs: dict[str, Any] = {}
     if solver == "fv-split":
         kwargs = {"cfl": case.cfl, "backend": backend, "splitting": case.splitting}
+        if backend == "numba":
+            # compiling (first run on a machine) or loading the kernels is not the run's
+            # wall time, nor should it hold up its progress bar
+            load_kernels()
     else:
         kwargs = {"dt": float(case.data.get("numerics", {}).get("dt", 1e-4))}
     wall0 = time.perf_counter()
@@ -91,7 +109,9 @@ def run_model(case: Case, model: str, *, tracker: Any = None,
         t_final = float(diag[L.D_T])
     result = RunResult(model, case, final, t_final, diag, info)
     result.snapshots = snaps.snapshots
-    result.summary = summarize(result, mass0, wall)
+    result.summary = summarize(result, mass0, wall, initial)
+    for message in result.summary["warnings"]:
+        warnings.warn(message, RunWarning, stacklevel=2)
     return result
 
 
@@ -104,7 +124,8 @@ def _stop_time(last_moving: float, t_final: float, at_rest: bool) -> float | Non
 
 _COMMON_KEYS = ("model", "solver", "t_final", "at_rest", "front_position", "runout",
                 "mass_relative_error", "steps", "wall_time_s", "stop_reason", "stop_time",
-                "max_fextra_over_rho1", "flux_fallback_steps")
+                "max_fextra_over_rho1", "flux_fallback_steps", "mass_change",
+                "runout_lower_bound", "domain_ends", "warnings")
 SUMMARY_KEYS: dict[str, tuple[str, ...]] = {
     "two_layer": (*_COMMON_KEYS, "lower_stop_time", "upper_stop_time", "lower_slow_time",
                   "upper_slow_time", "max_fextra_x", "max_fextra_time",
@@ -113,11 +134,14 @@ SUMMARY_KEYS: dict[str, tuple[str, ...]] = {
     "single_layer": (*_COMMON_KEYS, "slow_time"),
 }
 """Keys of :func:`summarize` per model with the fv-split solver (other py-pde solvers
-give the common keys; stop times are then None)."""
+give the common keys; stop times are then None). ``domain_ends`` (a table) and
+``warnings`` (a list) are not numbers: a study records them as JSON text."""
 
 
-def summarize(res: RunResult, mass0: float, wall: float) -> dict[str, Any]:
-    """The per-model summary written to the JSON summary file."""
+def summarize(res: RunResult, mass0: float, wall: float,
+              initial: np.ndarray | None = None) -> dict[str, Any]:
+    """The per-model summary written to the JSON summary file; ``initial`` (the initial
+    state data) lets it tell where material reached an end of the domain."""
     case = res.case
     dx = case.dx
     d = res.state.data
@@ -135,6 +159,7 @@ def summarize(res: RunResult, mass0: float, wall: float) -> dict[str, Any]:
         "runout": (front - case.x_start - case.L0) if (front is not None and case.L0)
         else None,
         "mass_relative_error": abs(mass(d, dx, r) - mass0) / mass0 if mass0 else 0.0,
+        "mass_change": (mass(d, dx, r) - mass0) / mass0 if mass0 else 0.0,
         "steps": int(res.info.get("solver", {}).get("steps", 0)),
         "wall_time_s": wall,
         "stop_reason": res.info.get("controller", {}).get("stop_reason"),
@@ -170,4 +195,8 @@ def summarize(res: RunResult, mass0: float, wall: float) -> dict[str, Any]:
             })
     else:
         out.update({"stop_time": None, "max_fextra_over_rho1": None})
+    if initial is not None:
+        out["domain_ends"] = domain_ends(case, initial, d, out["mass_change"])
+        out["runout_lower_bound"] = out["domain_ends"]["runout_lower_bound"]
+    out["warnings"] = result_warnings(case, res.model, out)
     return out

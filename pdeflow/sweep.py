@@ -15,14 +15,15 @@ of Lacaze et al. (2008) gives the exponent 0.83 +- 0.03.
 
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .cases import Case, load_case
-from .simulate import run_model
+from .cases import Case, CaseError, load_case
+from .simulate import load_case_kernels, run_model
 
 PAPER_FITS = {"single_layer": (2.25, 1.06), "two_layer": (1.61, 0.84)}
 DEM_EXPONENT = 0.83
@@ -39,16 +40,29 @@ def fit_power_law(a: np.ndarray, r: np.ndarray) -> tuple[float, float]:
     return float(np.exp(logp)), float(e)
 
 
+def sweep_ratios(case: Case) -> list[float]:
+    """The case's ``sweep.aspect_ratios``; CaseError if it has none or no column."""
+    ratios = case.data.get("sweep", {}).get("aspect_ratios", [])
+    if not ratios:
+        raise CaseError(f"{case.source}: a sweep needs a [sweep] section with "
+                        "aspect_ratios = [a, ...] (a = H0/L0 > 0), as in "
+                        "cases/collapse_sweep.toml, or --set 'sweep.aspect_ratios=[2, 4]'")
+    if any(isinstance(a, bool) or not isinstance(a, (int, float)) or not a > 0
+           for a in ratios):
+        raise CaseError(f"{case.source}: sweep.aspect_ratios must be numbers > 0, got "
+                        f"{ratios!r}")
+    if case.L0 is None:
+        raise CaseError(f"{case.source}: a sweep needs initial.L0 (shape = 'column')")
+    return [float(a) for a in ratios]
+
+
 def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
               models: list[str] | None = None) -> dict[str, Any]:
     """Run every model at every aspect ratio; return the sweep summary."""
-    ratios = aspect_ratios or [float(a) for a in case.data.get("sweep", {}).get(
-        "aspect_ratios", [])]
-    if not ratios:
-        raise ValueError(f"{case.source}: sweep.aspect_ratios is empty")
+    ratios = aspect_ratios or sweep_ratios(case)
     L0 = case.L0
     if L0 is None:
-        raise ValueError(f"{case.source}: a sweep needs initial.L0 (a column)")
+        raise CaseError(f"{case.source}: a sweep needs initial.L0 (shape = 'column')")
     models = models or case.models
     out: dict[str, Any] = {"case": case.name, "L0": L0, "dx": case.dx,
                            "front_threshold": case.front_threshold, "models": {}}
@@ -85,18 +99,20 @@ def sweep_figure(summary: dict[str, Any], path: str | Path) -> Path:
     """Log-log plot of r against a with the fits, the paper's fits and the DEM slope."""
     import matplotlib.pyplot as plt
 
-    from .plotting import save
+    from .plotting import ASPECT_TICKS, log_ticks, save
 
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
     styles = {"single_layer": ("k", "o", "single layer"),
               "two_layer": ("tab:orange", "s", "two layers")}
     amin, amax = np.inf, 0.0
+    rs: list[float] = []
     for model, res in summary["models"].items():
         color, marker, label = styles[model]
         pts = np.array([p for p in res["points"] if p[1]], dtype=float)
         if pts.size == 0:
             continue
         amin, amax = min(amin, pts[:, 0].min()), max(amax, pts[:, 0].max())
+        rs.extend(pts[:, 1])
         ax.loglog(pts[:, 0], pts[:, 1], marker, color=color, label=f"{label}")
         aa = np.geomspace(pts[:, 0].min(), pts[:, 0].max(), 50)
         if res["prefactor"]:
@@ -110,6 +126,10 @@ def sweep_figure(summary: dict[str, Any], path: str | Path) -> Path:
         anchor = (two.get("prefactor") or 1.0) * amin ** (two.get("exponent") or DEM_EXPONENT)
         ax.loglog(aa, anchor * (aa / amin) ** DEM_EXPONENT, "--", color="gray", lw=1,
                   label=f"DEM slope a^{DEM_EXPONENT} (Lacaze et al.)")
+    if amax > 0:
+        log_ticks(ax.xaxis, [a for a in ASPECT_TICKS if amin <= a <= amax] or [amin, amax])
+        decades = 10.0 ** np.arange(np.floor(np.log10(min(rs))), np.log10(max(rs)) + 1)
+        log_ticks(ax.yaxis, [m * d for d in decades for m in (1, 2, 5)])
     ax.set_xlabel("aspect ratio a = H0/L0")
     ax.set_ylabel("normalised run-out r = (R - L0)/L0")
     ax.legend(fontsize=7)
@@ -143,9 +163,14 @@ def add_arguments(ap: Any) -> None:
 
 def cmd_sweep(args: Any, write_json: Any = None) -> int:
     """Run the sweep described by parsed ``args``; print the fits."""
-    if write_json is None:
-        from .io import write_json
+    from . import io
+
+    write_json = write_json or io.write_json
+    io.check_output(args.summary, "--summary")
+    io.check_output(args.plot, "--plot")
     case = load_case(args.case, args.set)
+    sweep_ratios(case)  # before any run
+    load_case_kernels(case, None if args.quiet else sys.stderr)
     summary = run_sweep(case)
     if args.summary:
         write_json(args.summary, summary)
@@ -163,6 +188,4 @@ def cmd_sweep(args: Any, write_json: Any = None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    import sys
-
     sys.exit(main())

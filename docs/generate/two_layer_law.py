@@ -34,11 +34,10 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.ticker import FixedLocator, NullFormatter, ScalarFormatter  # noqa: E402
 
 from pdeflow.cases import load_case  # noqa: E402
 from pdeflow.io import atomic_path  # noqa: E402
-from pdeflow.plotting import save  # noqa: E402
+from pdeflow.plotting import ASPECT_TICKS, log_ticks, save  # noqa: E402
 from pdeflow.simulate import run_model  # noqa: E402
 from pdeflow.sweep import run_sweep  # noqa: E402
 
@@ -361,10 +360,8 @@ def figure_laws(curves: dict, path: Path) -> None:
         ax.plot(pa, pr, "o-", ms=4, label=label)
     ax.set_xscale("log")
     ax.set_yscale("log")
-    for axis, ticks in ((ax.xaxis, [2, 4, 8, 16, 30]), (ax.yaxis, [2, 5, 10, 20, 50])):
-        axis.set_major_locator(FixedLocator(ticks))
-        axis.set_major_formatter(ScalarFormatter())
-        axis.set_minor_formatter(NullFormatter())
+    log_ticks(ax.xaxis, ASPECT_TICKS)
+    log_ticks(ax.yaxis, [2, 5, 10, 20, 50])
     ax.set_xlabel("a = H0 / L0")
     ax.set_ylabel("r = (R - L0) / L0")
     ax.legend(fontsize=6.5, loc="upper left")
@@ -391,9 +388,7 @@ def figure_convergence(conv: dict, map_rows: list[dict], path: Path) -> None:
     ax.axhspan(TARGET_E - TOL_E, TARGET_E + TOL_E, color="0.85", label="0.84 +- 0.05")
     ax.axhline(1.06, color="0.5", ls="--", lw=1, label="paper, one layer: 1.06")
     ax.set_xscale("log")
-    ax.xaxis.set_major_locator(FixedLocator([0.01, 0.005, 0.0025, 0.00125, REFINE_DX]))
-    ax.xaxis.set_major_formatter(ScalarFormatter())
-    ax.xaxis.set_minor_formatter(NullFormatter())
+    log_ticks(ax.xaxis, [0.01, 0.005, 0.0025, 0.00125, REFINE_DX])
     ax.set_xlabel("dx [m]")
     ax.set_ylabel("5.2 exponent")
     ax.invert_xaxis()

@@ -4,9 +4,12 @@
 successive halvings of dx and reports, per level, the quantities of interest (QoIs):
 upper-layer volume V1(t) at fixed times, the lower and upper stop times (exactly u = 0,
 and |u| < 1 cm/s where h > 1 mm), the run-out, and the largest F_extra/rho1 with where
-and when it occurred. For every QoI it gives the change between the two finest grids and,
-with three or more levels, the observed order p = log2(|Q_h - Q_h/2| / |Q_h/2 - Q_h/4|)
-and the Richardson estimate Q_h/4 + (Q_h/4 - Q_h/2)/(2^p - 1) where p > 0.
+and when it occurred. For every QoI it gives the relative change between the two finest
+grids and, with three or more levels, the observed order
+p = log2(|Q_h - Q_h/2| / |Q_h/2 - Q_h/4|) and the Richardson estimate
+Q_h/4 + (Q_h/4 - Q_h/2)/(2^p - 1) where the last three values are monotone, p > 0, and
+the estimate keeps their sign (:func:`richardson`). It prints stop times, run-out,
+F_extra and wall time; ``--all`` every quantity, ``--summary`` writes all as JSON.
 
 For sweep cases (with a ``[sweep]`` section) it refines the sweep and reports the
 fitted run-out prefactor and exponent per level.
@@ -20,14 +23,16 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..cases import Case, load_case
-from ..simulate import run_model
+from ..cases import Case, CaseError, load_case
+from ..simulate import load_case_kernels, run_model
 
 QOI_KEYS = ("lower_stop_time", "upper_stop_time", "lower_slow_time", "upper_slow_time",
             "stop_time", "runout", "max_fextra_over_rho1")
@@ -78,21 +83,37 @@ def converge(case: Case, levels: int, model: str = "two_layer",
 
 
 def richardson(values: list[float | None]) -> dict[str, float | None]:
-    """Change between the finest two values, observed order and extrapolation."""
+    """Change between the finest two values, observed order and extrapolation.
+
+    The relative change is |Q_h/4 - Q_h/2| / |Q_h/4|: None where the finest value is 0
+    and the one before is not (no relative change of a zero), 0 where both are 0. The
+    order p = log2(|Q_h - Q_h/2| / |Q_h/2 - Q_h/4|) needs three values; the Richardson
+    estimate Q_h/4 + (Q_h/4 - Q_h/2)/(2^p - 1) is given only where the last three
+    values are monotone, p > 0, and the estimate keeps the sign of the values (stop
+    times, run-outs and volumes are not negative): elsewhere the sequence is not in its
+    asymptotic range and an extrapolation would mislead.
+    """
     out: dict[str, float | None] = {"finest": values[-1], "relative_change": None,
                                     "order": None, "extrapolated": None}
     v = values
     if len(v) >= 2 and v[-1] is not None and v[-2] is not None:
-        scale = max(abs(v[-1]), 1e-12)
-        out["relative_change"] = abs(v[-1] - v[-2]) / scale
+        change = abs(v[-1] - v[-2])
+        if v[-1] != 0:
+            out["relative_change"] = change / abs(v[-1])
+        elif change == 0:
+            out["relative_change"] = 0.0
     if len(v) >= 3 and None not in v[-3:]:
-        d1 = abs(v[-2] - v[-3])
-        d2 = abs(v[-1] - v[-2])
-        if d1 > 0 and d2 > 0:
-            p = math.log2(d1 / d2)
+        d1 = v[-2] - v[-3]
+        d2 = v[-1] - v[-2]
+        if d1 != 0 and d2 != 0:
+            p = math.log2(abs(d1) / abs(d2))
             out["order"] = p
-            if p > 0:
-                out["extrapolated"] = v[-1] + (v[-1] - v[-2]) / (2**p - 1)
+            if p > 0 and d1 * d2 > 0:  # converging and monotone
+                estimate = v[-1] + d2 / (2**p - 1)
+                lo, hi = min(v[-3:]), max(v[-3:])
+                if (lo < 0 < hi or (lo >= 0 and estimate >= 0)
+                        or (hi <= 0 and estimate <= 0)):
+                    out["extrapolated"] = estimate
     return out
 
 
@@ -122,11 +143,31 @@ def _fmt(v: Any) -> str:
     return str(v)
 
 
-def table(result: dict[str, Any], keys: list[str] | None = None) -> str:
+#: units of the quantities, for table headers
+UNITS = {"dx": "m", "wall_time_s": "s", "runout": "m", "max_fextra_over_rho1": "m^2/s^2",
+         "max_fextra_x": "m", "max_fextra_time": "s"}
+#: the columns ``pdeflow converge`` prints by default (``--all``: every quantity)
+SHORT_VIEW = ("dx", "cells", "stop_time", "lower_stop_time", "upper_stop_time", "runout",
+              "max_fextra_over_rho1", "wall_time_s")
+SWEEP_VIEW = ("dx", "prefactor", "exponent", "all_at_rest", "wall_time_s")
+
+
+def header(key: str) -> str:
+    """A column header with its unit: 'runout [m]', 'stop_time [s]', 'V1(0.1) [m^2]'."""
+    unit = UNITS.get(key)
+    if unit is None and (key == "stop_time" or key.endswith(("_stop_time", "_slow_time"))):
+        unit = "s"
+    if unit is None and key.startswith("V1("):
+        unit = "m^2"
+    name = "wall_time" if key == "wall_time_s" else key
+    return f"{name} [{unit}]" if unit else name
+
+
+def table(result: dict[str, Any], keys: Sequence[str] | None = None) -> str:
     """Markdown table: one row per level, then the change/order/extrapolation rows."""
     rows = result["levels"]
-    keys = keys or [k for k in rows[0] if k != "points"]
-    lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
+    keys = list(keys or [k for k in rows[0] if k != "points"])
+    lines = ["| " + " | ".join(header(k) for k in keys) + " |", "|" + "---|" * len(keys)]
     for r in rows:
         lines.append("| " + " | ".join(_fmt(r.get(k)) for k in keys) + " |")
     ana = result["analysis"]
@@ -294,8 +335,7 @@ def report(out_dir: str | Path, levels_51: int = 5, levels_52: int = 4,
                   table(res, ["dx", "cells", "steps", "stop_time", "runout"]), ""]
     for name, res in r52.items():
         lines += [f"## Test 5.2 run-out fit, {name}", "",
-                  table(res, ["dx", "prefactor", "exponent", "all_at_rest",
-                              "wall_time_s"]), ""]
+                  table(res, SWEEP_VIEW), ""]
     path = out_dir / "convergence.md"
     from ..io import atomic_path
 
@@ -311,27 +351,38 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="override a case value (repeatable)")
     ap.add_argument("--model", default="two_layer", choices=["two_layer", "single_layer"])
     ap.add_argument("--summary", metavar="OUT.json", help="write the results as JSON")
+    ap.add_argument("--all", action="store_true",
+                    help="print every quantity (default: stop times, run-out, F_extra, "
+                    "wall time)")
     ap.add_argument("--report", metavar="DIR",
                     help="regenerate DIR/convergence.md (paper vs relaxed closure)")
 
 
 def cmd_converge(args: argparse.Namespace) -> int:
-    from ..io import write_json
+    from ..io import check_output, write_json
 
     if args.report:
         print(f"wrote {report(args.report)}")
         return 0
     if not args.case:
-        raise SystemExit("pdeflow converge: a case file (or --report DIR) is required")
-    case = load_case(args.case, args.set)
+        raise CaseError("pdeflow converge: a case file (or --report DIR) is required")
     if args.levels < 2:
-        raise SystemExit("pdeflow converge: --levels must be at least 2")
+        raise CaseError(f"--levels must be an integer >= 2 (the number of grids), got "
+                        f"{args.levels}")
+    check_output(args.summary, "--summary")
+    case = load_case(args.case, args.set)
+    load_case_kernels(case, sys.stderr)
     if case.data.get("sweep"):
         res = converge_sweep(case, args.levels, args.model)
-        print(table(res, ["dx", "prefactor", "exponent", "all_at_rest", "wall_time_s"]))
+        print(table(res, SWEEP_VIEW))
     else:
         res = converge(case, args.levels, args.model)
-        print(table(res))
+        keys = None if args.all else [k for k in SHORT_VIEW if k in res["levels"][0]
+                                      and any(r[k] is not None for r in res["levels"])]
+        print(table(res, keys))
+        if not args.all:
+            print("(--all: every quantity, with the upper-layer volumes V1(t); "
+                  "--summary OUT.json: all of it as JSON)")
     if args.summary:
         write_json(args.summary, res)
     return 0
@@ -345,6 +396,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    import sys
-
     sys.exit(main())

@@ -659,11 +659,16 @@ def _grid_value(text: str) -> float | int:
     return float(text)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(prog: str = "python -m pdeflow.analysis.workprecision"
+                 ) -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
-        prog="python -m pdeflow.analysis.workprecision",
-        description="Work-precision study: every variant on a grid sequence against an "
-                    "exact solution or a fine-grid reference (error vs wall time).")
+        prog=prog,
+        description="Work-precision study: runs every numerical variant (flux, "
+                    "reconstruction, splitting, or a py-pde solver) on a sequence of grids "
+                    "and measures its error against an exact solution or a fine-grid "
+                    "reference, and its wall time; writes the error-against-wall-time "
+                    "diagram (PNG) and table (JSON, Markdown). To compare stored runs "
+                    "with each other, use `pdeflow plot RUN.h5 RUN.h5`.")
     p.add_argument("cases", nargs="+", help="case TOML files or built-in names "
                    f"({', '.join(BUILTIN_CASES)})")
     p.add_argument("--variants", nargs="+", default=None,
@@ -692,9 +697,10 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Command-line entry point; returns the exit status."""
-    args = build_parser().parse_args(argv)
+def main(argv: list[str] | None = None,
+         prog: str = "python -m pdeflow.analysis.workprecision") -> int:
+    """Command-line entry point (``prog`` names it in the help); returns the exit status."""
+    args = build_parser(prog).parse_args(argv)
     log = None if args.quiet else sys.stderr
     try:
         for case in args.cases:

@@ -51,6 +51,21 @@ def check_range(name: str, value: Any, low: float, high: float, *,
     return v
 
 
+def _named_progress(tracker: Any, t_range: Any) -> Any:
+    """``tracker`` with the trackers named 'progress' (also inside 'auto') replaced by
+    :class:`pdeflow.trackers.live.ProgressBar` at 1/100 of the time range."""
+    names = ["progress", "consistency"] if tracker == "auto" else tracker
+    if isinstance(names, str):
+        names = [names]
+    if not isinstance(names, (list, tuple)) or "progress" not in names:
+        return tracker
+    from ..trackers.live import ProgressBar
+
+    t0, t1 = (0.0, t_range) if np.isscalar(t_range) else t_range
+    bar = ProgressBar((float(t1) - float(t0)) / 100)
+    return [bar if t == "progress" else t for t in names]
+
+
 class ParametersBase:
     """Shared behaviour of the parameter dataclasses: validation on construction,
     construction from a mapping that rejects unknown keys by name, and export."""
@@ -130,6 +145,17 @@ class GranularPDE(PDEBase):
     def parameter_array(self) -> np.ndarray:
         """Flat float64 parameter vector read by the kernels (see numerics.layout)."""
         raise NotImplementedError
+
+    # --- solving --------------------------------------------------------------------------
+    def solve(self, state: Any, t_range: Any, dt: float | None = None,
+              tracker: Any = "auto", **kwargs: Any) -> Any:
+        """py-pde's :meth:`~pde.pdes.base.PDEBase.solve`, except that the progress bar
+        asked for by name (``tracker="auto"``, the default, or ``"progress"``) is
+        :class:`pdeflow.trackers.live.ProgressBar`: updated at 1/100 of ``t_range`` in
+        simulation time, it fills up and says so when ``fv-split`` ends a run at rest
+        (py-pde's own bar would stop where the run stopped)."""
+        return super().solve(state, t_range, dt, _named_progress(tracker, t_range),
+                             **kwargs)
 
     # --- states ---------------------------------------------------------------------------
     @staticmethod

@@ -17,6 +17,7 @@ which calls the same source-stage kernel that the hook wraps.
 from __future__ import annotations
 
 import logging
+import time
 import types
 from typing import Any
 
@@ -46,6 +47,55 @@ class _RestProfilerFilter(logging.Filter):
 
 
 logging.getLogger("pde.solvers.controller").addFilter(_RestProfilerFilter())
+
+
+def kernels_ready() -> bool:
+    """True if the ``fv-split`` stepping kernel is compiled (or loaded) in this process
+    (always with NUMBA_DISABLE_JIT=1: nothing to compile)."""
+    signatures = getattr(advance_split, "signatures", None)
+    return True if signatures is None else bool(signatures)
+
+
+def kernels_cached() -> bool:
+    """True if numba's disk cache holds the stepping kernel for this machine's CPU, so
+    that loading it takes a fraction of a second instead of compiling it (about 26 s
+    here: see docs/user_guide.md). Reads numba's cache index; False if it cannot."""
+    try:
+        index = advance_split._cache._cache_file._load_index()  # {} if source changed
+        magic = advance_split.targetctx.codegen().magic_tuple()
+    except Exception:  # pragma: no cover - numba internals moved: assume the worst
+        return False
+    return any(key[1] == magic for key in index)
+
+
+def load_kernels(log: Any = None) -> float:
+    """Compile the ``fv-split`` kernels (or load them from numba's disk cache) now, with
+    a run on four cells, so that this time is not booked on a real run's wall time or
+    progress bar. Returns the seconds it took (0 if they were already loaded).
+
+    Args:
+        log: a stream (e.g. ``sys.stderr``) that is told when the kernels have to be
+            compiled (once per machine) and how long it took; None: silent.
+    """
+    if kernels_ready():
+        return 0.0
+    from pde import CartesianGrid
+
+    from ..models import SingleLayerGranular
+
+    compiling = not kernels_cached()
+    if compiling and log is not None:
+        print("pdeflow: compiling numba kernels (once per machine) ...", end="",
+              file=log, flush=True)
+    t0 = time.perf_counter()
+    eq = SingleLayerGranular()
+    state = eq.make_state(CartesianGrid([[0, 1]], 4), h=np.array([1.0, 1.0, 0.0, 0.0]),
+                          u=np.zeros(4))
+    eq.solve(state, t_range=1e-3, solver="fv-split", tracker=None)
+    seconds = time.perf_counter() - t0
+    if compiling and log is not None:
+        print(f" done in {seconds:.1f} s", file=log, flush=True)
+    return seconds
 
 
 class SimulationBlowUp(FloatingPointError):

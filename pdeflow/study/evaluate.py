@@ -10,6 +10,7 @@ must not end a study of thousands.
 from __future__ import annotations
 
 import importlib
+import json
 import math
 import time
 from typing import Any
@@ -48,11 +49,14 @@ def _quantities(spec: StudySpec, point: dict[str, Any]) -> dict[str, Any]:
 
 
 def _number(v: Any) -> Any:
-    """Plain Python scalars for the table (bools as 0/1, None stays missing)."""
+    """Plain Python scalars for the table (bools as 0/1, None stays missing, tables and
+    lists as JSON text)."""
     if isinstance(v, bool):
         return int(v)
     if v is None or isinstance(v, (int, float, str)):
         return v
+    if isinstance(v, (dict, list, tuple)):
+        return json.dumps(v)
     return float(v)
 
 

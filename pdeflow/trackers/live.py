@@ -43,6 +43,8 @@ from pde.trackers.base import InfoDict, TrackerBase
 from ..plotting import RunFigure, Series
 from ..storage import PendingFile, fextra_over_rho1, model_of, show_final_state
 
+#: movie containers written with H.264 through ffmpeg (WebM cannot hold H.264)
+FFMPEG_SUFFIXES = (".mp4", ".m4v", ".mov", ".mkv", ".avi")
 #: matplotlib backends that cannot show a window
 HEADLESS_BACKENDS = ("agg", "pdf", "ps", "svg", "pgf", "cairo", "template")
 
@@ -82,13 +84,14 @@ def check_movie_path(path: str | Path) -> str:
     suffix = Path(path).suffix.lower()
     if suffix == ".gif":
         return "pillow"
-    if suffix in (".mp4", ".m4v", ".mov", ".mkv", ".webm", ".avi"):
+    if suffix in FFMPEG_SUFFIXES:
         if ffmpeg_path() is None:
             raise MovieError(f"{path}: writing {suffix} movies needs ffmpeg: "
                              "pip install 'pdeflow[movie]' (imageio-ffmpeg), or write "
                              "a .gif instead")
         return "ffmpeg"
-    raise MovieError(f"{path}: unknown movie format {suffix!r}; use .mp4 or .gif")
+    raise MovieError(f"{path}: unknown movie format {suffix!r}; use "
+                     f"{', '.join(FFMPEG_SUFFIXES)} (H.264 through ffmpeg) or .gif")
 
 
 class MovieFile:
@@ -250,6 +253,11 @@ class ProgressBar(ProgressTracker):
     result does not depend on the wall clock), which says "at rest" and fills up when
     the ``fv-split`` solver ends a run at rest before t_end.
 
+    While the ``fv-split`` kernels are compiled (the first run on a machine) or loaded
+    (the first run in a process), the bar says so; its clock and its estimate of the
+    remaining time start once the first interval has been computed, so the estimate is
+    simulated time per wall time of the run itself.
+
     Args:
         interrupts: simulation time between updates [s] (or anything py-pde accepts).
         label: text in front of the bar (e.g. the model).
@@ -258,11 +266,35 @@ class ProgressBar(ProgressTracker):
     def __init__(self, interrupts: Any = 0.05, *, label: str = "", **kwargs: Any):
         super().__init__(interrupts=interrupts, **kwargs)
         self.label = label
+        self._clock_started = False
+
+    def initialize(self, field: Any, info: InfoDict | None = None) -> float:
+        result = super().initialize(field, info)
+        self._clock_started = False
+        solver = (info or {}).get("solver", {}).get("class")
+        waiting = ""
+        if solver == "FVSplitSolver":
+            from ..solvers.fv_split import kernels_cached, kernels_ready
+
+            if not kernels_ready():
+                waiting = ("compiling kernels (once per machine)" if not kernels_cached()
+                           else "loading compiled kernels")
+        self._waiting = ": ".join(p for p in (self.label, waiting) if p)
+        self.progress_bar.set_description(self._waiting)
+        return result
 
     def handle(self, field: Any, t: float) -> None:
         super().handle(field, t)
-        self.progress_bar.set_description(self.label)
-        self.progress_bar.set_postfix_str(f"t = {t:.4g} s", refresh=False)
+        bar = self.progress_bar
+        if not self._clock_started and t > bar.initial:
+            if self._waiting != self.label:
+                # the first interval held the compilation: restart the clock here, so
+                # that the remaining time is estimated from the run alone
+                bar.start_t = bar.last_print_t = bar._time()
+                bar.initial = bar.n
+            self._clock_started = True
+        bar.set_description(self.label if self._clock_started else self._waiting)
+        bar.set_postfix_str(f"t = {t:.4g} s", refresh=False)
 
     def finalize(self, info: InfoDict | None = None) -> None:
         TrackerBase.finalize(self, info)

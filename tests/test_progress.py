@@ -1,0 +1,96 @@
+"""Progress while kernels compile and runs go (issue 14, part C): the first run says that
+it compiles, the estimate of the remaining time leaves the compilation out, and the bar
+of a plain ``eq.solve`` (the README's snippet) ends at rest."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+import pytest
+from pde import CartesianGrid
+from pde.trackers.base import TrackerBase
+
+import pdeflow
+from pdeflow.solvers import fv_split
+from pdeflow.trackers.live import ProgressBar
+
+ROOT = Path(__file__).parents[1]
+
+
+def _readme_state():
+    grid = CartesianGrid([[0, 7]], 140)
+    x = grid.axes_coords[0]
+    eq = pdeflow.TwoLayerGranular(bc=("wall", "open"))
+    h2 = np.clip((1 - x) * np.tan(np.radians(60)), 0, 2.0)
+    return eq, eq.make_state(grid, h1=np.where(x < 1, 2 - h2, 0), h2=h2)
+
+
+def test_readme_snippet_progress_bar_ends_at_rest(capsys):
+    """``eq.solve`` with its default trackers: pdeflow's bar, filled when the run stops
+    at rest at 1.36 s of t_range = 5 s (py-pde's own bar stayed at 27 %)."""
+    eq, state = _readme_state()
+    eq.solve(state, t_range=5, solver="fv-split", cfl=0.3)
+    last = capsys.readouterr().err.replace("\r", "\n").strip().splitlines()[-1]
+    assert last.lstrip().startswith("100%") and "at rest at t = 1.3" in last, last
+
+
+def test_named_progress_tracker_is_replaced():
+    from pdeflow.models.base import _named_progress
+
+    trackers = _named_progress("auto", (1.0, 3.0))
+    assert isinstance(trackers[0], ProgressBar) and trackers[1] == "consistency"
+    assert trackers[0].interrupt.dt == pytest.approx(0.02)
+    assert _named_progress(None, 5) is None
+    assert _named_progress(["consistency"], 5) == ["consistency"]
+
+
+def test_progress_bar_says_it_compiles_and_restarts_its_clock(monkeypatch, capsys):
+    """While the kernels are compiled the bar says so; its clock starts after the
+    first interval, so the remaining time comes from the run alone."""
+    monkeypatch.setattr(fv_split, "kernels_ready", lambda: False)
+    monkeypatch.setattr(fv_split, "kernels_cached", lambda: False)
+    eq, state = _readme_state()
+    bar = ProgressBar(0.5, label="two_layer")
+    seen = []
+
+    class Spy(TrackerBase):
+        def handle(self, field, t):
+            seen.append((t, bar.progress_bar.desc, bar.progress_bar.start_t,
+                         bar.progress_bar.initial))
+
+    eq.solve(state, t_range=5, solver="fv-split", tracker=[bar, Spy(0.5)])
+    # (tqdm appends ": " to a description)
+    assert seen[0][1].startswith("two_layer: compiling kernels (once per machine)")
+    assert seen[1][0] == pytest.approx(0.5) and seen[1][1].rstrip(": ") == "two_layer"
+    start0, start1 = seen[0][2], seen[1][2]
+    assert start1 > start0 and seen[1][3] == pytest.approx(0.5)  # clock restarted at 0.5 s
+    assert all(s[2] == start1 for s in seen[1:])  # only once
+    assert "at rest" in capsys.readouterr().err
+
+
+def test_cli_says_when_it_compiles(monkeypatch):
+    """``pdeflow run`` compiles (or loads) the kernels before its runs and, when it has
+    to compile them, says so with the time it took."""
+    monkeypatch.setattr(fv_split, "kernels_ready", lambda: False)
+    monkeypatch.setattr(fv_split, "kernels_cached", lambda: False)
+    log = io.StringIO()
+    seconds = fv_split.load_kernels(log)
+    assert seconds > 0
+    text = log.getvalue()
+    assert text.startswith("pdeflow: compiling numba kernels (once per machine) ...")
+    assert f"done in {seconds:.1f} s" in text
+    monkeypatch.setattr(fv_split, "kernels_cached", lambda: True)
+    log = io.StringIO()
+    fv_split.load_kernels(log)
+    assert log.getvalue() == ""  # loading from the disk cache is quick: nothing to say
+
+
+def test_kernels_are_loaded_before_the_wall_time_starts():
+    from pdeflow.cases import load_case
+    from pdeflow.simulate import run_model
+
+    run_model(load_case(ROOT / "cases" / "ritter_dam_break.toml",
+                        ["grid.cells=20", "output.snapshot_times=[]"]), "single_layer")
+    assert fv_split.kernels_ready() and fv_split.kernels_cached()
