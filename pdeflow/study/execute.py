@@ -46,8 +46,8 @@ def _client(workers: int | None, scheduler: str | None) -> tuple[Any, Any, int]:
 
 
 class _Progress:
-    def __init__(self, total: int, show: bool, log: Callable[[str], None]) -> None:
-        self.total, self.show, self.log = total, show, log
+    def __init__(self, total: int, show: bool) -> None:
+        self.total, self.show = total, show
         self.done = self.failed = 0
         self.t0 = time.perf_counter()
 
@@ -88,15 +88,17 @@ def run_study(spec: StudySpec, out: str, *, workers: int | None = None,
     log(f"{spec.name}: {total} evaluations to run ({len(done)} already in {table.csv})")
     t_start = time.perf_counter()
     client, cluster, n_workers = _client(workers, scheduler)
-    client.run(warm, spec)  # every worker loads the kernels once, before the clock
-    t_ready = time.perf_counter()
     log(f"Dask: {n_workers} workers, dashboard {client.dashboard_link}")
     walls: deque[float] = deque(maxlen=200)
-    bar = _Progress(total, progress, log)
+    bar = _Progress(total, progress)
     submitted = 0
     futures: Any = None
+    t_ready = time.perf_counter()
     try:
         from distributed import as_completed
+
+        client.run(warm, spec)  # every worker loads the kernels once, before the clock
+        t_ready = time.perf_counter()
 
         spec_f = client.scatter(spec, broadcast=True)  # shipped once per worker
 
