@@ -377,6 +377,14 @@ def build_parser() -> argparse.ArgumentParser:
                     help="CASE.toml|ritter|mangeney [--variants V ...] [--grids N|DX ...] "
                     "[--reference auto|exact|fine|fine:VARIANT] [--out-dir DIR] ...")
     cp.set_defaults(func=cmd_compare)
+
+    # --- app ------------------------------------------------------------------------------
+    from .app import server as app_server  # panel is imported only when the app runs
+
+    ap = sub.add_parser("app", help="teaching app in the browser (needs panel)",
+                        description=app_server.__doc__, formatter_class=raw)
+    app_server.add_arguments(ap)
+    ap.set_defaults(func=app_server.cmd_app)
     return parser
 
 
