@@ -1,7 +1,8 @@
 """The numba kernels, loaded in the background so that the app can say what it waits for.
 
-pdeflow's kernels are compiled on their first use and cached on disk (about half a minute
-to a few minutes on a fresh machine, a fraction of a second afterwards). The app starts
+pdeflow's kernels are compiled on their first use and cached on disk (about 40 s for the
+app's kernels on the two-core development machine, docs/teaching.md; a fraction of a
+second to load afterwards). The app starts
 :data:`WARMUP` when it is served or displayed; its pages show :meth:`KernelWarmup.message`
 (with the elapsed time) until the kernels are ready, instead of looking frozen.
 """
@@ -100,8 +101,8 @@ class KernelWarmup:
             return f"loading the kernels failed: {self.error}"
         if self.done:
             return f"kernels ready (loaded in {self.elapsed:.1f} s)"
-        return (f"compiling kernels (once per machine; later starts take a second): "
-                f"elapsed {self.elapsed:.0f} s")
+        return (f"compiling kernels (once per machine; later starts load them in under "
+                f"a second): elapsed {self.elapsed:.0f} s")
 
 
 WARMUP = KernelWarmup()

@@ -4,7 +4,7 @@ hyperbolicity) where every slider reruns pdeflow in the server.
 The page opens in the default browser (unless --no-browser) at http://HOST:PORT/;
 ?page=run-out or ?page=hyperbolicity opens another page first. The first start on a
 machine compiles the numerical kernels (the page says so, with the elapsed time); later
-starts take a second. Ctrl-C stops the server.
+starts load them in under a second. Ctrl-C stops the server.
 
 With --host 0.0.0.0 (or the machine's address) students on the same network can open
 the page at http://<teacher's machine>:PORT/; every open page reruns cases on this
