@@ -250,21 +250,21 @@ class DamBreakPage:
         initial = [case.initial_profiles(m) for m in run.results]
         depth = max(float(sum(p[k] for k in p if k.startswith("h")).max()) for p in initial)
         self.fig_h.y_range.start, self.fig_h.y_range.end = -0.02 * depth, 1.1 * depth
-        self._show_frames(run, limits=False)  # velocities: the frames' limits come next
+        # the final state; the player and the velocity limits wait for the frames (each
+        # change of the player would redraw it in the browser twice per move)
+        self.show_frame(len(run.times) - 1)
         self.summary.text = self._summary_html(run)
         self.status.object = ""
 
-    def _show_frames(self, run: DamBreakRun, limits: bool = True) -> None:
-        """The player's range and the last frame; with ``limits`` the velocity and
-        F_extra limits over all frames (fixed, so that the animation does not jitter)."""
+    def _show_frames(self, run: DamBreakRun) -> None:
+        """The player's range, the last frame, and the velocity and F_extra limits over
+        all frames (fixed, so that the animation does not jitter)."""
         last = len(run.times) - 1
         self.player.end = max(last, 1)
         if self.player.value == last:
             self.show_frame(last)
         else:
             self.player.value = last  # the final state, the deposit: watched -> show_frame
-        if not limits:
-            return
         us = [_velocity(s[:, k], s[:, k + 1]) for s in run.states.values()
               for k in range(0, s.shape[1], 2)]
         lo = min(0.0, *(float(np.nanmin(u)) for u in us if np.isfinite(u).any()))
