@@ -45,7 +45,7 @@ def app_server(root: Path, *, timeout: float = 60.0, env: dict[str, str] | None 
     full_env = dict(os.environ, **(env or {}))
     full_env["PYTHONPATH"] = os.pathsep.join(
         p for p in (str(root), full_env.get("PYTHONPATH", "")) if p)
-    err = open(log, "w") if log else subprocess.DEVNULL  # noqa: SIM115 - closed below
+    err = open(log, "w") if log else subprocess.DEVNULL  # closed in the finally below
     proc = subprocess.Popen(
         [sys.executable, "-m", "pdeflow.cli", "app", "--no-browser", "--host",
          "127.0.0.1", "--port", "0"], cwd=root, env=full_env, stdout=subprocess.PIPE,
