@@ -436,6 +436,14 @@ def build_parser() -> argparse.ArgumentParser:
                         description=study_cmd.__doc__, formatter_class=raw)
     study_cmd.add_arguments(st)
     st.set_defaults(func=study_cmd.cmd_study)
+
+    # --- app ------------------------------------------------------------------------------
+    from .app import server as app_server  # panel is imported only when the app runs
+
+    ap = sub.add_parser("app", help="teaching app in the browser (needs panel)",
+                        description=app_server.__doc__, formatter_class=raw)
+    app_server.add_arguments(ap)
+    ap.set_defaults(func=app_server.cmd_app)
     return parser
 
 

@@ -28,6 +28,23 @@ from .simulate import load_case_kernels, run_model
 PAPER_FITS = {"single_layer": (2.25, 1.06), "two_layer": (1.61, 0.84)}
 DEM_EXPONENT = 0.83
 
+PUBLISHED_LAWS = {"Lube et al. 2005": (1.8, 2.8), "Lajeunesse et al. 2005": (2.3, 2.3)}
+"""Planar-collapse experiments (REFERENCE section 4): r = 1.2 a below the first a given,
+r = 1.9 a^(2/3) above the second; in between a transition that neither law describes."""
+PUBLISHED_EXPONENTS = {"Balmforth & Kerswell 2005 (wide)": (0.9, 0.1),
+                       "Balmforth & Kerswell 2005 (narrow)": (0.65, None),
+                       "Lacaze et al. 2008 (DEM)": (DEM_EXPONENT, 0.03)}
+"""Laws given as an exponent only, r ~ a^e: name -> (e, its uncertainty or None)."""
+
+
+def published_law(name: str, a: np.ndarray, bridge: bool = False) -> np.ndarray:
+    """r(a) of the law ``name`` of :data:`PUBLISHED_LAWS`: NaN in its transition, or
+    with ``bridge`` the large-a branch there too (one curve to compare a run with)."""
+    a = np.asarray(a, dtype=float)
+    low, high = PUBLISHED_LAWS[name]
+    r = np.where(a < low, 1.2 * a, 1.9 * a ** (2 / 3))
+    return r if bridge else np.where((a >= low) & (a <= high) & (low < high), np.nan, r)
+
 
 def fit_power_law(a: np.ndarray, r: np.ndarray) -> tuple[float, float]:
     """Least-squares fit of log r = log p + e log a; returns (p, e)."""

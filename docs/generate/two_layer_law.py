@@ -29,6 +29,7 @@ import math
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
+from functools import partial
 from pathlib import Path
 
 import matplotlib
@@ -41,7 +42,12 @@ from pdeflow.cases import load_case  # noqa: E402
 from pdeflow.io import atomic_path  # noqa: E402
 from pdeflow.plotting import ASPECT_TICKS, log_ticks, save  # noqa: E402
 from pdeflow.simulate import run_model  # noqa: E402
-from pdeflow.sweep import run_sweep  # noqa: E402
+from pdeflow.sweep import (  # noqa: E402
+    PUBLISHED_EXPONENTS,
+    PUBLISHED_LAWS,
+    published_law,
+    run_sweep,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 CASE_51 = ROOT / "cases" / "paper_5_1_dam_break.toml"
@@ -73,13 +79,8 @@ REFINE_DX = 0.000625
 MUSCL = ["numerics.reconstruction='muscl'", "numerics.limiter='mc'"]
 
 # Published planar-collapse laws, r = (R - L0)/L0 against a = H0/L0 (REFERENCE section 4)
-LAWS = {
-    "Lube et al. 2005": lambda a: np.where(a < 1.8, 1.2 * a, 1.9 * a ** (2 / 3)),
-    "Lajeunesse et al. 2005": lambda a: np.where(a < 2.3, 1.2 * a, 1.9 * a ** (2 / 3)),
-}
-EXPONENTS = {"Balmforth & Kerswell 2005 (wide)": (0.9, 0.1),
-             "Balmforth & Kerswell 2005 (narrow)": (0.65, None),
-             "Lacaze et al. 2008 (DEM)": (0.83, 0.03)}
+LAWS = {name: partial(published_law, name, bridge=True) for name in PUBLISHED_LAWS}
+EXPONENTS = PUBLISHED_EXPONENTS
 
 
 def overrides(params: dict) -> list[str]:

@@ -1,0 +1,297 @@
+"""The case and its parameters as widgets, and the ``--set`` overrides they stand for.
+
+Every page that runs a case (dam break, run-out law) reads its sliders as the overrides
+``section.key=value`` of ``pdeflow run CASE --set ...`` and passes them to
+:func:`pdeflow.cases.load_case`: what a page shows is what the command line (printed
+under it) or the Python API gives for the same overrides. Values are in the units of
+the case files: m, deg, and dimensionless.
+"""
+
+from __future__ import annotations
+
+import math
+import shlex
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+import panel as pn
+
+from ..analysis.workprecision import DEFAULT_VARIANTS, MOL_RK, parse_variant
+from ..cases import Case, CaseError, load_case
+from ..models import SingleLayerParameters, TwoLayerParameters
+
+CLOSURES = ("paper", "relaxed")
+"""The exchange closures offered (a case with another one adds it to the choice)."""
+SCHEMES = tuple(v for v in DEFAULT_VARIANTS if v != MOL_RK)
+"""fv-split variants offered, by the names of ``pdeflow compare`` (FLUX/REC[/LIM][+SPLIT])."""
+MAX_CELLS = 20_000
+"""Larger grids would keep the server busy for seconds per slider move: refused."""
+
+
+class Slider(pn.widgets.FloatSlider):
+    """A float slider whose moves reach the server's callbacks at once.
+
+    Panel waits 50 ms after a widget's first event for more before it runs the callbacks;
+    a slider's release (``value_throttled``) is the last event of a move, so that wait
+    would only add to the time until the new picture."""
+
+    _priority_changes: ClassVar[list[str]] = ["value", "value_throttled"]
+
+
+@dataclass(frozen=True)
+class Knob:
+    """A slider for one or more case keys that always take the same value."""
+
+    name: str
+    """widget name (also its CSS class ``pdeflow-<name>``, used by the browser tests)"""
+    label: str
+    keys: tuple[str, ...]
+    """the case keys it sets, ``section.key``"""
+    start: float
+    end: float
+    step: float
+    models: tuple[str, ...] = ("two_layer",)
+    """the slider is enabled when the case runs one of these models"""
+    column_only: bool = False
+    """only for column cases (H0, L0)"""
+
+
+KNOBS = (
+    Knob("H0", "column height H0 [m]", ("initial.H0",), 0.25, 4.0, 0.05,
+         ("two_layer", "single_layer"), column_only=True),
+    Knob("L0", "column length L0 [m]", ("initial.L0",), 0.25, 2.0, 0.05,
+         ("two_layer", "single_layer"), column_only=True),
+    Knob("slope", "bed slope θ [deg]", ("two_layer.theta_deg", "single_layer.theta_deg"),
+         0.0, 35.0, 1.0, ("two_layer", "single_layer")),
+    Knob("density_ratio", "density ratio r = ρ1/ρ2", ("two_layer.density_ratio",),
+         0.3, 0.95, 0.01),
+    Knob("phi_int", "interface friction φ_int [deg]", ("two_layer.phi_int_deg",),
+         15.0, 45.0, 1.0),
+    Knob("phi_b_two", "basal friction φ_B, two layers [deg]", ("two_layer.phi_b_deg",),
+         20.0, 50.0, 1.0),
+    Knob("phi_b_single", "basal friction φ_B, single layer [deg]",
+         ("single_layer.phi_b_deg",), 15.0, 45.0, 1.0, ("single_layer",)),
+    Knob("k", "friction reduction k", ("two_layer.k",), 0.0, 0.95, 0.05),
+    Knob("c", "collisional coefficient c", ("two_layer.c",), 0.0, 3.0, 0.01),
+)
+
+
+def served() -> bool:
+    """True inside a served session (callbacks can be scheduled on its event loop)."""
+    doc = pn.state.curdoc
+    return doc is not None and doc.session_context is not None
+
+
+def find_case_dir(explicit: str | Path | None = None) -> Path:
+    """The directory of case files: ``explicit``, else ./cases, else the repository's.
+
+    Raises CaseError (one line) if there is none: the case files are not installed with
+    the package, the app runs from a clone (or is given ``--cases DIR``).
+    """
+    if explicit is not None:
+        path = Path(explicit)
+        if not path.is_dir() or not any(path.glob("*.toml")):
+            raise CaseError(f"--cases {path}: not a directory with case files (*.toml)")
+        return path
+    for path in (Path.cwd() / "cases", Path(__file__).resolve().parents[2] / "cases"):
+        if (path / "paper_5_1_dam_break.toml").is_file():
+            return path
+    raise CaseError("no case files found: run pdeflow app in the repository (next to "
+                    "cases/) or give --cases DIR")
+
+
+def list_cases(case_dir: Path, need: Callable[[Case], bool] = lambda c: True
+               ) -> dict[str, Path]:
+    """Case files in ``case_dir`` that load and satisfy ``need``, by file name."""
+    out = {}
+    for path in sorted(case_dir.glob("*.toml")):
+        try:
+            case = load_case(path)
+        except CaseError:
+            continue  # not runnable as it is: not offered
+        if need(case) and case.cells <= MAX_CELLS:
+            out[path.name] = path
+    return out
+
+
+def is_column(case: Case) -> bool:
+    return case.initial.get("shape") == "column"
+
+
+def case_value(case: Case, key: str) -> Any:
+    """The value ``section.key`` has in ``case``, with the models' documented defaults."""
+    section, name = key.split(".", 1)
+    if section == "initial":
+        return case.initial.get(name)
+    if section in ("two_layer", "single_layer"):
+        cls = TwoLayerParameters if section == "two_layer" else SingleLayerParameters
+        return getattr(cls.from_dict(case.data.get(section, {})), name)
+    return case.data.get(section, {}).get(name)
+
+
+def case_scheme(case: Case) -> str:
+    """The case's fv-split variant by its ``pdeflow compare`` name."""
+    name = case.make_pde(case.models[0]).variant
+    return name + ("+strang" if case.splitting == "strang" else "")
+
+
+def toml_value(value: Any) -> str:
+    """``value`` as the right-hand side of an override (floats to 6 digits)."""
+    if isinstance(value, str):
+        return repr(value)
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return str(value)
+
+
+def command_line(case_path: Path, overrides: Sequence[str]) -> str:
+    """The ``pdeflow run`` command that runs the same case with the same overrides."""
+    try:
+        shown = case_path.resolve().relative_to(Path.cwd())
+    except ValueError:
+        shown = case_path
+    args = ["pdeflow", "run", str(shown)]
+    for item in overrides:
+        args += ["--set", item]
+    return " ".join(shlex.quote(a) for a in args)
+
+
+class ParameterControls:
+    """A case selector, the sliders of :data:`KNOBS` and the closure and scheme choices.
+
+    ``on_change()`` is called after the user changed the case, released a slider, or
+    picked a closure or scheme; never while :meth:`set_case` puts a case's own values
+    into the widgets.
+
+    Args:
+        cases: selectable case files by name.
+        default: the name selected first.
+        on_change: called without arguments after a change by the user.
+        knobs: the sliders to show (default: all of :data:`KNOBS`).
+    """
+
+    def __init__(self, cases: dict[str, Path], default: str,
+                 on_change: Callable[[], None], knobs: Sequence[Knob] = KNOBS):
+        self.cases = cases
+        self.on_change = on_change
+        self.knobs = list(knobs)
+        self._quiet = False
+        self.case_select = pn.widgets.Select(label="case file", options=list(cases),
+                                             value=default, css_classes=["pdeflow-case"])
+        self.sliders = {k.name: Slider(
+            label=k.label, start=k.start, end=k.end, step=k.step, value=k.start,
+            css_classes=[f"pdeflow-{k.name}"], sizing_mode="stretch_width")
+            for k in self.knobs}
+        self.closure = pn.widgets.RadioButtonGroup(
+            label="exchange closure", options=list(CLOSURES), value="paper",
+            css_classes=["pdeflow-closure"])
+        self.scheme = pn.widgets.Select(label="scheme (flux/reconstruction[/limiter]"
+                                        "[+splitting])", options=list(SCHEMES),
+                                        value=SCHEMES[0], css_classes=["pdeflow-scheme"])
+        self.case: Case = load_case(cases[default])
+        self.set_case(self.case)
+        self.case_select.param.watch(self._case_changed, "value")
+        for s in self.sliders.values():
+            s.param.watch(self._changed, "value_throttled")
+        self.closure.param.watch(self._changed, "value")
+        self.scheme.param.watch(self._changed, "value")
+
+    # --- the case's own values into the widgets -------------------------------------------
+    def set_case(self, case: Case) -> None:
+        """Show ``case``'s values; enable what applies to its models and shape."""
+        self._quiet = True
+        try:
+            for k in self.knobs:
+                s = self.sliders[k.name]
+                applies = (any(m in case.models for m in k.models)
+                           and (is_column(case) or not k.column_only))
+                s.disabled = not applies
+                keys = _keys_of_case(k, case)
+                value = case_value(case, keys[0]) if applies and keys else None
+                if value is None:
+                    continue
+                value = float(value)
+                if k.column_only:  # around the case's own column, inside its domain
+                    s.start = _round_step(min(k.start, value / 4), k.step)
+                    end = max(k.end, 2 * value)
+                    if k.name == "L0":
+                        end = min(end, case.length / 2)
+                    s.end = _round_step(end, k.step)
+                else:
+                    s.start = min(k.start, value)
+                    s.end = max(k.end, value)
+                s.value = value
+            two = "two_layer" in case.models
+            closure = str(case_value(case, "two_layer.exchange_closure"))
+            self.closure.options = list(dict.fromkeys([*CLOSURES, closure]))
+            self.closure.value = closure
+            self.closure.disabled = not two
+            scheme = case_scheme(case)
+            self.scheme.options = list(dict.fromkeys([*SCHEMES, scheme]))
+            self.scheme.value = scheme
+            self.scheme.disabled = case.solver != "fv-split"
+        finally:
+            self._quiet = False
+
+    # --- the widgets' values as overrides -------------------------------------------------
+    def overrides(self) -> list[str]:
+        """``section.key=value`` for every value that differs from the case's own."""
+        case = self.case
+        out = []
+        for k in self.knobs:
+            s = self.sliders[k.name]
+            if s.disabled:
+                continue
+            for key in _keys_of_case(k, case):
+                own = case_value(case, key)
+                if own is None or not math.isclose(s.value, float(own),
+                                                   abs_tol=k.step / 1000):
+                    out.append(f"{key}={toml_value(float(s.value))}")
+        if not self.closure.disabled and self.closure.value != case_value(
+                case, "two_layer.exchange_closure"):
+            out.append(f"two_layer.exchange_closure={toml_value(self.closure.value)}")
+        if not self.scheme.disabled and self.scheme.value != case_scheme(case):
+            eq = case.make_pde(case.models[0])
+            own = {"flux": eq.flux, "reconstruction": eq.reconstruction,
+                   "limiter": eq.limiter, "splitting": case.splitting}
+            for key, value in parse_variant(self.scheme.value).numerics.items():
+                if own[key] != value:
+                    out.append(f"numerics.{key}={toml_value(value)}")
+        return out
+
+    @property
+    def case_path(self) -> Path:
+        return self.cases[self.case_select.value]
+
+    def load(self, extra: Sequence[str] = ()) -> Case:
+        """The selected case with the widgets' overrides (and ``extra`` ones) applied."""
+        return load_case(self.case_path, [*self.overrides(), *extra])
+
+    # --- events ---------------------------------------------------------------------------
+    def _case_changed(self, event: Any) -> None:
+        self.case = load_case(self.cases[event.new])
+        self.set_case(self.case)
+        self.on_change()
+
+    def _changed(self, event: Any) -> None:
+        if not self._quiet:
+            self.on_change()
+
+    def panel(self, title: str = "parameters") -> pn.Column:
+        """The widgets, for a page's side bar."""
+        return pn.Column(f"### {title}", self.case_select,
+                         *self.sliders.values(), "exchange closure", self.closure,
+                         self.scheme, sizing_mode="stretch_width")
+
+
+def _keys_of_case(knob: Knob, case: Case) -> list[str]:
+    """The knob's keys that ``case`` uses: [initial] and the sections of its models (a
+    single-layer case on a slope must not get the two-layer model's flat bed)."""
+    return [k for k in knob.keys if k.split(".")[0] in ("initial", *case.models)]
+
+
+def _round_step(value: float, step: float) -> float:
+    """``value`` rounded to a whole number of ``step`` (at least one step)."""
+    return max(step, round(value / step) * step)

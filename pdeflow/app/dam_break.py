@@ -1,0 +1,327 @@
+"""Page 1, dam break: sliders for a case's parameters, both models animated, the summary.
+
+Every change runs each model of the case twice with :func:`pdeflow.simulate.run_model`:
+once exactly as ``pdeflow run`` does (the summary table, the same numbers as the command
+line printed under it, and the final state: these go to the browser at once), and then
+once with a :class:`~pdeflow.trackers.SnapshotTracker` that records the frames of the
+animation. The solver lands on every frame time, so those frames come from a run whose
+steps differ a little from the first (by the order of the discretisation error, as any
+tracker's: docs/user_guide.md); the numbers and the last frame never come from it.
+Depths in m, velocities in m/s, F_extra/rho1 in m^2/s^2, times in s.
+"""
+
+from __future__ import annotations
+
+import io
+import time
+from dataclasses import dataclass, field
+from html import escape
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import panel as pn
+import param
+from bokeh.models import ColumnDataSource, Div, Range1d, Span
+from bokeh.plotting import figure
+
+from ..cases import Case, CaseError
+from ..cli import print_summary
+from ..plotting import (
+    DRY,
+    _velocity,  # u = hu/h, NaN (a gap in a line) where dry
+)
+from ..simulate import RunResult, run_model
+from ..solvers.fv_split import SimulationBlowUp
+from ..trackers import SnapshotTracker
+from .controls import ParameterControls, command_line, list_cases, served
+
+FRAMES_PER_T_END = 250
+"""Frame interval of the animation: t_end / this [s] (5.1: 0.02 s, ~70 frames to rest)."""
+COLOURS = {"upper": "#ff7f0e", "lower": "#8c564b", "single": "black", "fextra": "#d62728"}
+"""As the figures of pdeflow.plotting: upper layer orange, lower brown, single layer black."""
+SEND_MS = 40
+"""Time given to the server to send a new picture before it records the frames [ms]
+(the frames' run would otherwise hold the message back until it is done)."""
+LABELS = {"two_layer": "two layers", "single_layer": "single layer"}
+"""The models as the pages name them."""
+
+
+@dataclass
+class DamBreakRun:
+    """One run of every model of a case: summary runs and animation frames."""
+
+    case: Case
+    case_path: Path
+    overrides: list[str]
+    results: dict[str, RunResult]
+    """per model, the run exactly as ``pdeflow run`` makes it (summary, final state)"""
+    times: np.ndarray
+    """frame times [s]: multiples of t_end/FRAMES_PER_T_END, and each model's end
+    (only the ends until :func:`add_frames` has run)"""
+    states: dict[str, np.ndarray] = field(default_factory=dict)
+    """per model, the state at every frame time (frames, fields, cells); a model that
+    has stopped keeps its final state"""
+    fextra: np.ndarray | None = None
+    """F_extra/rho1 of the two-layer run at every frame time (frames, cells)"""
+    wall_time_s: float = 0.0
+    """wall time of the summary's runs of all models [s]"""
+
+    @property
+    def x(self) -> np.ndarray:
+        return next(iter(self.results.values())).x
+
+    @property
+    def summary(self) -> dict[str, Any]:
+        """The case name and the per-model summaries, as in ``pdeflow run --summary``."""
+        return {"case": self.case.name,
+                "models": {m: r.summary for m, r in self.results.items()}}
+
+    def table(self) -> str:
+        """The table ``pdeflow run`` prints for the same case and overrides."""
+        out = io.StringIO()
+        print_summary(self.summary, out)
+        return out.getvalue()
+
+
+def _frames(case: Case, model: str) -> list[tuple[float, np.ndarray, np.ndarray]]:
+    """(t, state, F_extra/rho1) every t_end/FRAMES_PER_T_END s, from a run of its own."""
+    c = case.copy()
+    c.data.setdefault("output", {})["snapshot_times"] = []
+    c.validate()
+    snaps = SnapshotTracker(case.t_end / FRAMES_PER_T_END)
+    run_model(c, model, tracker=snaps)
+    return [(t, d, f) for t, (d, f) in sorted(snaps.snapshots.items())]
+
+
+def simulate(case: Case, case_path: Path, overrides: list[str],
+             frames: bool = True) -> DamBreakRun:
+    """Run every model of ``case`` (loaded with ``overrides``) as ``pdeflow run`` does;
+    with ``frames`` also record the animation (:func:`add_frames`)."""
+    wall0 = time.perf_counter()
+    results = {m: run_model(case, m) for m in case.models}
+    run = DamBreakRun(case, case_path, list(overrides), results, np.zeros(0))
+    _set_frames(run, {m: [] for m in results})
+    run.wall_time_s = time.perf_counter() - wall0
+    if frames:
+        add_frames(run)
+    return run
+
+
+def add_frames(run: DamBreakRun) -> None:
+    """Record the animation of ``run``: the frames of a second run of every model before
+    its end, and the final state of the summary's run (so the last frame, the deposit,
+    is the one the numbers describe)."""
+    _set_frames(run, {m: _frames(run.case, m) for m in run.results})
+
+
+def _set_frames(run: DamBreakRun,
+                frames: dict[str, list[tuple[float, np.ndarray, np.ndarray]]]) -> None:
+    """Put per-model frames (t, state, F_extra) before each model's end, and its final
+    state, on the common times of ``run``; a model that has stopped keeps its end."""
+    series = {}
+    for m, res in run.results.items():
+        items = [f for f in frames[m] if f[0] < res.t_final - 1e-9]
+        items.append((res.t_final, res.state.data, res.fextra_over_rho1))
+        series[m] = items
+    run.times = np.unique(np.round([f[0] for items in series.values() for f in items], 9))
+    for m, items in series.items():
+        t = np.array([f[0] for f in items])
+        idx = np.clip(np.searchsorted(t, run.times + 1e-9, side="right") - 1, 0, None)
+        run.states[m] = np.array([items[i][1] for i in idx])
+        if m == "two_layer":
+            run.fextra = np.array([items[i][2] for i in idx])
+
+
+class SharedRun(param.Parameterized):
+    """The current dam-break run of a session, for the pages that show it too."""
+
+    run = param.Parameter(default=None, doc="the last DamBreakRun of the dam-break page")
+
+
+class DamBreakPage:
+    """The dam-break page of one session (build it once the kernels are loaded)."""
+
+    def __init__(self, case_dir: Path, shared: SharedRun | None = None,
+                 default: str = "paper_5_1_dam_break.toml"):
+        cases = list_cases(case_dir, lambda c: bool(c.models))
+        self.shared = shared or SharedRun()
+        self.controls = ParameterControls(cases, default if default in cases
+                                          else next(iter(cases)), self.rerun)
+        self.run: DamBreakRun | None = None
+        self.status = pn.pane.HTML("", css_classes=["pdeflow-status"],
+                                   sizing_mode="stretch_width")
+        # a plain Bokeh Div: its text goes out in the same message as the figures' data
+        # (a Panel HTML pane sends its first change separately, later)
+        self.summary = Div(text="", css_classes=["pdeflow-summary"], width=380)
+        self.player = pn.widgets.Player(
+            label="time", start=0, end=1, value=0, interval=60, loop_policy="once",
+            show_loop_controls=False, css_classes=["pdeflow-player"],
+            visible_buttons=["first", "previous", "pause", "play", "next", "last"],
+            sizing_mode="stretch_width")
+        self.player.param.watch(lambda e: self.show_frame(e.new), "value")
+        self._figures()
+        self.rerun()
+
+    # --- figures --------------------------------------------------------------------------
+    def _figures(self) -> None:
+        xr = Range1d(0, 1)  # shared by the panels; set to the domain by each run
+        opts = {"height": 230, "sizing_mode": "stretch_width", "toolbar_location": "right",
+                "tools": "pan,wheel_zoom,box_zoom,reset,save", "x_range": xr}
+        zero = np.zeros(2)
+        self.src_two = ColumnDataSource({k: zero for k in
+                                         ("x", "zero", "h2", "top", "u1", "u2", "f")})
+        self.src_one = ColumnDataSource({k: zero for k in ("x", "h", "u")})
+        fh = figure(title="", y_axis_label="depth normal to bed [m]",
+                    y_range=Range1d(0, 1), **opts)
+        fh.varea("x", "zero", "h2", source=self.src_two, color=COLOURS["lower"],
+                 alpha=0.6, legend_label="lower layer h2")
+        fh.varea("x", "h2", "top", source=self.src_two, color=COLOURS["upper"],
+                 alpha=0.5, legend_label="upper layer h1")
+        fh.line("x", "h", source=self.src_one, color=COLOURS["single"], line_width=2,
+                legend_label="single layer")
+        fu = figure(y_axis_label="velocity [m/s]", y_range=Range1d(0, 1), **opts)
+        fu.line("x", "u1", source=self.src_two, color=COLOURS["upper"], line_width=2,
+                legend_label="u1 (upper)")
+        fu.line("x", "u2", source=self.src_two, color=COLOURS["lower"], line_width=2,
+                line_dash="dashed", legend_label="u2 (lower)")
+        fu.line("x", "u", source=self.src_one, color=COLOURS["single"], line_width=2,
+                legend_label="u single layer")
+        ff = figure(x_axis_label="x [m]", y_axis_label="F_extra/ρ1 [m²/s²]",
+                    y_range=Range1d(0, 1), **opts)
+        ff.line("x", "f", source=self.src_two, color=COLOURS["fextra"], line_width=2,
+                legend_label="momentum exchange keeping the system hyperbolic")
+        for f in (fh, fu, ff):
+            f.legend.location = "top_right"
+            f.legend.label_text_font_size = "9pt"
+            f.legend.click_policy = "hide"
+        self.fronts = {m: Span(location=0, dimension="height", line_dash="dotted",
+                               line_width=2, visible=False,
+                               line_color=COLOURS["upper" if m == "two_layer"
+                                                  else "single"])
+                       for m in ("two_layer", "single_layer")}
+        for s in self.fronts.values():
+            fh.add_layout(s)
+        for f, name in ((fh, "depths"), (fu, "velocities"), (ff, "fextra")):
+            f.css_classes = [f"pdeflow-{name}"]  # for the browser tests
+        self.fig_h, self.fig_u, self.fig_f = fh, fu, ff
+
+    # --- running --------------------------------------------------------------------------
+    def rerun(self) -> None:
+        """Run the case with the sliders' values and show it (errors as one line)."""
+        c = self.controls
+        try:
+            overrides = c.overrides()
+            case = c.load()
+            run = simulate(case, c.case_path, overrides, frames=False)
+        except (CaseError, SimulationBlowUp, ValueError) as err:
+            self.status.object = f"<b>cannot run this:</b> {escape(str(err))}"
+            return
+        with pn.io.hold():
+            self._show_run(run)
+        # the final state and the numbers go out first; the animation's frames (a second
+        # run, a few times slower: it stops at every frame) follow once they are sent
+        if served():
+            pn.state.curdoc.add_timeout_callback(lambda: self._animate(run), SEND_MS)
+        else:
+            self._animate(run)
+
+    def _animate(self, run: DamBreakRun) -> None:
+        if run is not self.run:
+            return  # a newer run replaced it meanwhile
+        try:
+            add_frames(run)
+        except SimulationBlowUp as err:  # the frames' run differs a little
+            self.status.object = f"<b>no animation:</b> {escape(str(err))}"
+            return
+        with pn.io.hold():
+            self._show_frames(run)
+        self.shared.run = run
+
+    def _show_run(self, run: DamBreakRun) -> None:
+        """A new run: its final state, fronts and summary."""
+        self.run = run
+        case = run.case
+        self.fig_h.x_range.start, self.fig_h.x_range.end = case.x_start, case.x_start + case.length
+        for m, span in self.fronts.items():
+            front = run.results[m].summary["front_position"] if m in run.results else None
+            span.visible = front is not None
+            span.location = front or 0.0
+        initial = [case.initial_profiles(m) for m in run.results]
+        depth = max(float(sum(p[k] for k in p if k.startswith("h")).max()) for p in initial)
+        self.fig_h.y_range.start, self.fig_h.y_range.end = -0.02 * depth, 1.1 * depth
+        # the final state; the player and the velocity limits wait for the frames (each
+        # change of the player would redraw it in the browser twice per move)
+        self.show_frame(len(run.times) - 1)
+        self.summary.text = self._summary_html(run)
+        self.status.object = ""
+
+    def _show_frames(self, run: DamBreakRun) -> None:
+        """The player's range, the last frame, and the velocity and F_extra limits over
+        all frames (fixed, so that the animation does not jitter)."""
+        last = len(run.times) - 1
+        self.player.end = max(last, 1)
+        if self.player.value == last:
+            self.show_frame(last)
+        else:
+            self.player.value = last  # the final state, the deposit: watched -> show_frame
+        us = [_velocity(s[:, k], s[:, k + 1]) for s in run.states.values()
+              for k in range(0, s.shape[1], 2)]
+        lo = min(0.0, *(float(np.nanmin(u)) for u in us if np.isfinite(u).any()))
+        hi = max(0.1, *(float(np.nanmax(u)) for u in us if np.isfinite(u).any()))
+        self.fig_u.y_range.start, self.fig_u.y_range.end = lo - 0.05 * (hi - lo), 1.1 * hi
+        fmax = float(run.fextra.max()) if run.fextra is not None else 0.0
+        self.fig_f.y_range.start, self.fig_f.y_range.end = -0.05, 1.1 * max(fmax, 0.1)
+
+    def show_frame(self, i: int) -> None:
+        """Draw frame ``i`` of the current run (both models at one time)."""
+        run = self.run
+        if run is None:
+            return
+        i = int(min(max(i, 0), len(run.times) - 1))
+        x = run.x
+        nan = np.full(x.size, np.nan)
+        two = run.states.get("two_layer")
+        if two is not None:
+            h1, m1, h2, m2 = two[i]
+            self.src_two.data = {"x": x, "zero": np.zeros_like(x), "h2": h2,
+                                 "top": h1 + h2, "u1": _velocity(h1, m1),
+                                 "u2": _velocity(h2, m2), "f": run.fextra[i]}
+        else:
+            self.src_two.data = {"x": x, "zero": nan, "h2": nan, "top": nan, "u1": nan,
+                                 "u2": nan, "f": nan}
+        one = run.states.get("single_layer")
+        if one is not None:
+            h, m = one[i]
+            self.src_one.data = {"x": x, "h": np.where(h > DRY, h, np.nan),
+                                 "u": _velocity(h, m)}
+        else:
+            self.src_one.data = {"x": x, "h": nan, "u": nan}
+        self.fig_h.title.text = (f"{run.case.name}   t = {run.times[i]:.3f} s"
+                                 + ("   (final state)" if i == len(run.times) - 1 else "")
+                                 + "   dotted: the final fronts")
+
+    def _summary_html(self, run: DamBreakRun) -> str:
+        rows = []
+        for m, r in run.results.items():
+            s = r.summary
+            stop = s.get("stop_time")
+            state = (f"at rest at {stop:.3g} s" if stop is not None
+                     else "still moving at t_end")
+            rows.append(f"<li><b>{LABELS[m]}</b>: {state}</li>")
+        return (f"<ul>{''.join(rows)}</ul>"
+                f"<pre class='pdeflow-table'>{escape(run.table())}</pre>"
+                f"<p>The same numbers from the command line:<br>"
+                f"<code class='pdeflow-command'>"
+                f"{escape(command_line(run.case_path, run.overrides))}</code></p>"
+                f"<p style='color:#666'>run-out = front - L0. The runs took "
+                f"{1000 * run.wall_time_s:.0f} ms; the animation's frames before the end "
+                f"come from a second run that stops at every frame time.</p>")
+
+    def panel(self) -> pn.Row:
+        plots = pn.Column(self.status, self.player, pn.pane.Bokeh(self.fig_h),
+                          pn.pane.Bokeh(self.fig_u), pn.pane.Bokeh(self.fig_f),
+                          sizing_mode="stretch_width")
+        return pn.Row(pn.Column(self.controls.panel("dam break"), width=320), plots,
+                      pn.Column("### results", pn.pane.Bokeh(self.summary), width=400),
+                      sizing_mode="stretch_width")

@@ -1,0 +1,249 @@
+"""The teaching app without a browser: its options, and that every page shows what the
+Python API gives for the same case and overrides (the browser tests,
+tests/test_app_browser.py, check the same through Chromium)."""
+
+from __future__ import annotations
+
+import io
+import socket
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pn = pytest.importorskip("panel")  # the app extra (part of the test extra)
+
+from pdeflow.app.controls import KNOBS, command_line, find_case_dir  # noqa: E402
+from pdeflow.app.dam_break import DamBreakPage, SharedRun, simulate  # noqa: E402
+from pdeflow.app.hyperbolicity import (  # noqa: E402
+    G,
+    HyperbolicityPage,
+    band_edges,
+    cell_state,
+    format_eigenvalue,
+)
+from pdeflow.app.kernels import WARMUP, KernelWarmup  # noqa: E402
+from pdeflow.app.runout import RunoutPage, format_r  # noqa: E402
+from pdeflow.cases import load_case  # noqa: E402
+from pdeflow.cli import main, print_summary  # noqa: E402
+from pdeflow.numerics.hyperbolicity import (  # noqa: E402
+    discriminant,
+    eigenvalues,
+    lower_bound_fl,
+    upper_bound_fr,
+)
+from pdeflow.simulate import run_model  # noqa: E402
+from pdeflow.sweep import PUBLISHED_LAWS, published_law, run_sweep  # noqa: E402
+
+ROOT = Path(__file__).parents[1]
+CASES = ROOT / "cases"
+CASE_51 = CASES / "paper_5_1_dam_break.toml"
+
+
+@pytest.fixture(scope="module", autouse=True)
+def kernels() -> None:
+    assert WARMUP.wait(600), "the kernels did not load"
+    assert WARMUP.error is None, WARMUP.error
+
+
+# --- the command ------------------------------------------------------------------------
+@pytest.mark.parametrize("argv, says", [
+    (["--port", "70000"], "--port must lie in [0, 65535]"),
+    (["--cases", "/nonexistent/cases"], "--cases /nonexistent/cases"),
+])
+def test_app_bad_options_are_one_line_errors(argv, says, capsys):
+    assert main(["app", "--no-browser", *argv]) == 2
+    err = capsys.readouterr().err
+    assert says in err and err.count("\n") == 1, err
+
+
+def test_app_refuses_a_port_in_use(capsys):
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        port = s.getsockname()[1]
+        assert main(["app", "--no-browser", "--port", str(port)]) == 2
+    err = capsys.readouterr().err
+    assert f"cannot serve on --host 127.0.0.1 --port {port}" in err
+    assert err.count("\n") == 1
+
+
+def test_case_dir_is_found_from_elsewhere(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # no cases/ here: the repository's
+    assert find_case_dir() == CASES
+
+
+# --- page 1: dam break ------------------------------------------------------------------
+def _api_table(case_file: Path, overrides: list[str]) -> list[str]:
+    """``pdeflow run``'s table of the same case from the Python API, but the wall times."""
+    case = load_case(case_file, overrides)
+    out = io.StringIO()
+    print_summary({"case": case.name,
+                   "models": {m: run_model(case, m).summary for m in case.models}}, out)
+    return [r for r in out.getvalue().splitlines() if not r.startswith("wall time")]
+
+
+def test_dam_break_page_shows_the_api_numbers_for_its_sliders():
+    page = DamBreakPage(CASES)
+    shown = [r for r in page.run.table().splitlines() if not r.startswith("wall time")]
+    assert shown == _api_table(CASE_51, [])
+    sliders = page.controls.sliders
+    sliders["phi_b_two"].value = 35.0
+    sliders["H0"].value = 1.5
+    page.controls.closure.value = "relaxed"  # watched: reruns
+    overrides = page.controls.overrides()
+    assert overrides == ["initial.H0=1.5", "two_layer.phi_b_deg=35",
+                         "two_layer.exchange_closure='relaxed'"]
+    table = [r for r in page.run.table().splitlines() if not r.startswith("wall time")]
+    assert table == _api_table(CASE_51, overrides) != shown
+    assert "--set initial.H0=1.5" in page.summary.text
+    assert command_line(CASE_51, overrides).startswith("pdeflow run ")
+
+
+def test_dam_break_animation_ends_on_the_summarised_state():
+    case = load_case(CASE_51)
+    run = simulate(case, CASE_51, [])
+    assert len(run.times) > 50 and np.all(np.diff(run.times) > 0)
+    for m, res in run.results.items():
+        assert np.array_equal(run.states[m][-1], res.state.data)  # the last frame
+        np.testing.assert_allclose(run.states[m][0], case.make_state(m)[1].data)
+    assert run.fextra.shape == (len(run.times), run.x.size)
+    assert run.fextra.max() > 0
+
+
+def test_scheme_and_case_choices_become_overrides():
+    page = DamBreakPage(CASES)
+    page.controls.scheme.value = "ifcp/muscl/mc+strang"
+    assert page.controls.overrides() == [
+        "numerics.flux='ifcp'", "numerics.reconstruction='muscl'",
+        "numerics.limiter='mc'", "numerics.splitting='strang'"]
+    assert page.run.case.make_pde("two_layer").variant == "ifcp/muscl/mc"
+    page.controls.case_select.value = "ritter_dam_break.toml"  # one model, no column
+    assert page.run.case.models == ["single_layer"]
+    for name in ("H0", "L0", "phi_b_two", "k", "c", "density_ratio"):
+        assert page.controls.sliders[name].disabled, name
+    assert not page.controls.sliders["phi_b_single"].disabled
+    assert page.controls.closure.disabled
+    assert page.controls.overrides() == []
+    assert page.status.object == ""
+    page.controls.case_select.value = "mangeney_dam_break_slope.toml"  # 30 deg, one layer
+    assert page.controls.sliders["slope"].value == 30.0
+    assert page.controls.overrides() == []
+    page.controls.sliders["slope"].value = 25.0
+    assert page.controls.overrides() == ["single_layer.theta_deg=25"]
+
+
+def test_every_knob_names_case_keys():
+    case = load_case(CASE_51)
+    for k in KNOBS:
+        for key in k.keys:
+            load_case(CASE_51, [f"{key}={k.start}"])  # a valid override
+        assert k.start < k.end and k.step > 0
+    assert case.initial["H0"] == 2.0
+
+
+# --- page 2: run-out law ----------------------------------------------------------------
+def test_runout_page_points_and_fit_are_the_sweeps():
+    page = RunoutPage(CASES)  # not served: the whole set at once
+    sweep_case = CASES / "collapse_sweep.toml"
+    ratios = sorted(set(load_case(sweep_case).data["sweep"]["aspect_ratios"]) | {5.0})
+    api = run_sweep(load_case(sweep_case), [float(a) for a in ratios])
+    for model, res in api["models"].items():
+        assert [[a, row["r"]] for a, row in sorted(page.points[model].items())] == \
+            res["points"]
+        p, e = page.fit(model)
+        assert (p, e) == pytest.approx((res["prefactor"], res["exponent"]), rel=1e-12)
+        assert f"r = {format_r(res['points'][ratios.index(5.0)][1])}" in \
+            page.current.object
+    page.add_point(7.5)
+    assert 7.5 in page.points["two_layer"]
+    page.clear.clicks += 1  # clear the set
+    assert page.fit("two_layer") is None and "needs two points" in page.fits.object
+
+
+def test_published_laws_leave_their_transition_open():
+    a = np.array([1.0, 2.0, 2.5, 3.0])
+    lube = published_law("Lube et al. 2005", a)
+    assert lube[0] == pytest.approx(1.2) and np.isnan(lube[1:3]).all()
+    assert lube[3] == pytest.approx(1.9 * 3 ** (2 / 3))
+    assert not np.isnan(published_law("Lube et al. 2005", a, bridge=True)).any()
+    assert not np.isnan(published_law("Lajeunesse et al. 2005", a)).any()
+    assert set(PUBLISHED_LAWS) == {"Lube et al. 2005", "Lajeunesse et al. 2005"}
+
+
+# --- page 3: hyperbolicity --------------------------------------------------------------
+@pytest.mark.parametrize("h1, h2, r", [(0.5, 1.0, 0.67), (1.0, 0.2, 0.3), (0.05, 1.5, 0.9)])
+def test_band_edges_bracket_the_complex_eigenvalues(h1, h2, r):
+    f_c1, f_c2 = band_edges(h1, h2, r)
+    assert lower_bound_fl(h1, h2, G, r) <= f_c1 + 1e-9 < f_c2 <= upper_bound_fr(h1, h2, G, r)
+    for du, complex_pair in ((0.99 * f_c1, False), (0.5 * (f_c1 + f_c2), True),
+                             (1.01 * f_c2, False)):
+        lam = eigenvalues(h1, h2, du, 0.0, G, r)
+        assert (np.abs(lam.imag).max() > 1e-9) == complex_pair, du
+        assert (discriminant(h1, h2, du, 0.0, G, r) < 0) == complex_pair
+
+
+def test_hyperbolicity_page_shows_the_eigenvalues_and_the_run():
+    shared = SharedRun()
+    dam = DamBreakPage(CASES, shared)
+    page = HyperbolicityPage(shared)
+    for z in eigenvalues(0.5, 1.0, 3.0, 0.0, G, 0.67):
+        assert format_eigenvalue(z) in page.text.object
+    assert "not hyperbolic" in page.text.object  # du = 3 m/s lies in the band
+    # the cell where the run needed the largest F_extra: after the restoration its
+    # state lies at the band's lower edge, hyperbolic
+    run = dam.run
+    k, c = page.frame.value, page.cell.value
+    assert run.fextra[k, c] == run.fextra.max() > 0
+    page.take.clicks += 1
+    s = cell_state(run, k, c)
+    assert page.sliders["h1"].value == s["h1"] and page.sliders["du"].value == abs(s["du"])
+    assert "<b style='color:green'>hyperbolic</b>" in page.text.object
+    assert f"{run.results['two_layer'].summary['max_fextra_over_rho1']:.4g}" in \
+        page.cell_text.object
+    # and so in every cell and frame where F_extra acted: |du| at F_c1, from below
+    ratios = []
+    for k, c in zip(*np.nonzero(run.fextra > 0), strict=True):
+        s = cell_state(run, k, c)
+        if min(s["h1"], s["h2"]) > 1e-3:
+            ratios.append(abs(s["du"]) / band_edges(s["h1"], s["h2"], s["r"], s["g"])[0])
+    assert len(ratios) > 100
+    assert 1 - 1e-6 < min(ratios) and max(ratios) <= 1 + 1e-12
+
+
+# --- kernels and Jupyter ----------------------------------------------------------------
+def test_warmup_says_what_it_waits_for_and_why_it_failed():
+    gate = threading.Event()
+    w = KernelWarmup(gate.wait)
+    w.start()
+    assert not w.done and w.message().startswith("compiling kernels (once per machine")
+    assert "elapsed" in w.message()
+    gate.set()
+    assert w.wait(10) and w.error is None and "ready" in w.message()
+
+    def broken() -> None:
+        raise RuntimeError("no compiler")
+
+    w = KernelWarmup(broken)
+    assert w.wait(10)
+    assert w.message() == "loading the kernels failed: RuntimeError: no compiler"
+
+
+def test_create_app_displays_in_jupyter():
+    """One call shows the app in a notebook (the kernel renders Panel's bundle)."""
+    nbformat = pytest.importorskip("nbformat")
+    nbclient = pytest.importorskip("nbclient")
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [nbformat.v4.new_code_cell("from pdeflow.app import create_app\n"
+                                          "create_app()")]
+    client = nbclient.NotebookClient(nb, timeout=600, kernel_name="python3",
+                                     resources={"metadata": {"path": str(ROOT)}})
+    try:
+        client.execute()
+    except nbclient.exceptions.CellExecutionError:
+        raise
+    except Exception as err:  # no kernel here (see tests/test_notebooks.py)
+        pytest.skip(f"no Jupyter kernel can start here: {err!r}")
+    data = [o.get("data", {}) for o in nb.cells[0].outputs]
+    assert any("application/vnd.holoviews_exec.v0+json" in d for d in data), data
