@@ -49,7 +49,7 @@ def _is_sweep(path: Path) -> bool:
 def test_every_case_file_loads_and_is_documented(path):
     assert path.name in (DOCS / "cases.md").read_text(), "docs/cases.md must list it"
     if _is_sweep(path):
-        pytest.skip("not a plain case file (sweep)")
+        pytest.skip("not a plain case file (a sweep or a study file)")
     case = load_case(path)
     for model in case.models:
         eq, state = case.make_state(model)

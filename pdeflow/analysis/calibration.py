@@ -9,15 +9,15 @@ re-runs the best candidates with the paper's closure under perturbed numerics::
     python -m pdeflow.analysis.calibration \
         --results docs/studies/calibration_5_1/results.csv > docs/calibration_5_1.md
 
-``--study-relaxed`` instead runs the recalibration with the relaxed closure
-(docs/calibration_relaxed.md), whose second stage (rerun the best on dx/2, sweep the
-best four) is not a single design.
+``--study-relaxed`` instead gives the recalibration with the relaxed closure
+(docs/calibration_relaxed.md): its stage 1 is the study
+``cases/study_calibration_relaxed.toml``; stages 2-3 (the best sets rerun on dx/2, the
+5.2 sweep of the best four) run here on its table.
 """
 
 from __future__ import annotations
 
 import argparse
-import itertools
 import math
 from pathlib import Path
 from typing import Any
@@ -57,25 +57,26 @@ def robustness(case_path: str | Path, params: dict[str, Any]) -> dict[str, float
     return worst
 
 
-RELAXED_GRID = {"phi_b_deg": [36, 38, 41, 44], "k": [0.3, 0.5, 0.8],
-                "c": [0.01, 0.03, 0.1], "tau_star": [0.1, 0.3, 1.0, 3.0]}
 RELAXED_SCHEME = ["two_layer.exchange_closure='relaxed'", "numerics.reconstruction='muscl'",
                   "numerics.limiter='mc'"]
+RELAXED_RESULTS = "docs/studies/calibration_relaxed/results.csv"
 
 
-def study_relaxed(case_51: str | Path, case_52: str | Path, dx_51: float = 0.00625,
-                  dx_52: float = 0.0025, top: int = 4, check: int = 20,
-                  grid: dict[str, list[float]] = RELAXED_GRID) -> tuple[list[dict], float]:
+def study_relaxed(case_51: str | Path, case_52: str | Path,
+                  results: str | Path = RELAXED_RESULTS, dx_51: float = 0.00625,
+                  dx_52: float = 0.0025, top: int = 4, check: int = 20
+                  ) -> tuple[list[dict], float]:
     """Recalibration with the relaxed closure on converged grids: (rows, best first;
     the single layer's run-out [m] on the same grid and scheme).
 
-    Scores every set of ``grid`` on 5.1 at ``dx_51`` with the relaxed closure and the
-    MUSCL scheme (where run-out and stop times have converged to about 1 % with the
-    default parameters, docs/convergence.md). The ``check`` best are rerun on dx/2:
-    ``change_dx/2`` is the largest relative change of the scored figures, and sets
-    whose figures change by 2 % or more rank after those that converged. The 5.2 sweep
-    at ``dx_52`` runs for the ``top`` best of that ranking.
-    The score differs from :func:`scan` in what does not converge: it uses the
+    Stage 1 is the study ``cases/study_calibration_relaxed.toml`` (``results``: its
+    table): every set on 5.1 at ``dx_51`` with the relaxed closure and the MUSCL scheme
+    (where run-out and stop times have converged to about 1 % with the default
+    parameters, docs/convergence.md). Here the sets are scored, the ``check`` best are
+    rerun on dx/2: ``change_dx/2`` is the largest relative change of the scored figures,
+    and sets whose figures change by 2 % or more rank after those that converged. The
+    5.2 sweep at ``dx_52`` runs for the ``top`` best of that ranking.
+    The score differs from the 5.1 calibration's in what does not converge: it uses the
     *practical* stop times (the exact lower stop time is not grid-converged), leaves
     out max F_extra (a start-up transient at the column's corner that grows with
     resolution under MUSCL; reported, not scored) and measures "clearly shorter
@@ -89,23 +90,13 @@ def study_relaxed(case_51: str | Path, case_52: str | Path, dx_51: float = 0.006
         "case.models=['single_layer']", *RELAXED_SCHEME[1:], f"grid.dx={dx_51}",
         "output.snapshot_times=[]"]), "single_layer").summary
     r_max = 0.85 * (single["runout"] or 0.0)
-    rows = []
-    keys = list(grid)
-    for values in itertools.product(*grid.values()):
-        over = [f"two_layer.{k}={v}" for k, v in zip(keys, values, strict=True)]
-        over += ["case.models=['two_layer']", *RELAXED_SCHEME]
-        s1 = run_model(load_case(case_51, over + [f"grid.dx={dx_51}",
-                                                  "output.snapshot_times=[]"]),
-                       "two_layer").summary
-        row = dict(zip(keys, values, strict=True))
-        row.update({k: s1[k] for k in ("lower_stop_time", "upper_stop_time",
-                                       "lower_slow_time", "upper_slow_time", "runout",
-                                       "max_fextra_over_rho1")})
-        row["score"] = ((s1["lower_slow_time"] or 10.0) - TARGET_LOWER) ** 2 + (
-            (s1["upper_slow_time"] or 10.0) - TARGET_UPPER) ** 2 + max(
-            0.0, (s1["runout"] or 0.0) - r_max) ** 2
-        row["_over"] = over
-        rows.append(row)
+    rows = _study_rows(results)
+    for row in rows:
+        row["score"] = ((row["lower_slow_time"] or 10.0) - TARGET_LOWER) ** 2 + (
+            (row["upper_slow_time"] or 10.0) - TARGET_UPPER) ** 2 + max(
+            0.0, (row["runout"] or 0.0) - r_max) ** 2
+        row["_over"] = [f"{k}={v}" for k, v in row.pop("_params").items()] + [
+            "case.models=['two_layer']", *RELAXED_SCHEME]
     rows.sort(key=lambda r: r["score"])
     # a set only counts if its scored figures have converged: rerun the best on dx/2
     scored = ("lower_slow_time", "upper_slow_time", "runout")
@@ -141,24 +132,25 @@ def markdown(rows: list[dict], top: int) -> str:
 
 
 def _study_rows(path: str | Path) -> list[dict[str, Any]]:
-    """Rows of the calibration study's results, best score first, keys shortened."""
+    """The ok rows of a study's results table: keys without their section
+    (``two_layer.k`` -> ``k``), missing values as None, and under ``_params`` the varied
+    case keys with their values (ready for ``--set``)."""
     import pandas as pd
 
     df = pd.read_csv(path, keep_default_na=False, na_values=[""])
-    df = df[df["status"] == "ok"].sort_values("score")
+    df = df[df["status"] == "ok"].sort_values("id")
     rows = []
     for rec in df.to_dict("records"):
-        rows.append({k.split(".", 1)[1] if "." in k else k: (None if isinstance(v, float)
-                                                              and math.isnan(v) else v)
-                     for k, v in rec.items()
-                     if k not in ("id", "status", "message", "wall_s")})
-        rows[-1]["_params"] = {k: rec[k] for k in rec if k.startswith(("two_layer.",
-                                                                          "initial."))
-                               and k.split(".", 1)[1] in PARAMS}
+        row = {k.split(".", 1)[1] if "." in k else k: (None if isinstance(v, float)
+                                                        and math.isnan(v) else v)
+               for k, v in rec.items() if k not in ("id", "status", "message", "wall_s")}
+        row["_params"] = {k: rec[k] for k in rec if k.startswith(("two_layer.", "initial."))
+                          and k.split(".", 1)[1] in PARAMS}
+        rows.append(row)
     return rows
 
 
-PARAMS = ("phi_b_deg", "k", "c", "du_reg", "film_depth", "wedge_angle_deg")
+PARAMS = ("phi_b_deg", "k", "c", "du_reg", "film_depth", "wedge_angle_deg", "tau_star")
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -167,14 +159,20 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--case", default=CASE_51)
     ap.add_argument("--results", default="docs/studies/calibration_5_1/results.csv",
                     help="results.csv of cases/study_calibration_5_1.toml")
+    ap.add_argument("--relaxed-results", default=RELAXED_RESULTS,
+                    help="results.csv of cases/study_calibration_relaxed.toml")
     ap.add_argument("--study-relaxed", action="store_true",
                     help="instead: recalibration with the relaxed closure on refined grids "
                     "(docs/calibration_relaxed.md)")
     args = ap.parse_args(argv)
     if args.study_relaxed:
-        rows, single_runout = study_relaxed(args.case, "cases/collapse_sweep.toml")
+        rows, single_runout = study_relaxed(args.case, "cases/collapse_sweep.toml",
+                                            args.relaxed_results)
         print("# Recalibration with the relaxed closure on converged grids\n")
-        print("Generated by `python -m pdeflow.analysis.calibration --study-relaxed > "
+        print("Generated by `pdeflow study cases/study_calibration_relaxed.toml --out "
+              "docs/studies/calibration_relaxed` (stage 1, [report]"
+              "(studies/calibration_relaxed/report.md)) and `python -m "
+              "pdeflow.analysis.calibration --study-relaxed > "
               "docs/calibration_relaxed.md`: relaxed closure with the MUSCL scheme "
               "(hll/muscl/mc); 5.1 at dx = 0.00625 m, scored against the paper's figures "
               "(see `study_relaxed`: practical stop times, slow_time: |u| < 1 cm/s where "
@@ -190,7 +188,7 @@ def main(argv: list[str] | None = None) -> None:
               f"{len(rows)} sets; the best 20:\n")
         print(markdown(rows, 20))
         return
-    rows = _study_rows(args.results)
+    rows = sorted(_study_rows(args.results), key=lambda r: r["score"])
     print("# Calibration of the lost Table-1 parameters on test 5.1\n")
     print("The grid search is the study `cases/study_calibration_5_1.toml`: "
           f"{len(rows)} parameter sets, its score, the whole table and the best sets in "

@@ -13,9 +13,18 @@ import importlib
 import json
 import math
 import time
+import warnings
 from typing import Any
 
 from .spec import StudySpec
+
+
+def _silence_run_warnings() -> None:
+    """A run's warnings are in its summary (quantity ``<model>.warnings``); thousands of
+    evaluations printing them would bury the study's own output (worker processes only)."""
+    from ..checks import RunWarning
+
+    warnings.simplefilter("ignore", RunWarning)
 
 
 def _quantities(spec: StudySpec, point: dict[str, Any]) -> dict[str, Any]:
@@ -29,6 +38,7 @@ def _quantities(spec: StudySpec, point: dict[str, Any]) -> dict[str, Any]:
     from ..simulate import run_model
     from ..sweep import run_sweep
 
+    _silence_run_warnings()
     values: dict[str, Any] = {}
     models = spec.models()
     if models:
@@ -87,6 +97,7 @@ def warm(spec: StudySpec) -> float:
     from ..simulate import run_model
 
     t0 = time.perf_counter()
+    _silence_run_warnings()
     if spec.function is not None:
         importlib.import_module(spec.function.split(":", 1)[0])
     for base, models in ((spec.case, spec.models()), (spec.sweep_case, spec.sweep_models())):
