@@ -15,8 +15,9 @@ checked on finer grids, and set against published laws.
 3. The computed r(a) against the published planar-collapse laws (REFERENCE section 4).
 
 Search and map are plain loops written before pdeflow had a study engine; the map over
-the relaxed closure's tau_star is a study (cases/study_two_layer_law_relaxed.toml, run by
-``pdeflow study``), whose results table this file reads. Every number in the report comes
+each closure's regularisation (tau_star, du_reg) are studies
+(cases/study_two_layer_law_relaxed.toml, cases/study_two_layer_law_du_reg.toml, run by
+``pdeflow study``), whose results tables this file reads. Every number in the report comes
 from this file or that table. All results also go to docs/two_layer_law_search.csv.
 """
 
@@ -434,38 +435,42 @@ def figure_map(rows: list[dict], path: Path) -> None:
     save(fig, path)
 
 
-STUDY_RELAXED = "studies/two_layer_law_relaxed"
-"""the tau_star map, a study: pdeflow study cases/study_two_layer_law_relaxed.toml
---out docs/studies/two_layer_law_relaxed (this script only reads its results table)"""
+STUDY_MAPS = {  # study name -> (varied closure key, what the map above holds, closure)
+    "two_layer_law_relaxed": ("tau_star", "tau_star = 0.1", "relaxed closure"),
+    "two_layer_law_du_reg": ("du_reg", "du_reg = 0.2 m/s", "paper's closure bounded by du_reg"),
+}
+"""maps over a closure's regularisation, studies: pdeflow study cases/study_NAME.toml
+--out docs/studies/NAME (this script only reads their results tables)"""
 
 
-def relaxed_study_section(docs: Path) -> list[str]:
-    """Part C over the relaxed closure's tau_star, from the study's results table."""
-    path = docs / STUDY_RELAXED / "results.csv"
+def study_map_section(docs: Path, name: str) -> list[str]:
+    """Part C over one closure's regularisation, from a study's results table."""
+    key, held, closure = STUDY_MAPS[name]
+    study = f"studies/{name}"
+    path = docs / study / "results.csv"
     if not path.exists():
         return []
     with open(path) as fh:
         rows = [r for r in csv.DictReader(fh) if r["status"] == "ok"]
     groups: dict = {}
     for r in rows:
-        key = tuple(float(r[f"two_layer.{k}"]) for k in ("tau_star", "phi_b_deg", "c"))
+        point = tuple(float(r[f"two_layer.{k}"]) for k in (key, "phi_b_deg", "c"))
         e = r["sweep.two_layer.exponent"]
-        groups.setdefault(key, {})[float(r["grid.dx"])] = {
+        groups.setdefault(point, {})[float(r["grid.dx"])] = {
             "exponent": float(e) if e else None,
             "prefactor": float(r["sweep.two_layer.prefactor"]) if e else None,
             "sweep_at_rest": r["sweep.two_layer.all_at_rest"] == "1"}
     dxs = sorted({dx for lv in groups.values() for dx in lv}, reverse=True)
-    lines = ["", "**The relaxation stress tau_star** (the map above holds tau_star = 0.1): "
-             "the study `cases/study_two_layer_law_relaxed.toml`, run by `pdeflow study "
-             f"cases/study_two_layer_law_relaxed.toml --out docs/{STUDY_RELAXED}` "
-             f"([report]({STUDY_RELAXED}/report.md)), relaxed closure, MUSCL/mc, k = 0.8, "
-             "wedge 60 deg:", "",
-             "| tau_star | phi_B | c | " + " | ".join(f"fit, dx {d}" for d in dxs)
+    lines = ["", f"**{closure.capitalize()} over {key}** (the map above holds {held}): "
+             f"the study `cases/study_{name}.toml`, run by `pdeflow study "
+             f"cases/study_{name}.toml --out docs/{study}` "
+             f"([report]({study}/report.md)), MUSCL/mc, k = 0.8, wedge 60 deg:", "",
+             f"| {key} | phi_B | c | " + " | ".join(f"fit, dx {d}" for d in dxs)
              + " | change of the exponent | converged (< 0.01)? | sub-linear (< 0.95)? |",
              "|---|---|---|" + "---|" * (len(dxs) + 3)]
     conv_sub, conv_all, sub_all = [], [], []
-    for key in sorted(groups):
-        lv = groups[key]
+    for point in sorted(groups):
+        lv = groups[point]
         cells = []
         for dx in dxs:
             r = lv.get(dx)
@@ -481,20 +486,20 @@ def relaxed_study_section(docs: Path) -> list[str]:
                 "yes" if e[1] < 0.95 else "no"
             (conv_all if d < 0.01 else []).append(e[1])
             if e[1] < 0.95:
-                sub_all.append((key, e[1], d))
+                sub_all.append((point, e[1], d))
                 if d < 0.01:
-                    conv_sub.append((key, e[1]))
-        lines.append(f"| {key[0]:g} | {key[1]:g} | {key[2]:g} | " + " | ".join(cells)
+                    conv_sub.append((point, e[1]))
+        lines.append(f"| {point[0]:g} | {point[1]:g} | {point[2]:g} | " + " | ".join(cells)
                      + f" | {ch} | {ok} | {sub} |")
     lines += ["", f"* {len(conv_all)} of {len(groups)} sets converged"
               + (f" (exponents {min(conv_all):.3f} - {max(conv_all):.3f})" if conv_all
                  else "") + f"; {len(conv_sub)} of them sub-linear"
-              + (": " + ", ".join(f"tau_star {k[0]:g}, phi_B {k[1]:g}, c {k[2]:g} "
+              + (": " + ", ".join(f"{key} {k[0]:g}, phi_B {k[1]:g}, c {k[2]:g} "
                                   f"({e:.3f})" for k, e in conv_sub) if conv_sub else "")
               + "."]
     if sub_all:
         lines.append("* Sub-linear on the finer grid: " + ", ".join(
-            f"tau_star {k[0]:g}, phi_B {k[1]:g}, c {k[2]:g} ({e:.3f}, change {d:.3f})"
+            f"{key} {k[0]:g}, phi_B {k[1]:g}, c {k[2]:g} ({e:.3f}, change {d:.3f})"
             for k, e, d in sub_all) + ".")
     return lines
 
@@ -683,7 +688,8 @@ def main(argv: list[str] | None = None) -> int:
         lines += ["", f"({len(map_rows)} sweeps, {sum(walls) / 60:.0f} CPU-minutes, "
                   f"{args.workers} worker processes.)"]
         lines += ["", *map_answer(groups), "", *answers(groups, conv)]
-    lines += relaxed_study_section(docs)
+    for name in STUDY_MAPS:
+        lines += study_map_section(docs, name)
     lines += ["", "![the 5.2 exponent against dx](figures/two_layer_law_convergence.png)"]
     lines += ["", "## D. Against experiments and DEM", "",
               "r = (R - L0)/L0 with R the front (last cell deeper than 1 mm) in every "
