@@ -450,8 +450,12 @@ def study_map_section(docs: Path, name: str) -> list[str]:
     path = docs / study / "results.csv"
     if not path.exists():
         return []
-    with open(path) as fh:
-        rows = [r for r in csv.DictReader(fh) if r["status"] == "ok"]
+    rows = []
+    # a study NAME_refine holds sets of NAME one level finer
+    for p in (path, docs / f"{study}_refine" / "results.csv"):
+        if p.exists():
+            with open(p) as fh:
+                rows += [r for r in csv.DictReader(fh) if r["status"] == "ok"]
     groups: dict = {}
     for r in rows:
         point = tuple(float(r[f"two_layer.{k}"]) for k in (key, "phi_b_deg", "c"))
@@ -464,7 +468,11 @@ def study_map_section(docs: Path, name: str) -> list[str]:
     lines = ["", f"**{closure.capitalize()} over {key}** (the map above holds {held}): "
              f"the study `cases/study_{name}.toml`, run by `pdeflow study "
              f"cases/study_{name}.toml --out docs/{study}` "
-             f"([report]({study}/report.md)), MUSCL/mc, k = 0.8, wedge 60 deg:", "",
+             f"([report]({study}/report.md)"
+             + (f"; one level finer for some sets: [report]({study}_refine/report.md)"
+                if (docs / f"{study}_refine").exists() else "")
+             + "), MUSCL/mc, k = 0.8, wedge 60 deg; the change is between each set's "
+             "two finest grids:", "",
              f"| {key} | phi_B | c | " + " | ".join(f"fit, dx {d}" for d in dxs)
              + " | change of the exponent | converged (< 0.01)? | sub-linear (< 0.95)? |",
              "|---|---|---|" + "---|" * (len(dxs) + 3)]
@@ -477,7 +485,7 @@ def study_map_section(docs: Path, name: str) -> list[str]:
             cells.append("" if r is None else "-" if r["exponent"] is None else
                          f"{r['prefactor']:.2f} a^{r['exponent']:.3f}"
                          + ("" if r["sweep_at_rest"] else "*"))
-        e = [lv.get(dx, {}).get("exponent") for dx in dxs[-2:]]
+        e = [lv[dx]["exponent"] for dx in sorted(lv, reverse=True)[-2:]]  # finest two
         if None in e:
             ch = ok = sub = "-"
         else:
