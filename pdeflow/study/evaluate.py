@@ -104,8 +104,9 @@ def warm(spec: StudySpec) -> float:
         if base is None or not models:
             continue
         tiny = base.copy()
-        tiny.data["grid"].pop("dx", None)
-        tiny.data["grid"]["cells"] = 16
+        grid = tiny.data.setdefault("grid", {})
+        grid.pop("dx", None)
+        grid["cells"] = 16
         tiny.data.setdefault("case", {})["t_end"] = 0.01
         tiny.data.pop("sweep", None)
         for model in models:
