@@ -18,6 +18,7 @@ re-runs the best candidates with the paper's closure under perturbed numerics::
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 from pathlib import Path
 from typing import Any
@@ -30,13 +31,21 @@ TARGET_UPPER = 1.45
 CASE_51 = "cases/paper_5_1_dam_break.toml"
 
 
+STUDY_51 = "cases/study_calibration_5_1.toml"
+
+
+@functools.lru_cache(maxsize=1)
+def _score_expression() -> Any:
+    from ..study import load_study
+
+    return load_study(STUDY_51).objectives["score"]
+
+
 def score(s: dict[str, Any]) -> float:
-    """The study's score (cases/study_calibration_5_1.toml) of a run summary."""
-    lo = s["lower_stop_time"] if s["lower_stop_time"] is not None else 10.0
-    up = s["upper_stop_time"] if s["upper_stop_time"] is not None else 10.0
-    return ((lo - TARGET_LOWER) ** 2 + (up - TARGET_UPPER) ** 2
-            + max(0.0, s["max_fextra_over_rho1"] - 2.0) ** 2
-            + max(0.0, (s["runout"] or 0.0) - 4.2) ** 2)
+    """The 5.1 calibration's score of a two-layer run summary: the objective ``score`` of
+    the study ``cases/study_calibration_5_1.toml`` (one definition for both stages; paths
+    relative to the repository root, like the module's other defaults)."""
+    return _score_expression()({f"two_layer.{k}": v for k, v in s.items()})
 
 
 def robustness(case_path: str | Path, params: dict[str, Any]) -> dict[str, float]:
@@ -135,10 +144,10 @@ def _study_rows(path: str | Path) -> list[dict[str, Any]]:
     """The ok rows of a study's results table: keys without their section
     (``two_layer.k`` -> ``k``), missing values as None, and under ``_params`` the varied
     case keys with their values (ready for ``--set``)."""
-    import pandas as pd
+    from ..study.results import read_frame
 
-    df = pd.read_csv(path, keep_default_na=False, na_values=[""])
-    df = df[df["status"] == "ok"].sort_values("id")
+    df = read_frame(path)
+    df = df[df["status"] == "ok"]
     rows = []
     for rec in df.to_dict("records"):
         row = {k.split(".", 1)[1] if "." in k else k: (None if isinstance(v, float)

@@ -92,17 +92,20 @@ class ResultsTable:
 
     def frame(self) -> Any:
         """The table as a pandas DataFrame sorted by id."""
-        import pandas as pd
-
-        df = pd.read_csv(self.csv, keep_default_na=False, na_values=[""])
-        return df.sort_values("id").reset_index(drop=True)
-
-    def done_ids(self) -> set[int]:
-        return {int(r["id"]) for r in self.rows()}
+        return read_frame(self.csv)
 
     def record_execution(self, info: dict[str, Any]) -> None:
         self.meta.setdefault("executions", []).append(info)
         write_json(self.meta_path, self.meta)
+
+
+def read_frame(path: str | Path) -> Any:
+    """A results.csv as a pandas DataFrame sorted by id (empty fields are missing values,
+    the string "NA" stays a string)."""
+    import pandas as pd
+
+    df = pd.read_csv(path, keep_default_na=False, na_values=[""])
+    return df.sort_values("id").reset_index(drop=True)
 
 
 def _parse(text: str) -> Any:
