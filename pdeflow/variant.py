@@ -1,0 +1,195 @@
+"""Numerical variants: one type for every choice of discretisation and integrator.
+
+A :class:`Variant` names how a case is solved, never what is solved: the interface flux,
+the reconstruction and its limiter, the splitting, the hyperbolicity treatment (the
+two-layer model's ``hyperbolicity`` parameter) and the integrator. Its name is the one the
+docs use::
+
+    FLUX/RECONSTRUCTION[/LIMITER][+SPLITTING][@HYPERBOLICITY]   the fv-split scheme
+    mol-rk | mol-euler [:FLUX/RECONSTRUCTION[/LIMITER]][@HYPERBOLICITY]
+                                                                   method of lines
+
+e.g. ``hll/first-order`` (the paper's scheme), ``hll/muscl/mc+strang``,
+``hll/first-order@bound``, ``mol-rk`` (py-pde's classical RK4 with a fixed step on the
+method-of-lines rate of hll/first-order), ``mol-euler:rusanov/first-order``. The limiter
+defaults to minmod, the splitting to Lie, the hyperbolicity treatment to the paper's
+exact test; defaults are left out of :attr:`Variant.name`, so a name printed is a name
+parsed.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any
+
+from .numerics import layout as L
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .cases import Case
+
+FLUXES: tuple[str, ...] = tuple(L.FLUXES)
+RECONSTRUCTIONS: tuple[str, ...] = ("first-order", "muscl")
+LIMITERS: tuple[str, ...] = tuple(L.LIMITERS)
+SPLITTINGS: tuple[str, ...] = ("lie", "strang")
+HYPERBOLICITY: tuple[str, ...] = ("exact", "bound", "none")
+MOL_SOLVERS: dict[str, str] = {"mol-rk": "runge-kutta", "mol-euler": "euler"}
+"""method-of-lines names -> py-pde solver names (fixed time step)"""
+
+_SCHEME = r"(?P<flux>[a-z]+)/(?P<rec>[a-z-]+)(?:/(?P<lim>[a-z]+))?"
+_FV_RE = re.compile(rf"^{_SCHEME}(?:\+(?P<split>[a-z]+))?(?:@(?P<hyp>[a-z]+))?$")
+_MOL_RE = re.compile(rf"^(?P<mol>mol-[a-z]+)(?::{_SCHEME})?(?:@(?P<hyp>[a-z]+))?$")
+
+GRAMMAR = ("FLUX/RECONSTRUCTION[/LIMITER][+SPLITTING][@HYPERBOLICITY] or "
+           "mol-rk|mol-euler[:FLUX/RECONSTRUCTION[/LIMITER]][@HYPERBOLICITY]")
+
+
+class VariantError(ValueError):
+    """A variant name or field that is not one of the allowed choices."""
+
+
+def _choice(what: str, value: str, allowed: tuple[str, ...], name: str) -> None:
+    if value not in allowed:
+        raise VariantError(f"variant {name!r}: {what} must be one of {list(allowed)}, "
+                           f"got {value!r}")
+
+
+@dataclass(frozen=True)
+class Variant:
+    """How a case is solved: discretisation, splitting, hyperbolicity, integrator.
+
+    ``solver`` is ``"fv-split"`` (the paper's split scheme, a CFL time step) or a
+    py-pde solver name run with a fixed step on the method-of-lines rate (see
+    :data:`MOL_SOLVERS`); ``splitting`` applies to fv-split only.
+    """
+
+    flux: str = "hll"
+    reconstruction: str = "first-order"
+    limiter: str = "minmod"
+    splitting: str = "lie"
+    hyperbolicity: str = "exact"
+    solver: str = "fv-split"
+
+    def __post_init__(self) -> None:
+        name = self._compose()
+        _choice("flux", self.flux, FLUXES, name)
+        _choice("reconstruction", self.reconstruction, RECONSTRUCTIONS, name)
+        _choice("limiter", self.limiter, LIMITERS, name)
+        _choice("splitting", self.splitting, SPLITTINGS, name)
+        _choice("hyperbolicity", self.hyperbolicity, HYPERBOLICITY, name)
+        _choice("solver", self.solver, ("fv-split", *MOL_SOLVERS.values()), name)
+        if self.solver != "fv-split" and self.splitting != "lie":
+            raise VariantError(f"variant {name!r}: splitting applies to the fv-split "
+                               "solver only (the method of lines does not split)")
+
+    # --- names ---------------------------------------------------------------------------
+    @classmethod
+    def parse(cls, name: str) -> Variant:
+        """The variant of a name (grammar in the module docstring); VariantError names
+        the part that is wrong and the allowed choices."""
+        text = str(name).strip()
+        m = _FV_RE.match(text) or _MOL_RE.match(text)
+        if not m:
+            raise VariantError(f"variant {text!r} is not {GRAMMAR} (fluxes "
+                               f"{list(FLUXES)}, reconstructions {list(RECONSTRUCTIONS)},"
+                               f" limiters {list(LIMITERS)}, splittings "
+                               f"{list(SPLITTINGS)}, hyperbolicity {list(HYPERBOLICITY)})")
+        parts = m.groupdict()
+        if parts.get("lim") and parts.get("rec") != "muscl":
+            raise VariantError(f"variant {text!r}: a limiter needs the muscl "
+                               "reconstruction")
+        kwargs: dict[str, Any] = {"hyperbolicity": parts.get("hyp") or "exact"}
+        if parts.get("mol"):
+            if parts["mol"] not in MOL_SOLVERS:
+                raise VariantError(f"variant {text!r}: method of lines must be one of "
+                                   f"{list(MOL_SOLVERS)}, got {parts['mol']!r}")
+            kwargs["solver"] = MOL_SOLVERS[parts["mol"]]
+        else:
+            kwargs["splitting"] = parts.get("split") or "lie"
+        if parts.get("flux"):
+            kwargs.update(flux=parts["flux"], reconstruction=parts["rec"],
+                          limiter=parts.get("lim") or "minmod")
+        return cls(**kwargs)
+
+    def _compose(self) -> str:
+        scheme = f"{self.flux}/{self.reconstruction}"
+        if self.reconstruction == "muscl":
+            scheme += f"/{self.limiter}"
+        hyp = "" if self.hyperbolicity == "exact" else f"@{self.hyperbolicity}"
+        if self.solver == "fv-split":
+            split = "" if self.splitting == "lie" else f"+{self.splitting}"
+            return f"{scheme}{split}{hyp}"
+        mol = {v: k for k, v in MOL_SOLVERS.items()}.get(self.solver, self.solver)
+        if scheme == "hll/first-order":
+            return f"{mol}{hyp}"
+        return f"{mol}:{scheme}{hyp}"
+
+    @property
+    def name(self) -> str:
+        """Canonical name (defaults left out); ``Variant.parse(v.name) == v``."""
+        return self._compose()
+
+    def __str__(self) -> str:
+        return self.name
+
+    @property
+    def description(self) -> str:
+        """One line in words, for tables and legends."""
+        rec = ("first order" if self.reconstruction == "first-order"
+               else f"MUSCL ({self.limiter})")
+        if self.solver == "fv-split":
+            how = f"fv-split, {self.splitting.capitalize()} splitting"
+            if self.reconstruction == "muscl":
+                how += ", SSP-RK2 advection"
+        else:
+            how = f"py-pde {self.solver}, fixed dt, method of lines"
+        hyp = {"exact": "exact hyperbolicity test", "bound": "hyperbolicity restored "
+               "below F_L only", "none": "no hyperbolicity correction"}[self.hyperbolicity]
+        return f"{self.flux.upper()} flux, {rec}; {how}; {hyp}"
+
+    @property
+    def is_mol(self) -> bool:
+        """True for a py-pde solver on the method-of-lines rate."""
+        return self.solver != "fv-split"
+
+    def with_(self, **changes: Any) -> Variant:
+        """A copy with some fields changed (validated)."""
+        return replace(self, **changes)
+
+    # --- cases ---------------------------------------------------------------------------
+    @classmethod
+    def from_case(cls, case: Case) -> Variant:
+        """The variant a case file selects (its ``[numerics]`` and the two-layer
+        ``hyperbolicity`` parameter); VariantError names the bad entry."""
+        num = case.data.get("numerics", {})
+        return cls(flux=num.get("flux", "hll"),
+                   reconstruction=num.get("reconstruction", "first-order"),
+                   limiter=num.get("limiter", "minmod"),
+                   splitting=num.get("splitting", "lie"),
+                   hyperbolicity=case.data.get("two_layer", {}).get("hyperbolicity",
+                                                                    "exact"),
+                   solver=num.get("solver", "fv-split"))
+
+    def numerics(self) -> dict[str, Any]:
+        """The case file's ``[numerics]`` entries that select this variant."""
+        out: dict[str, Any] = {"solver": self.solver, "flux": self.flux,
+                               "reconstruction": self.reconstruction,
+                               "limiter": self.limiter}
+        if self.solver == "fv-split":
+            out["splitting"] = self.splitting
+        return out
+
+    def apply(self, case: Case) -> Case:
+        """A copy of ``case`` solved with this variant (its other numerics, e.g. cfl and
+        dt, kept); the two-layer ``hyperbolicity`` parameter is set unless it is the
+        default that the case already has."""
+        c = case.copy()
+        num = c.data.setdefault("numerics", {})
+        for key in ("flux", "reconstruction", "limiter", "splitting", "solver"):
+            num.pop(key, None)
+        num.update(self.numerics())
+        two = c.data.get("two_layer", {})
+        if self.hyperbolicity != two.get("hyperbolicity", "exact"):
+            c.data.setdefault("two_layer", {})["hyperbolicity"] = self.hyperbolicity
+        c.validate()
+        return c
