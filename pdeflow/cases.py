@@ -47,6 +47,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from .models.base import check_range
+from .variant import Variant, VariantError
 
 MODEL_NAMES = ("two_layer", "single_layer")
 
@@ -71,16 +72,6 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
 }
 
 SHAPES = ("column", "dam_break", "heap", "file")
-
-
-def solver_names() -> list[str]:
-    """Names accepted as ``numerics.solver``: fv-split and py-pde's registered solvers."""
-    import pde.solvers
-
-    from . import solvers  # noqa: F401 - registers fv-split
-
-    names = [n for n in pde.solvers.registered_solvers() if not n.endswith("Solver")]
-    return sorted(names, key=lambda n: (n != "fv-split", n))
 
 
 class CaseError(ValueError):
@@ -195,15 +186,10 @@ class Case:
                 raise self._err(f"boundaries.{side} must be 'wall' or 'open', got {bc!r}")
         if "initial" not in self.data or "shape" not in self.data["initial"]:
             raise self._err("[initial] with a 'shape' is required")
-        solvers = solver_names()
-        if self.solver not in solvers:
-            raise self._err(f"numerics.solver must be one of {solvers}, got "
-                            f"{self.solver!r}")
-        if self.splitting not in ("lie", "strang"):
-            raise self._err(f"numerics.splitting must be 'lie' or 'strang', got "
-                            f"{self.splitting!r}")
-        for model in MODEL_NAMES:
-            self.make_pde(model)  # checks flux, reconstruction, limiter by name
+        try:
+            Variant.from_case(self)  # solver, flux, reconstruction, limiter, splitting
+        except VariantError as err:
+            raise self._err(str(err)) from None
         if self.initial["shape"] not in SHAPES:
             raise self._err(f"initial.shape must be one of {list(SHAPES)}, got "
                             f"{self.initial['shape']!r}")

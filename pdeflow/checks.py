@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from .analysis.metrics import total_depth
+from .metrics import total_depth
 
 #: memory of a run per cell [bytes]: peak of tracemalloc over run_model on 200,000 cells
 #: without snapshots (312 two layers, 168 one layer), rounded up

@@ -1,32 +1,44 @@
-"""Run a model of a case with py-pde's controller and summarise the result."""
+"""Runs: a case, a model and a numerical variant, set up once and run with py-pde.
+
+A :class:`Run` turns a :class:`~pdeflow.cases.Case` (+ a
+:class:`~pdeflow.variant.Variant`) into the PDE, the initial state, the solver and its
+arguments exactly once; :meth:`Run.execute` integrates it with py-pde's controller and
+returns a :class:`RunResult` that carries the PDE, the final state, the snapshots, a
+typed view of the solver's diagnostics and the summary.
+"""
 
 from __future__ import annotations
 
 import time
 import warnings
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 from pde import FieldCollection
 
-from .analysis.metrics import front_position, mass
-from .cases import Case
+from .cases import Case, load_case
 from .checks import RunWarning, cost_warning, domain_ends, result_warnings, solver_warning
-from .numerics import layout as L
+from .metrics import front_position, mass
+from .models.base import GranularPDE
+from .solvers.diagnostics import SplitDiagnostics
 from .solvers.fv_split import load_kernels
 from .trackers import SnapshotTracker
+from .variant import Variant
 
 
 @dataclass
 class RunResult:
-    """Outcome of one model run: final state, snapshots, diagnostics, summary."""
+    """Outcome of one model run: PDE, final state, snapshots, diagnostics, summary."""
 
     model: str
     case: Case
+    pde: GranularPDE
     state: FieldCollection
     t_final: float
-    diagnostics: np.ndarray | None
+    diagnostics: SplitDiagnostics | None
+    """the fv-split solver's record (None for py-pde's solvers)"""
     info: dict[str, Any]
     snapshots: dict[float, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
     """t -> (state data, F_extra/rho1 per cell)"""
@@ -41,7 +53,7 @@ class RunResult:
         """F_extra/rho1 of the last step, per cell [m^2/s^2] (zeros for one layer)."""
         if self.diagnostics is None:
             return np.zeros(self.x.size)
-        return self.diagnostics[L.N_DIAG:].copy()
+        return self.diagnostics.fextra_over_rho1.copy()
 
     def final_arrays(self) -> dict[str, np.ndarray]:
         """x, depths and velocities of the final state (keys as in the ``--final`` npz)."""
@@ -63,56 +75,95 @@ def load_case_kernels(case: Case, log: Any = None) -> float:
     return load_kernels(log) if case.solver == "fv-split" else 0.0
 
 
-def run_model(case: Case, model: str, *, tracker: Any = None,
-              backend: str = "numba") -> RunResult:
-    """Run ``model`` ('two_layer' or 'single_layer') of ``case`` to rest or t_end.
+class Run:
+    """One model of one case with one numerical variant, set up once.
 
-    Snapshots are stored at ``output.snapshot_times`` through a py-pde
-    ``MemoryStorage`` tracker; ``tracker`` adds user trackers (e.g. a live plot).
+    Args:
+        case: the case (not modified; with ``variant`` a copy solved that way).
+        model: ``"two_layer"`` or ``"single_layer"``.
+        variant: how to solve it; default: what the case file selects.
+        backend: ``"numba"`` (compiled stepping loop) or ``"numpy"`` (fv-split only).
+
+    Attributes ``case``, ``variant``, ``pde`` and ``state`` (the initial state) are built
+    here, once; :meth:`execute` may be called more than once (it never changes them).
     """
-    for message in (solver_warning(case), cost_warning(case, model)):
-        if message:
-            warnings.warn(message, RunWarning, stacklevel=2)
-    eq, state = case.make_state(model)
-    dx = case.dx
-    r = eq.parameters.density_ratio if model == "two_layer" else None
-    mass0 = mass(state.data, dx, r)
-    initial = state.data.copy()
-    snaps = SnapshotTracker(interrupts=sorted(case.snapshot_times))
-    trackers: list[Any] = [snaps] if case.snapshot_times else []
-    if tracker is not None:
-        trackers.extend(tracker if isinstance(tracker, list) else [tracker])
-    solver = case.solver
-    kwargs: dict[str, Any] = {}
-    if solver == "fv-split":
-        kwargs = {"cfl": case.cfl, "backend": backend, "splitting": case.splitting}
-        if backend == "numba":
+
+    def __init__(self, case: Case, model: str, variant: Variant | str | None = None, *,
+                 backend: str = "numba"):
+        if isinstance(variant, str):
+            variant = Variant.parse(variant)
+        self.case = case if variant is None else variant.apply(case)
+        self.variant = variant or Variant.from_case(case)
+        self.model = model
+        self.backend = backend
+        self.pde, self.state = self.case.make_state(model)
+
+    @classmethod
+    def from_file(cls, path: str | Path, model: str, overrides: list[str] | None = None,
+                  variant: Variant | str | None = None) -> Run:
+        """The run of ``model`` of a case file (with ``section.key=value`` overrides)."""
+        return cls(load_case(path, overrides), model, variant)
+
+    def solver_arguments(self) -> dict[str, Any]:
+        """Keyword arguments of py-pde's ``solve`` that select the integrator."""
+        if self.variant.is_mol:
+            return {"solver": self.variant.solver,
+                    "dt": float(self.case.data.get("numerics", {}).get("dt", 1e-4))}
+        return {"solver": "fv-split", "cfl": self.case.cfl, "backend": self.backend,
+                "splitting": self.variant.splitting}
+
+    def execute(self, tracker: Any = None) -> RunResult:
+        """Integrate to rest or ``case.t_end`` and summarise.
+
+        Snapshots are stored at ``output.snapshot_times``; ``tracker`` adds user
+        trackers (one or a list, e.g. a live plot). Run warnings (cost, domain ends,
+        mass) are issued as :class:`~pdeflow.checks.RunWarning`.
+        """
+        case, model = self.case, self.model
+        for message in (solver_warning(case), cost_warning(case, model)):
+            if message:
+                warnings.warn(message, RunWarning, stacklevel=2)
+        r = self.pde.parameters.density_ratio if model == "two_layer" else None
+        mass0 = mass(self.state.data, case.dx, r)
+        snaps = SnapshotTracker(interrupts=sorted(case.snapshot_times))
+        trackers: list[Any] = [snaps] if case.snapshot_times else []
+        if tracker is not None:
+            trackers.extend(tracker if isinstance(tracker, list) else [tracker])
+        if not self.variant.is_mol and self.backend == "numba":
             # compiling (first run on a machine) or loading the kernels is not the run's
             # wall time, nor should it hold up its progress bar
             load_kernels()
-    else:
-        kwargs = {"dt": float(case.data.get("numerics", {}).get("dt", 1e-4))}
-    wall0 = time.perf_counter()
-    final, info = eq.solve(state, t_range=case.t_end, solver=solver, tracker=trackers,
-                           ret_info=True, **kwargs)
-    wall = time.perf_counter() - wall0
-    if str(info.get("controller", {}).get("stop_reason", "")).startswith("User interrupted"):
-        # py-pde turns Ctrl-C into a normal return; a truncated run must not be written
-        # out as if it were complete
-        raise KeyboardInterrupt(f"{model} run of {case.name} interrupted at "
-                                f"t={info['controller'].get('t_final')}")
-    sinfo = info.get("solver", {})
-    diag = sinfo.get("post_step_data")
-    diag = diag if isinstance(diag, np.ndarray) else None
-    t_final = float(sinfo.get("rest_time", info["controller"].get("t_final", case.t_end)))
-    if diag is not None and diag[L.D_T] > 0:
-        t_final = float(diag[L.D_T])
-    result = RunResult(model, case, final, t_final, diag, info)
-    result.snapshots = snaps.snapshots
-    result.summary = summarize(result, mass0, wall, initial)
-    for message in result.summary["warnings"]:
-        warnings.warn(message, RunWarning, stacklevel=2)
-    return result
+        wall0 = time.perf_counter()
+        final, info = self.pde.solve(self.state, t_range=case.t_end, tracker=trackers,
+                                     ret_info=True, **self.solver_arguments())
+        wall = time.perf_counter() - wall0
+        stop = str(info.get("controller", {}).get("stop_reason", ""))
+        if stop.startswith("User interrupted"):
+            # py-pde turns Ctrl-C into a normal return; a truncated run must not be
+            # written out as if it were complete
+            raise KeyboardInterrupt(f"{model} run of {case.name} interrupted at "
+                                    f"t={info['controller'].get('t_final')}")
+        sinfo = info.get("solver", {})
+        data = sinfo.get("post_step_data")
+        diag = (SplitDiagnostics.from_array(data)
+                if isinstance(data, np.ndarray) and not self.variant.is_mol else None)
+        t_final = float(sinfo.get("rest_time", info["controller"].get("t_final",
+                                                                      case.t_end)))
+        if diag is not None and diag.t > 0:
+            t_final = diag.t
+        result = RunResult(model, case, self.pde, final, t_final, diag, info)
+        result.snapshots = snaps.snapshots
+        result.summary = summarize(result, mass0, wall, self.state.data)
+        for message in result.summary["warnings"]:
+            warnings.warn(message, RunWarning, stacklevel=2)
+        return result
+
+
+def run_model(case: Case, model: str, *, tracker: Any = None,
+              backend: str = "numba") -> RunResult:
+    """Run ``model`` ('two_layer' or 'single_layer') of ``case`` to rest or t_end:
+    ``Run(case, model, backend=backend).execute(tracker)``."""
+    return Run(case, model, backend=backend).execute(tracker)
 
 
 def _stop_time(last_moving: float, t_final: float, at_rest: bool) -> float | None:
@@ -145,8 +196,7 @@ def summarize(res: RunResult, mass0: float, wall: float,
     case = res.case
     dx = case.dx
     d = res.state.data
-    r = (res.case.make_pde("two_layer").parameters.density_ratio
-         if res.model == "two_layer" else None)
+    r = res.pde.parameters.density_ratio if res.model == "two_layer" else None
     front = front_position(res.x, d, case.front_threshold, dx)
     at_rest = "rest_time" in res.info.get("solver", {})
     diag = res.diagnostics
@@ -164,33 +214,33 @@ def summarize(res: RunResult, mass0: float, wall: float,
         "wall_time_s": wall,
         "stop_reason": res.info.get("controller", {}).get("stop_reason"),
     }
-    if diag is not None and case.solver == "fv-split":
+    if diag is not None:
         # steps that IFCP could not keep positive, redone with HLL (0 for other fluxes)
-        out["flux_fallback_steps"] = int(diag[L.D_FLUX_FALLBACKS])
+        out["flux_fallback_steps"] = diag.flux_fallbacks
         tf = res.t_final
-        up = _stop_time(diag[L.D_MOVE_UPPER], tf, at_rest)
+        up = _stop_time(diag.last_move_upper, tf, at_rest)
         if res.model == "two_layer":
-            lo = _stop_time(diag[L.D_MOVE_LOWER], tf, at_rest)
+            lo = _stop_time(diag.last_move_lower, tf, at_rest)
             out.update({
                 "lower_stop_time": lo,
                 "upper_stop_time": up,
                 "stop_time": None if (lo is None or up is None) else max(lo, up),
-                "lower_slow_time": _stop_time(diag[L.D_FAST_LOWER], tf, False),
-                "upper_slow_time": _stop_time(diag[L.D_FAST_UPPER], tf, False),
-                "max_fextra_over_rho1": float(diag[L.D_FEXTRA_MAX]),
-                "max_fextra_x": float(res.x[int(diag[L.D_FEXTRA_CELL])]),
-                "max_fextra_time": float(diag[L.D_FEXTRA_TIME]),
-                "hyperbolicity_events": int(diag[L.D_HYP_EVENTS]),
-                "hyperbolicity_bisections": int(diag[L.D_HYP_BISECTIONS]),
-                "deposited_volume": float(diag[L.D_DEPOSITED] * dx),
-                "eroded_volume": float(diag[L.D_ERODED] * dx),
+                "lower_slow_time": _stop_time(diag.last_fast_lower, tf, False),
+                "upper_slow_time": _stop_time(diag.last_fast_upper, tf, False),
+                "max_fextra_over_rho1": diag.fextra_max,
+                "max_fextra_x": float(res.x[diag.fextra_cell]),
+                "max_fextra_time": diag.fextra_time,
+                "hyperbolicity_events": diag.hyperbolicity_events,
+                "hyperbolicity_bisections": diag.hyperbolicity_bisections,
+                "deposited_volume": float(diag.deposited * dx),
+                "eroded_volume": float(diag.eroded * dx),
                 "upper_volume_final": float(np.sum(d[0]) * dx),
                 "lower_volume_final": float(np.sum(d[2]) * dx),
             })
         else:
             out.update({
                 "stop_time": up,
-                "slow_time": _stop_time(diag[L.D_FAST_UPPER], tf, False),
+                "slow_time": _stop_time(diag.last_fast_upper, tf, False),
                 "max_fextra_over_rho1": 0.0,
             })
     else:

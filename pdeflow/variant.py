@@ -6,12 +6,12 @@ two-layer model's ``hyperbolicity`` parameter) and the integrator. Its name is t
 docs use::
 
     FLUX/RECONSTRUCTION[/LIMITER][+SPLITTING][@HYPERBOLICITY]   the fv-split scheme
-    mol-rk | mol-euler [:FLUX/RECONSTRUCTION[/LIMITER]][@HYPERBOLICITY]
-                                                                   method of lines
+    mol-SOLVER[:FLUX/RECONSTRUCTION[/LIMITER]][@HYPERBOLICITY]     method of lines
 
 e.g. ``hll/first-order`` (the paper's scheme), ``hll/muscl/mc+strang``,
 ``hll/first-order@bound``, ``mol-rk`` (py-pde's classical RK4 with a fixed step on the
-method-of-lines rate of hll/first-order), ``mol-euler:rusanov/first-order``. The limiter
+method-of-lines rate of hll/first-order), ``mol-euler:rusanov/first-order``; ``SOLVER`` is
+``rk`` or ``euler`` or the name of any py-pde solver (``mol-scipy``). The limiter
 defaults to minmod, the splitting to Lie, the hyperbolicity treatment to the paper's
 exact test; defaults are left out of :attr:`Variant.name`, so a name printed is a name
 parsed.
@@ -34,24 +34,36 @@ LIMITERS: tuple[str, ...] = tuple(L.LIMITERS)
 SPLITTINGS: tuple[str, ...] = ("lie", "strang")
 HYPERBOLICITY: tuple[str, ...] = ("exact", "bound", "none")
 MOL_SOLVERS: dict[str, str] = {"mol-rk": "runge-kutta", "mol-euler": "euler"}
-"""method-of-lines names -> py-pde solver names (fixed time step)"""
+"""short method-of-lines names -> py-pde solver names; any other py-pde solver is
+``mol-<its name>``"""
 
 _SCHEME = r"(?P<flux>[a-z]+)/(?P<rec>[a-z-]+)(?:/(?P<lim>[a-z]+))?"
 _FV_RE = re.compile(rf"^{_SCHEME}(?:\+(?P<split>[a-z]+))?(?:@(?P<hyp>[a-z]+))?$")
-_MOL_RE = re.compile(rf"^(?P<mol>mol-[a-z]+)(?::{_SCHEME})?(?:@(?P<hyp>[a-z]+))?$")
+_MOL_RE = re.compile(rf"^(?P<mol>mol-[a-z-]+)(?::{_SCHEME})?(?:@(?P<hyp>[a-z]+))?$")
 
 GRAMMAR = ("FLUX/RECONSTRUCTION[/LIMITER][+SPLITTING][@HYPERBOLICITY] or "
-           "mol-rk|mol-euler[:FLUX/RECONSTRUCTION[/LIMITER]][@HYPERBOLICITY]")
+           "mol-SOLVER[:FLUX/RECONSTRUCTION[/LIMITER]][@HYPERBOLICITY]")
+
+
+def solver_names() -> list[str]:
+    """Solvers a variant can name: fv-split first, then py-pde's registered solvers
+    (each integrates the method-of-lines rate)."""
+    import pde.solvers
+
+    from . import solvers  # noqa: F401 - registers fv-split
+
+    names = [n for n in pde.solvers.registered_solvers() if not n.endswith("Solver")]
+    return sorted(names, key=lambda n: (n != "fv-split", n))
 
 
 class VariantError(ValueError):
     """A variant name or field that is not one of the allowed choices."""
 
 
-def _choice(what: str, value: str, allowed: tuple[str, ...], name: str) -> None:
+def _choice(what: str, value: str, allowed: tuple[str, ...], name: str | None) -> None:
     if value not in allowed:
-        raise VariantError(f"variant {name!r}: {what} must be one of {list(allowed)}, "
-                           f"got {value!r}")
+        where = f"variant {name!r}: " if name else ""
+        raise VariantError(f"{where}{what} must be one of {list(allowed)}, got {value!r}")
 
 
 @dataclass(frozen=True)
@@ -77,7 +89,7 @@ class Variant:
         _choice("limiter", self.limiter, LIMITERS, name)
         _choice("splitting", self.splitting, SPLITTINGS, name)
         _choice("hyperbolicity", self.hyperbolicity, HYPERBOLICITY, name)
-        _choice("solver", self.solver, ("fv-split", *MOL_SOLVERS.values()), name)
+        _choice("solver", self.solver, tuple(solver_names()), name)
         if self.solver != "fv-split" and self.splitting != "lie":
             raise VariantError(f"variant {name!r}: splitting applies to the fv-split "
                                "solver only (the method of lines does not split)")
@@ -100,10 +112,12 @@ class Variant:
                                "reconstruction")
         kwargs: dict[str, Any] = {"hyperbolicity": parts.get("hyp") or "exact"}
         if parts.get("mol"):
-            if parts["mol"] not in MOL_SOLVERS:
-                raise VariantError(f"variant {text!r}: method of lines must be one of "
-                                   f"{list(MOL_SOLVERS)}, got {parts['mol']!r}")
-            kwargs["solver"] = MOL_SOLVERS[parts["mol"]]
+            solver = MOL_SOLVERS.get(parts["mol"], parts["mol"][4:])
+            if solver not in solver_names() or solver == "fv-split":
+                known = [*MOL_SOLVERS, *(f"mol-{n}" for n in solver_names()[1:])]
+                raise VariantError(f"variant {text!r}: the method of lines must be one "
+                                   f"of {known}, got {parts['mol']!r}")
+            kwargs["solver"] = solver
         else:
             kwargs["splitting"] = parts.get("split") or "lie"
         if parts.get("flux"):
@@ -119,7 +133,7 @@ class Variant:
         if self.solver == "fv-split":
             split = "" if self.splitting == "lie" else f"+{self.splitting}"
             return f"{scheme}{split}{hyp}"
-        mol = {v: k for k, v in MOL_SOLVERS.items()}.get(self.solver, self.solver)
+        mol = {v: k for k, v in MOL_SOLVERS.items()}.get(self.solver, f"mol-{self.solver}")
         if scheme == "hll/first-order":
             return f"{mol}{hyp}"
         return f"{mol}:{scheme}{hyp}"
@@ -162,13 +176,20 @@ class Variant:
         """The variant a case file selects (its ``[numerics]`` and the two-layer
         ``hyperbolicity`` parameter); VariantError names the bad entry."""
         num = case.data.get("numerics", {})
-        return cls(flux=num.get("flux", "hll"),
-                   reconstruction=num.get("reconstruction", "first-order"),
-                   limiter=num.get("limiter", "minmod"),
-                   splitting=num.get("splitting", "lie"),
-                   hyperbolicity=case.data.get("two_layer", {}).get("hyperbolicity",
-                                                                    "exact"),
-                   solver=num.get("solver", "fv-split"))
+        fields = {"solver": num.get("solver", "fv-split"), "flux": num.get("flux", "hll"),
+                  "reconstruction": num.get("reconstruction", "first-order"),
+                  "limiter": num.get("limiter", "minmod"),
+                  "splitting": num.get("splitting", "lie")}
+        allowed = {"solver": tuple(solver_names()), "flux": FLUXES,
+                   "reconstruction": RECONSTRUCTIONS, "limiter": LIMITERS,
+                   "splitting": SPLITTINGS}
+        for key, value in fields.items():  # errors name the case file's key
+            _choice(f"numerics.{key}", value, allowed[key], None)
+        if fields["solver"] != "fv-split":
+            fields["splitting"] = "lie"  # the method of lines does not split
+        hyp = case.data.get("two_layer", {}).get("hyperbolicity", "exact")
+        _choice("two_layer.hyperbolicity", hyp, HYPERBOLICITY, None)
+        return cls(hyperbolicity=hyp, **fields)
 
     def numerics(self) -> dict[str, Any]:
         """The case file's ``[numerics]`` entries that select this variant."""

@@ -23,18 +23,37 @@ def test_stoker_solution_is_consistent():
     assert np.trapezoid(h, x) == pytest.approx(3 * 1.0 + 3 * 0.1, rel=1e-4)
 
 
+def _exact_case(name: str, *sets: str):
+    return load_case(ROOT / "cases" / name, ["numerics.cfl=0.45", *sets])
+
+
 def test_orders_on_exact_solutions_fast_form():
-    rows = {r["variant"]: r for r in exact_study("ritter", [100, 200, 400])}
+    rows = {r["variant"]: r for r in exact_study(_exact_case("ritter_dam_break.toml"),
+                                                 [100, 200, 400])}
     assert min(rows["hll/first-order"]["order_L1_h"]) > 0.55
-    assert min(rows["hll/muscl"]["order_L1_h"]) > 0.9
-    assert min(rows["hll/muscl"]["order_L1_h_away"]) > 0.95
-    rows = {r["variant"]: r for r in exact_study("stoker", [100, 200, 400])}
-    assert rows["hll/muscl"]["L1_h"][-1] < 0.5 * rows["hll/first-order"]["L1_h"][-1]
+    assert min(rows["hll/muscl/minmod"]["order_L1_h"]) > 0.9
+    assert min(rows["hll/muscl/minmod"]["order_L1_h_away"]) > 0.95
+    rows = {r["variant"]: r for r in exact_study(_exact_case("stoker_dam_break.toml"),
+                                                 [100, 200, 400])}
+    assert rows["hll/muscl/minmod"]["L1_h"][-1] < 0.5 * rows["hll/first-order"]["L1_h"][-1]
+
+
+def test_exact_solutions_come_from_the_case_files():
+    from pdeflow.analysis.exact import exact_solution_for
+
+    kinds = {name: exact_solution_for(_exact_case(f"{name}.toml")).name
+             for name in ("ritter_dam_break", "mangeney_dam_break_slope",
+                          "stoker_dam_break")}
+    assert kinds == {"ritter_dam_break": "ritter", "mangeney_dam_break_slope": "mangeney",
+                     "stoker_dam_break": "stoker"}
+    assert exact_solution_for(load_case(ROOT / "cases" / "paper_5_1_dam_break.toml")) is None
+    with pytest.raises(Exception, match="no exact solution"):
+        exact_study(load_case(ROOT / "cases" / "paper_5_1_dam_break.toml"), [10])
 
 
 def test_second_order_on_smooth_problem_fast_form():
     rows = {r["variant"]: r for r in smooth_study([50, 100, 200])}
-    assert rows["hll/muscl"]["order_L1_h"][-1] > 1.7
+    assert rows["hll/muscl/minmod"]["order_L1_h"][-1] > 1.7
     assert 0.8 < rows["hll/first-order"]["order_L1_h"][-1] < 1.2
 
 

@@ -1,6 +1,6 @@
-"""Analysis: exact solutions and scalar measures of states."""
+"""Analysis: exact solutions, and the studies defined on :class:`~pdeflow.analysis.study.Study`
+(convergence, work-precision, validation, stability)."""
 
 from .exact import mangeney, ritter, stoker
-from .metrics import front_position, mass, momentum, total_depth
 
-__all__ = ["front_position", "mangeney", "mass", "momentum", "ritter", "stoker", "total_depth"]
+__all__ = ["mangeney", "ritter", "stoker"]

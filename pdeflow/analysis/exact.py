@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -82,3 +84,77 @@ def stoker(x: np.ndarray, t: float, h_left: float, h_right: float, x0: float = 0
                  np.where(xi <= um - cm, 2.0 / 3.0 * (xi + cl),
                           np.where(xi <= s, um, 0.0)))
     return h, u
+
+
+FRICTIONLESS_DEG = 1e-6
+"""Friction angles at or below this [deg] count as zero: case files write a frictionless
+bed as phi_b_deg = 1e-9 (angles must lie in (0, 90) deg)."""
+
+
+@dataclass(frozen=True)
+class ExactSolution:
+    """A single-layer dam break with an exact solution (Ritter, Mangeney, Stoker).
+
+    Depth ``h_left`` [m] upstream of the dam at ``x0`` [m], ``h_right`` [m] downstream
+    (> 0: Stoker, flat frictionless bed only), bed slope ``theta_deg`` and Coulomb
+    friction ``delta_deg`` <= theta (Mangeney; Ritter for both 0).
+    """
+
+    name: str
+    h_left: float
+    h_right: float
+    x0: float
+    g: float = 9.81
+    theta_deg: float = 0.0
+    delta_deg: float = 0.0
+
+    def __call__(self, x: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """(h [m], u [m/s]) at the points ``x`` [m] and time ``t`` [s]."""
+        if self.h_right > 0:
+            return stoker(x, t, self.h_left, self.h_right, x0=self.x0, g=self.g)
+        return mangeney(x, t, self.h_left, x0=self.x0, g=self.g,
+                        theta_deg=self.theta_deg, delta_deg=self.delta_deg)
+
+    def front(self, t: float) -> float | None:
+        """Position [m] of the dry front at ``t`` (None on a wet bed)."""
+        if self.h_right > 0:
+            return None
+        th = math.radians(self.theta_deg)
+        gz = self.g * math.cos(th)
+        m = gz * (math.tan(th) - math.tan(math.radians(self.delta_deg)))
+        return self.x0 + 2 * math.sqrt(gz * self.h_left) * t + 0.5 * m * t * t
+
+    def cell_averages(self, edges: np.ndarray, t: float,
+                      points: int = 8) -> tuple[np.ndarray, np.ndarray]:
+        """Cell averages of (h [m], hu [m^2/s]) between ``edges`` [m] (midpoint rule
+        with ``points`` points per cell)."""
+        lo, hi = edges[:-1], edges[1:]
+        frac = (np.arange(points) + 0.5) / points
+        x = lo[:, None] + (hi - lo)[:, None] * frac[None, :]
+        h, u = self(x, t)
+        return h.mean(axis=1), (h * u).mean(axis=1)
+
+
+def exact_solution_for(case: Any, model: str = "single_layer") -> ExactSolution | None:
+    """The exact solution of a case, or None if it has none.
+
+    Single-layer dam breaks (``initial.shape = "dam_break"``): onto a dry bed with
+    phi_B <= theta, Mangeney's solution (Ritter's for theta = phi_B = 0); onto a wet bed
+    (``h_right > 0``) on a flat frictionless bed, Stoker's. Valid while the waves stay
+    inside the domain.
+    """
+    ini = case.initial
+    if model != "single_layer" or ini.get("shape") != "dam_break":
+        return None
+    p = case.make_pde("single_layer").parameters
+    delta = p.phi_b_deg if p.phi_b_deg > FRICTIONLESS_DEG else 0.0
+    h_right = float(ini.get("h_right", 0.0))
+    x0 = case.x_start + float(ini["x_dam"])
+    if h_right > 0:
+        if p.theta_deg != 0.0 or delta != 0.0:
+            return None
+        return ExactSolution("stoker", float(ini["h_left"]), h_right, x0, p.g)
+    if delta > max(p.theta_deg, 0.0) + 1e-6:
+        return None
+    name = "ritter" if p.theta_deg == 0.0 and delta == 0.0 else "mangeney"
+    return ExactSolution(name, float(ini["h_left"]), 0.0, x0, p.g, p.theta_deg, delta)

@@ -1,0 +1,105 @@
+"""Studies: runs over a grid of cases, variants and levels, and the table of results.
+
+Every study of pdeflow is the same three things: a list of :class:`Point` (a case, a
+model, a :class:`~pdeflow.variant.Variant` and the labels that place it in the study:
+level, aspect ratio, ...), a *measure* that turns one point into a row of numbers (it
+builds the point's :class:`~pdeflow.simulate.Run` and executes it, once or repeatedly
+for timings), and an *executor* that maps the measure over the points. Convergence,
+work-precision, validation and aspect-ratio sweeps are thin definitions on it
+(:mod:`pdeflow.analysis.convergence`, :mod:`~pdeflow.analysis.workprecision`,
+:mod:`~pdeflow.analysis.validation`, :mod:`pdeflow.sweep`).
+
+Execution is pluggable: an executor is any ``executor(fn, items) -> list`` that returns
+``[fn(item) for item in items]`` in order. :func:`serial` is the default;
+:func:`pool_executor` wraps a ``concurrent.futures`` pool and :func:`dask_executor` a
+Dask client (the study-file engine, :mod:`pdeflow.study`, schedules on Dask the same
+way). A measure must then be a module-level function, so that it pickles.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from functools import partial
+from typing import Any
+
+from ..cases import Case
+from ..simulate import Run
+from ..variant import Variant
+
+Executor = Callable[[Callable[[Any], Any], Sequence[Any]], list[Any]]
+
+
+def serial(fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
+    """Run ``fn`` over ``items`` in this process, in order."""
+    return [fn(item) for item in items]
+
+
+def pool_executor(pool: Any) -> Executor:
+    """An executor on a ``concurrent.futures`` pool (results in order)."""
+    return lambda fn, items: list(pool.map(fn, items))
+
+
+def dask_executor(client: Any) -> Executor:
+    """An executor on a Dask ``distributed.Client`` (results in order)."""
+    return lambda fn, items: client.gather(client.map(fn, list(items), pure=False))
+
+
+@dataclass
+class Point:
+    """One run of a study: a case, a model, a variant, and the labels of its row."""
+
+    case: Case
+    model: str
+    variant: Variant | None = None
+    """None: the variant the case file selects"""
+    labels: dict[str, Any] = field(default_factory=dict)
+
+    def run(self) -> Run:
+        """The point's run, set up (PDE, initial state, solver arguments)."""
+        return Run(self.case, self.model, self.variant)
+
+
+def on_grid(case: Case, *, cells: int | None = None, dx: float | None = None) -> Case:
+    """Copy of ``case`` on another grid: ``cells`` cells, or spacing ``dx`` [m] (which
+    must divide the domain into whole cells, as in a case file)."""
+    c = case.copy()
+    grid = c.data.setdefault("grid", {})
+    grid.pop("cells", None)
+    grid.pop("dx", None)
+    if cells is not None:
+        grid["cells"] = int(cells)
+    elif dx is not None:
+        grid["dx"] = float(dx)
+    c.validate()
+    return c
+
+
+def refined(case: Case, level: int, dx0: float | None = None) -> Case:
+    """Copy of ``case`` with dx = dx0 / 2**level (dx0: the case's dx)."""
+    return on_grid(case, dx=(case.dx if dx0 is None else dx0) / 2**level)
+
+
+def with_sets(case: Case, items: Iterable[str]) -> Case:
+    """Copy of ``case`` with ``section.key=value`` overrides applied, validated."""
+    c = case.copy()
+    for item in items:
+        c.set(item)
+    c.validate()
+    return c
+
+
+def _row(measure: Callable[[Point], dict[str, Any]], point: Point) -> dict[str, Any]:
+    return {**point.labels, **measure(point)}
+
+
+@dataclass
+class Study:
+    """Points and the measure that turns each into a row of results."""
+
+    points: list[Point]
+    measure: Callable[[Point], dict[str, Any]]
+
+    def execute(self, executor: Executor = serial) -> list[dict[str, Any]]:
+        """The rows ``{**point.labels, **measure(point)}``, in the order of the points."""
+        return executor(partial(_row, self.measure), self.points)
