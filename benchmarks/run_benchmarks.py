@@ -42,8 +42,12 @@ FIGURES = ROOT / "docs" / "figures"
 DOC = ROOT / "docs" / "performance.md"
 
 WP_CASES: dict[str, dict[str, Any]] = {
-    "ritter": {"case": "ritter", "grids": [125, 250, 500, 1000], "t": 0.5},
-    "mangeney": {"case": "mangeney", "grids": [150, 300, 600, 1200], "t": 0.5},
+    # the exact-solution cases on a domain that holds the waves until t, at CFL 0.45
+    "ritter": {"case": "cases/ritter_dam_break.toml", "grids": [125, 250, 500, 1000],
+               "t": 0.5, "set": ["grid.length=2.5", "numerics.cfl=0.45"]},
+    "mangeney": {"case": "cases/mangeney_dam_break_slope.toml",
+                 "grids": [150, 300, 600, 1200], "t": 0.5,
+                 "set": ["grid.length=3.0", "numerics.cfl=0.45", "case.t_end=0.5"]},
     "paper_5_1_dam_break": {"case": str(suite.CASE_5_1.relative_to(ROOT)),
                             "grids": [0.05, 0.025, 0.0125], "t": 0.4},
     # the same against one common reference: do the variants converge to one solution?
@@ -89,6 +93,8 @@ def conditions() -> dict[str, Any]:
 def measure_wp(quick: bool, repeats: int, results: Path = RESULTS) -> dict[str, Any]:
     """Work-precision studies, the mol-rk stiffness probe and the hyperbolicity modes."""
     from pdeflow.analysis import workprecision as wp
+    from pdeflow.analysis.hyperbolicity_modes import hyperbolicity_study
+    from pdeflow.cases import load_case
 
     out: dict[str, Any] = {"conditions": conditions(), "cases": {}}
     figures = results / "figures" if quick else FIGURES
@@ -98,10 +104,12 @@ def measure_wp(quick: bool, repeats: int, results: Path = RESULTS) -> dict[str, 
         variants = (["hll/first-order", "hll/muscl/minmod", "mol-rk"] if quick
                     else list(wp.DEFAULT_VARIANTS))
         case = cfg["case"]
-        res = wp.compare(case, variants, grids, cfg.get("reference", "auto"), None,
+        res = wp.compare(load_case(ROOT / case, cfg.get("set", [])), variants, grids,
+                         cfg.get("reference", "auto"), None,
                          t=cfg["t"], repeats=repeats, label=label, log=sys.stderr)
         fig = wp.plot(res, figures / f"workprecision_{res.case}.png")
-        out["cases"][res.case] = {"source": case, "t": res.t, "rows": res.rows,
+        out["cases"][res.case] = {"source": " --set ".join([case, *cfg.get("set", [])]),
+                                  "t": res.t, "rows": res.rows,
                                   "figure": str(fig.relative_to(ROOT) if fig.is_relative_to(ROOT)
                                                 else fig)}
     # mol-rk on the two-layer 5.1 case with ever smaller time steps: fail or crawl
@@ -113,7 +121,7 @@ def measure_wp(quick: bool, repeats: int, results: Path = RESULTS) -> dict[str, 
                          log=sys.stderr)
         probe.append({"cfl": cfl, **res.rows[0]})
     out["mol_probe"] = probe
-    out["hyperbolicity"] = wp.hyperbolicity_study(
+    out["hyperbolicity"] = hyperbolicity_study(
         suite.CASE_5_1, grids=[0.05] if quick else [0.05, 0.0125], repeats=repeats,
         log=sys.stderr)
     return out
@@ -228,7 +236,7 @@ def render(wp: dict[str, Any] | None, bench: dict[str, Any] | None,
       "sum |h - h_ref| dx [m^2], momentum sum |hu - (hu)_ref| dx [m^3/s]; against the "
       "cell averages of the exact solution, or against a fine-grid run of the same "
       "variant (dx_ref = min dx / 4) averaged onto the coarse cells.")
-    a("* The harness: `python -m pdeflow.analysis.workprecision CASE --variants ... "
+    a("* The harness: `pdeflow compare CASE --variants ... "
       "--grids ...` (function `pdeflow.analysis.workprecision.compare`, see its "
       "docstring); the suite: `benchmarks/suite.py`, pytest-benchmark tests in "
       "`benchmarks/test_benchmarks.py` (`python -m pytest benchmarks`, not part of the "

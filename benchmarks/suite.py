@@ -107,13 +107,14 @@ def cell_update_rates(variants: Sequence[str] = BENCH_VARIANTS, dx: float = 0.01
                       t_end: float = 0.4, repeats: int = 5) -> list[dict[str, Any]]:
     """Cell updates per second of every model and variant on the 5.1 case (dx [m],
     run to ``t_end`` [s]), with the compiled fv-split stepper."""
-    from pdeflow.analysis.workprecision import case_on_grid, parse_variant, resolve_case
+    from pdeflow.analysis.workprecision import case_on_grid, resolve_case
+    from pdeflow.variant import Variant
 
     base = resolve_case(CASE_5_1)
     rows = []
     for model in ("single_layer", "two_layer"):
         for name in variants:
-            v = parse_variant(name)
+            v = Variant.parse(name)
             c = case_on_grid(base, dx, v)
             run = fv_stepper_run(c, model, t_end)
             out = run()
@@ -124,7 +125,7 @@ def cell_update_rates(variants: Sequence[str] = BENCH_VARIANTS, dx: float = 0.01
                          "cell_updates_per_s": updates / med,
                          "ns_per_cell_update": 1e9 * med / updates})
     # where the two-layer cost goes: the same run without restoring hyperbolicity
-    c = case_on_grid(base, dx, parse_variant("hll/first-order"))
+    c = case_on_grid(base, dx, Variant.parse("hll/first-order"))
     c.data.setdefault("two_layer", {})["hyperbolicity"] = "none"
     run = fv_stepper_run(c, "two_layer", t_end)
     out = run()

@@ -417,17 +417,13 @@ def build_parser() -> argparse.ArgumentParser:
                         description=convergence.__doc__, formatter_class=raw)
     convergence.add_arguments(cv)
     cv.set_defaults(func=convergence.cmd_converge)
+    from .analysis import workprecision
+
     cp = sub.add_parser("compare", help="work-precision study: error against wall time "
                         "of solver variants (to compare runs, use plot)",
-                        description="Work-precision study: runs every variant on a sequence "
-                        "of grids against an exact solution or a fine-grid reference; "
-                        "writes a work-precision diagram and table "
-                        "(pdeflow.analysis.workprecision). `pdeflow compare --help` lists "
-                        "its options.", formatter_class=raw)
-    cp.add_argument("args", nargs=argparse.REMAINDER,
-                    help="CASE.toml|ritter|mangeney [--variants V ...] [--grids N|DX ...] "
-                    "[--reference auto|exact|fine|fine:VARIANT] [--out-dir DIR] ...")
-    cp.set_defaults(func=cmd_compare)
+                        description=workprecision.HELP, formatter_class=raw)
+    workprecision.add_arguments(cp)
+    cp.set_defaults(func=workprecision.cmd_compare)
 
     # --- study ----------------------------------------------------------------------------
     from .study import command as study_cmd
@@ -445,13 +441,6 @@ def build_parser() -> argparse.ArgumentParser:
     app_server.add_arguments(ap)
     ap.set_defaults(func=app_server.cmd_app)
     return parser
-
-
-def cmd_compare(args: argparse.Namespace) -> int:
-    """Forward to :func:`pdeflow.analysis.workprecision.main` (its own options)."""
-    from .analysis import workprecision
-
-    return int(workprecision.main(list(args.args)) or 0)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -481,11 +470,6 @@ def _main(argv: list[str] | None = None) -> int:
     from .storage import StorageError
 
     argv = sys.argv[1:] if argv is None else list(argv)
-    if argv[:1] == ["compare"]:
-        # the work-precision harness parses its own options (and its own --help)
-        from .analysis import workprecision
-
-        return int(workprecision.main(argv[1:], prog="pdeflow compare") or 0)
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)

@@ -112,6 +112,18 @@ class Run:
         return {"solver": "fv-split", "cfl": self.case.cfl, "backend": self.backend,
                 "splitting": self.variant.splitting}
 
+    def make_solver(self) -> Any:
+        """The py-pde solver of this run (for timing the bare stepper, as the
+        work-precision study does: ``solver.make_stepper(state[, dt])``)."""
+        from pde.solvers.base import SolverBase
+
+        kwargs = self.solver_arguments()
+        name = kwargs.pop("solver")
+        kwargs.pop("dt", None)  # a fixed step is the stepper's argument
+        if self.variant.is_mol:
+            kwargs["backend"] = self.backend
+        return SolverBase.from_name(name, self.pde, **kwargs)
+
     def execute(self, tracker: Any = None) -> RunResult:
         """Integrate to rest or ``case.t_end`` and summarise.
 

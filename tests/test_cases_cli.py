@@ -125,7 +125,8 @@ def test_cli_sweep_converge_compare(tmp_path):
                "--summary", str(conv)])
     assert rc == 0
     assert len(json.loads(conv.read_text())["levels"]) == 2
-    rc = main(["compare", "ritter", "--variants", "hll/first-order", "--grids", "50", "100",
-               "--out-dir", str(tmp_path / "wp"), "--quiet", "--repeats", "1"])
+    rc = main(["compare", str(ROOT / "cases" / "ritter_dam_break.toml"), "--variants",
+               "hll/first-order", "--grids", "50", "100", "--out-dir", str(tmp_path / "wp"),
+               "--quiet", "--repeats", "1"])
     assert rc == 0
-    assert (tmp_path / "wp" / "ritter_workprecision.png").stat().st_size > 1000
+    assert (tmp_path / "wp" / "ritter_dam_break_workprecision.png").stat().st_size > 1000

@@ -7,21 +7,16 @@ import numpy as np
 import pytest
 
 from pdeflow.analysis import workprecision as wp
+from pdeflow.analysis.timing import mol_time_step
+from pdeflow.cases import load_case
+from pdeflow.simulate import Run
+from pdeflow.variant import Variant
 
-CASE_5_1 = Path(__file__).parents[1] / "cases" / "paper_5_1_dam_break.toml"
-
-
-def test_variant_names():
-    v = wp.parse_variant("ifcp/muscl/mc+strang")
-    assert (v.flux, v.reconstruction, v.limiter, v.splitting, v.solver) == (
-        "ifcp", "muscl", "mc", "strang", "fv-split")
-    assert wp.parse_variant("rusanov/muscl").limiter == "minmod"
-    assert wp.parse_variant("hll/first-order").splitting == "lie"
-    assert wp.parse_variant("mol-rk").solver == "runge-kutta"
-    for bad in ("roe/first-order", "hll/weno", "hll/first-order/mc", "hll/muscl/superbee",
-                "hll/muscl+marchuk"):
-        with pytest.raises(ValueError, match="variant"):
-            wp.parse_variant(bad)
+CASES = Path(__file__).parents[1] / "cases"
+CASE_5_1 = CASES / "paper_5_1_dam_break.toml"
+# the work-precision benchmark's Ritter problem (benchmarks/run_benchmarks.py)
+RITTER = load_case(CASES / "ritter_dam_break.toml",
+                   ["grid.length=2.5", "numerics.cfl=0.45", "output.snapshot_times=[]"])
 
 
 def test_restriction_is_exact_cell_averaging():
@@ -38,8 +33,8 @@ def test_restriction_is_exact_cell_averaging():
 
 
 def test_ritter_errors_fall_and_outputs_are_written(tmp_path):
-    res = wp.compare("ritter", ["hll/first-order", "hll/muscl/minmod"], [50, 100, 200],
-                     out_dir=tmp_path, repeats=1)
+    res = wp.compare(RITTER, ["hll/first-order", "hll/muscl/minmod"], [50, 100, 200],
+                     out_dir=tmp_path, repeats=1, label="ritter")
     assert len(res.rows) == 6
     for r in res.rows:
         assert r["status"] == "ok" and r["reference"] == "exact Ritter"
@@ -70,26 +65,33 @@ def test_fine_reference_on_the_two_layer_case(tmp_path):
 
 
 def test_exact_reference_is_found_for_dam_breaks_only():
-    ritter = wp.resolve_case("ritter")
-    assert wp.exact_solution_for(ritter, "single_layer")["theta_deg"] == 0.0
-    assert wp.exact_solution_for(ritter, "two_layer") is None
-    assert wp.exact_solution_for(wp.resolve_case(CASE_5_1), "single_layer") is None
+    from pdeflow.analysis.exact import exact_solution_for
+
+    assert exact_solution_for(RITTER, "single_layer").name == "ritter"
+    assert exact_solution_for(RITTER, "two_layer") is None
+    assert exact_solution_for(wp.resolve_case(CASE_5_1), "single_layer") is None
     with pytest.raises(ValueError, match="no exact solution"):
         wp.compare(CASE_5_1, ["hll/first-order"], [0.5], reference="exact", out_dir=None,
                    models=["single_layer"])
 
 
 def test_mol_time_step_is_cfl_bound_and_divides_t():
-    case = wp.case_on_grid(wp.resolve_case("ritter"), 100, wp.parse_variant("mol-rk"))
-    dt = wp.mol_time_step(case, "single_layer", 0.5)
+    case = wp.case_on_grid(RITTER, 100, Variant.parse("mol-rk"))
+    dt = mol_time_step(Run(case, "single_layer"), 0.5)
     c0 = np.sqrt(9.81 * 0.1)
     assert dt <= 0.45 * case.dx / (2 * c0) + 1e-15
     assert abs(0.5 / dt - round(0.5 / dt)) < 1e-9
 
 
 def test_command_line(tmp_path, capsys):
-    assert wp.main(["ritter", "--variants", "rusanov/first-order", "--grids", "50", "100",
-                    "--repeats", "1", "--out-dir", str(tmp_path), "--quiet"]) == 0
+    from pdeflow.cli import main
+
+    ritter = str(CASES / "ritter_dam_break.toml")
+    assert main(["compare", ritter, "--set", "numerics.cfl=0.45", "--variants",
+                 "rusanov/first-order", "--grids", "50", "100", "--repeats", "1",
+                 "--out-dir", str(tmp_path), "--quiet"]) == 0
     out = capsys.readouterr().out
-    assert "rusanov/first-order" in out and (tmp_path / "ritter_workprecision.png").exists()
-    assert wp.main(["ritter", "--variants", "roe/first-order", "--quiet"]) == 2
+    assert "rusanov/first-order" in out
+    assert (tmp_path / "ritter_dam_break_workprecision.png").exists()
+    assert main(["compare", ritter, "--variants", "roe/first-order", "--quiet"]) == 2
+    assert "flux must be one of" in capsys.readouterr().err

@@ -80,12 +80,14 @@ def refined(case: Case, level: int, dx0: float | None = None) -> Case:
     return on_grid(case, dx=(case.dx if dx0 is None else dx0) / 2**level)
 
 
-def with_sets(case: Case, items: Iterable[str]) -> Case:
-    """Copy of ``case`` with ``section.key=value`` overrides applied, validated."""
+def with_sets(case: Case, items: Iterable[str], validate: bool = True) -> Case:
+    """Copy of ``case`` with ``section.key=value`` overrides applied (validated unless
+    the caller changes more before validating once)."""
     c = case.copy()
     for item in items:
         c.set(item)
-    c.validate()
+    if validate:
+        c.validate()
     return c
 
 

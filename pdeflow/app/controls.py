@@ -18,13 +18,14 @@ from typing import Any, ClassVar
 
 import panel as pn
 
-from ..analysis.workprecision import DEFAULT_VARIANTS, MOL_RK, parse_variant
+from ..analysis.workprecision import DEFAULT_VARIANTS
 from ..cases import Case, CaseError, load_case
 from ..models import SingleLayerParameters, TwoLayerParameters
+from ..variant import Variant
 
 CLOSURES = ("paper", "relaxed")
 """The exchange closures offered (a case with another one adds it to the choice)."""
-SCHEMES = tuple(v for v in DEFAULT_VARIANTS if v != MOL_RK)
+SCHEMES = tuple(v for v in DEFAULT_VARIANTS if not Variant.parse(v).is_mol)
 """fv-split variants offered, by the names of ``pdeflow compare`` (FLUX/REC[/LIM][+SPLIT])."""
 MAX_CELLS = 20_000
 """Larger grids would keep the server busy for seconds per slider move: refused."""
@@ -253,11 +254,9 @@ class ParameterControls:
                 case, "two_layer.exchange_closure"):
             out.append(f"two_layer.exchange_closure={toml_value(self.closure.value)}")
         if not self.scheme.disabled and self.scheme.value != case_scheme(case):
-            eq = case.make_pde(case.models[0])
-            own = {"flux": eq.flux, "reconstruction": eq.reconstruction,
-                   "limiter": eq.limiter, "splitting": case.splitting}
-            for key, value in parse_variant(self.scheme.value).numerics.items():
-                if own[key] != value:
+            own = Variant.from_case(case).numerics()
+            for key, value in Variant.parse(self.scheme.value).numerics().items():
+                if own.get(key) != value:
                     out.append(f"numerics.{key}={toml_value(value)}")
         return out
 
