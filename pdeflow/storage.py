@@ -32,8 +32,6 @@ from __future__ import annotations
 import datetime
 import json
 import math
-import os
-import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,6 +40,7 @@ from typing import Any
 import numpy as np
 from pde.trackers.base import InfoDict, TrackerBase
 
+from .io import PendingFile, atomic_path, jsonable
 from .trackers import fextra_over_rho1  # noqa: F401 - also re-exported for live.py
 
 FORMAT = "pdeflow-run/1"
@@ -66,68 +65,7 @@ def require_h5py() -> None:
                            "pip install 'pdeflow[storage]'") from None
 
 
-def jsonable(value: Any) -> Any:
-    """``value`` with numpy scalars/arrays and tuples turned into JSON types."""
-    if isinstance(value, dict):
-        return {str(k): jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return jsonable(value.tolist())
-    if isinstance(value, np.generic):
-        return jsonable(value.item())
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, Path):
-        return str(value)
-    return value
-
-
 # --- helpers shared with the live plots ---------------------------------------------------
-class PendingFile:
-    """A file written under a temporary name next to ``path`` and renamed on commit.
-
-    The temporary name keeps the suffix (``.NAME.XXXX.part.SUFFIX``), so that writers
-    that choose a format by the file name (movies) still do so.
-    """
-
-    def __init__(self, path: str | Path):
-        self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.",
-                                   suffix=f".part{self.path.suffix}", dir=self.path.parent)
-        os.close(fd)
-        self.tmp = Path(tmp)
-        self.done = False
-
-    def commit(self) -> Path:
-        """Rename the temporary file onto the target; return the target.
-
-        The file gets the permissions of a file created normally (mkstemp makes
-        temporary files private to the user).
-        """
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(self.tmp, 0o666 & ~umask)
-        os.replace(self.tmp, self.path)
-        self.done = True
-        return self.path
-
-    def discard(self) -> None:
-        """Remove the temporary file (the target is left as it was)."""
-        self.tmp.unlink(missing_ok=True)
-        self.done = True
-
-    def __enter__(self) -> Path:
-        return self.tmp
-
-    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
-        if exc_type is None:
-            self.commit()
-        else:
-            self.discard()
-
-
 def final_time(info: InfoDict | None) -> float | None:
     """End time [s] of a run from the controller's diagnostics: the rest time if the
     ``fv-split`` solver stopped at rest, else the controller's final time."""
@@ -392,7 +330,7 @@ class StoredRun:
     def to_csv(self, path: str | Path) -> Path:
         """Write the long table as CSV (header t,x,...; units in docs/user_guide.md)."""
         header = ",".join(["t", "x", *self.columns()])
-        with PendingFile(path) as tmp:
+        with atomic_path(path) as tmp:
             np.savetxt(tmp, self.table(), delimiter=",", header=header, comments="",
                        fmt="%.10g")
         return Path(path)
@@ -404,7 +342,7 @@ class StoredRun:
         for name in self.columns():
             arrays[name] = np.stack([p[name] for p in per])
         arrays["metadata_json"] = np.array(json.dumps(self.metadata))
-        with PendingFile(path) as tmp, tmp.open("wb") as fh:
+        with atomic_path(path) as tmp, tmp.open("wb") as fh:
             np.savez(fh, **arrays)
         return Path(path)
 
@@ -431,7 +369,7 @@ class StoredRun:
     def to_netcdf(self, path: str | Path) -> Path:
         """Write :meth:`to_xarray` as NetCDF (engine chosen by xarray)."""
         ds = self.to_xarray()
-        with PendingFile(path) as tmp:
+        with atomic_path(path) as tmp:
             ds.to_netcdf(tmp)
         return Path(path)
 
@@ -500,5 +438,5 @@ def open_run(path: str | Path) -> StoredRun:
     return StoredRun(path, times, x, state, fextra, meta)
 
 
-__all__ = ["FORMAT", "PendingFile", "RunStorageTracker", "StorageError", "StoredRun",
+__all__ = ["FORMAT", "RunStorageTracker", "StorageError", "StoredRun",
            "final_time", "fextra_over_rho1", "open_run", "open_storage", "run_metadata"]

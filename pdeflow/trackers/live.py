@@ -40,8 +40,9 @@ import numpy as np
 from pde.trackers import ProgressTracker
 from pde.trackers.base import InfoDict, TrackerBase
 
+from ..io import PendingFile
 from ..plotting import RunFigure, Series
-from ..storage import PendingFile, fextra_over_rho1, model_of, show_final_state
+from ..storage import fextra_over_rho1, model_of, show_final_state
 
 #: movie containers written with H.264 through ffmpeg (WebM cannot hold H.264)
 FFMPEG_SUFFIXES = (".mp4", ".m4v", ".mov", ".mkv", ".avi")
