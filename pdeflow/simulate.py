@@ -14,8 +14,9 @@ from .analysis.metrics import front_position, mass
 from .cases import Case
 from .checks import RunWarning, cost_warning, domain_ends, result_warnings, solver_warning
 from .numerics import layout as L
+from .numerics.state import velocity_profile
 from .solvers.fv_split import load_kernels
-from .trackers import SnapshotTracker
+from .trackers import FextraStorageTracker
 
 
 @dataclass
@@ -47,12 +48,12 @@ class RunResult:
         """x, depths and velocities of the final state (keys as in the ``--final`` npz)."""
         out = {"x": self.x, "t": np.float64(self.t_final)}
         d = self.state.data
-        dry = 1e-12
+        dry = self.case.make_pde(self.model).parameters.dry_tolerance
         names = ("h1", "u1", "h2", "u2") if self.model == "two_layer" else ("h", "u")
         for k in range(0, d.shape[0], 2):
             h = d[k]
             out[names[k]] = h.copy()
-            out[names[k + 1]] = np.where(h > dry, d[k + 1] / np.where(h > dry, h, 1), 0)
+            out[names[k + 1]] = velocity_profile(h, d[k + 1], dry)
         return out
 
 
@@ -78,7 +79,7 @@ def run_model(case: Case, model: str, *, tracker: Any = None,
     r = eq.parameters.density_ratio if model == "two_layer" else None
     mass0 = mass(state.data, dx, r)
     initial = state.data.copy()
-    snaps = SnapshotTracker(interrupts=sorted(case.snapshot_times))
+    snaps = FextraStorageTracker(sorted(case.snapshot_times))
     trackers: list[Any] = [snaps] if case.snapshot_times else []
     if tracker is not None:
         trackers.extend(tracker if isinstance(tracker, list) else [tracker])
