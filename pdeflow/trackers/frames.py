@@ -94,23 +94,27 @@ class FextraStorageTracker(StorageTracker):
         super().__init__(MemoryStorage() if storage is None else storage, interrupts)
         self._info: InfoDict | None = None
         self._field: Any = None
+        self._frame: FieldCollection | None = None
         self.last_time = -np.inf
 
     def initialize(self, field: Any, info: InfoDict | None = None) -> float:
         self._info = info
         self._field = field
+        grid = field.grid
+        labels = (*STATE_LABELS[model_of(field)], FEXTRA_LABEL)
+        self._frame = FieldCollection([ScalarField(grid, label=name) for name in labels])
         return super().initialize(field, info)
 
     def _transform(self, field: Any, t: float) -> FieldCollection:
         """The frame: the state's fields (labelled as :data:`STATE_LABELS`), then
-        F_extra/rho1 of the last step."""
-        grid = field.grid
-        labels = STATE_LABELS[model_of(field)]
-        fields = [ScalarField(grid, field.data[k], label=name)
-                  for k, name in enumerate(labels)]
-        fields.append(ScalarField(grid, fextra_over_rho1(self._info, grid.shape[0]),
-                                  label=FEXTRA_LABEL))
-        return FieldCollection(fields)
+        F_extra/rho1 of the last step. One collection is refilled for every frame (the
+        storage copies its data when appending): building one per frame would cost
+        more than the run between two frames of the app's animation."""
+        assert self._frame is not None, "initialize() first"
+        data = self._frame.data
+        data[:-1] = field.data
+        data[-1] = fextra_over_rho1(self._info, data.shape[1])
+        return self._frame
 
     def handle(self, field: Any, t: float) -> None:
         super().handle(field, t)
