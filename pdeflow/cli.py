@@ -102,18 +102,18 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
 
         progress = not args.quiet and (sys.stdout.isatty() or run_cost(case, model).long)
     if progress:
-        from .trackers.live import ProgressBar
+        from .trackers import ProgressBar
 
         trackers.append(ProgressBar(interval, label=model))
     from .trackers.live import display_mode
 
     show = args.live and display_mode("auto") != "none"  # headless: nothing to show
     if show or args.movie or args.frames:
-        from .trackers.live import LivePlotTracker
+        from .trackers.live import LayersPlotTracker
 
         movie = _model_path(args.movie, model, first) if args.movie else None
         frames = (Path(args.frames) / model) if args.frames else None
-        trackers.append(LivePlotTracker(
+        trackers.append(LayersPlotTracker(
             args.live_every or interval, title=f"{case.name}: {model.replace('_', ' ')}",
             display="auto" if show else "none", movie=movie, frames=frames,
             fps=args.fps))
@@ -270,8 +270,8 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
         check_movie_path(args.movie)
     runs = [open_run(p) for p in args.runs]
-    series = [Series(r.x, r.model, lab) for r, lab in zip(runs, _plot_labels(runs),
-                                                           strict=True)]
+    series = [Series(r.x, r.model, lab, r.dry_tolerance)
+              for r, lab in zip(runs, _plot_labels(runs), strict=True)]
     title = args.title if args.title is not None else runs[0].metadata.get(
         "case_name", runs[0].path.stem)
     written = []

@@ -18,12 +18,15 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .io import atomic_path
+from .numerics.state import DRY_TOLERANCE, velocity_profile
 
 DRY = 1e-9
+"""Depths [m] up to which no surface line is drawn."""
 
 
-def _velocity(h: np.ndarray, m: np.ndarray) -> np.ndarray:
-    return np.where(h > DRY, m / np.where(h > DRY, h, 1.0), np.nan)
+def _velocity(h: np.ndarray, m: np.ndarray, dry: float = DRY_TOLERANCE) -> np.ndarray:
+    """u = hu/h [m/s], NaN (a gap in a line) where the layer is dry."""
+    return velocity_profile(h, m, dry, fill=np.nan)
 
 
 def plot_depths(ax, x: np.ndarray, two: np.ndarray | None,
@@ -159,6 +162,8 @@ class Series:
     """'two_layer' (state h1, h1u1, h2, h2u2) or 'single_layer' (state h, hu)"""
     label: str = ""
     """legend label (default: the model name)"""
+    dry: float = DRY_TOLERANCE
+    """the model's dry tolerance [m]: no velocity is drawn where a layer is thinner"""
 
 
 class RunFigure:
@@ -336,7 +341,7 @@ class RunFigure:
                 top = h1 + h2
                 ln["surface"].set_ydata(np.where(top > DRY, top, np.nan))
                 ln["interface"].set_ydata(np.where(h2 > DRY, h2, np.nan))
-                u1, u2 = _velocity(h1, d[1]), _velocity(h2, d[3])
+                u1, u2 = _velocity(h1, d[1], s.dry), _velocity(h2, d[3], s.dry)
                 _set(ln, "u1", u1)
                 _set(ln, "u2", u2)
                 us = [u1, u2]
@@ -351,7 +356,7 @@ class RunFigure:
             else:
                 h = d[0]
                 ln["surface"].set_ydata(np.where(h > DRY, h, np.nan))
-                u = _velocity(h, d[1])
+                u = _velocity(h, d[1], s.dry)
                 _set(ln, "u", u)
                 us = [u]
                 if i == 0:

@@ -22,9 +22,10 @@ from .cases import Case, load_case
 from .checks import RunWarning, cost_warning, domain_ends, result_warnings, solver_warning
 from .metrics import front_position, mass
 from .models.base import GranularPDE
+from .numerics.state import velocity_profile
 from .solvers.diagnostics import SplitDiagnostics
 from .solvers.fv_split import load_kernels
-from .trackers import SnapshotTracker
+from .trackers import FextraStorageTracker
 from .variant import Variant
 
 
@@ -59,12 +60,12 @@ class RunResult:
         """x, depths and velocities of the final state (keys as in the ``--final`` npz)."""
         out = {"x": self.x, "t": np.float64(self.t_final)}
         d = self.state.data
-        dry = 1e-12
+        dry = self.pde.parameters.dry_tolerance
         names = ("h1", "u1", "h2", "u2") if self.model == "two_layer" else ("h", "u")
         for k in range(0, d.shape[0], 2):
             h = d[k]
             out[names[k]] = h.copy()
-            out[names[k + 1]] = np.where(h > dry, d[k + 1] / np.where(h > dry, h, 1), 0)
+            out[names[k + 1]] = velocity_profile(h, d[k + 1], dry)
         return out
 
 
@@ -137,7 +138,7 @@ class Run:
                 warnings.warn(message, RunWarning, stacklevel=2)
         r = self.pde.parameters.density_ratio if model == "two_layer" else None
         mass0 = mass(self.state.data, case.dx, r)
-        snaps = SnapshotTracker(interrupts=sorted(case.snapshot_times))
+        snaps = FextraStorageTracker(sorted(case.snapshot_times))
         trackers: list[Any] = [snaps] if case.snapshot_times else []
         if tracker is not None:
             trackers.extend(tracker if isinstance(tracker, list) else [tracker])

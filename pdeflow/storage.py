@@ -10,17 +10,22 @@ Writing (``pdeflow run CASE --store out.h5 [--store-every DT]``, or in Python)::
     run.times, run.x, run.profiles(-1)["h1"], run.metadata["parameters"]
     run.to_csv("out.csv"); run.to_netcdf("out.nc")          # NetCDF needs xarray
 
-Each stored frame is a py-pde ``FieldCollection`` of the state (h1, h1u1, h2, h2u2 or
-h, hu; depths in m, discharges in m^2/s) followed by the field ``fextra_over_rho1``
-[m^2/s^2] read from the ``fv-split`` solver's post-step data (zeros for other solvers
-and for one layer). Frames are taken at the tracker's interrupts (simulation time, s)
-and once more at the end of the run (the rest time when the solver stops at rest).
-The file is therefore also readable with plain py-pde: ``pde.FileStorage(path)``.
+:class:`RunStorageTracker` is py-pde's ``StorageTracker`` on a ``FileStorage`` (through
+:class:`pdeflow.trackers.FextraStorageTracker`): each stored frame is a py-pde
+``FieldCollection`` of the state (h1, h1u1, h2, h2u2 or h, hu; depths in m, discharges
+in m^2/s) followed by the field ``fextra_over_rho1`` [m^2/s^2] read from the
+``fv-split`` solver's post-step data (zeros for other solvers and for one layer).
+Frames are taken at the tracker's interrupts (simulation time, s) and once more at the
+end of the run (the rest time when the solver stops at rest). The file is therefore
+also readable with plain py-pde: ``pde.FileStorage(path)``.
 
 Metadata (JSON in the HDF5 attribute ``pdeflow``): the format tag, pdeflow and py-pde
 versions, case name, file and data (all sections, after overrides), the overrides,
 the model, its variant, its parameters, and at the end t_final, the stop reason and
-(when written by the CLI) the run's summary.
+(when written by the CLI) the run's summary. Beside it, py-pde stores its own
+attributes (the controller's information, the field attributes).
+Velocities (in :meth:`StoredRun.profiles` and the exports) are zero where a layer is
+not thicker than the model's dry tolerance, as in the solver.
 
 Files are complete or absent: the run writes to a temporary name next to the target
 (``.NAME.XXXX.part.h5``) and renames it once the run has finished; a run that fails
@@ -31,26 +36,28 @@ from __future__ import annotations
 
 import datetime
 import json
-import math
-import os
-import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from pde.trackers.base import InfoDict, TrackerBase
+from pde.trackers.base import InfoDict
 
-from .trackers import fextra_over_rho1  # noqa: F401 - also re-exported for live.py
+from .io import PendingFile, atomic_path, jsonable
+from .numerics.state import DRY_TOLERANCE, velocity_profile
+from .trackers.frames import (
+    FEXTRA_LABEL,
+    STATE_LABELS,
+    FextraStorageTracker,
+    model_of,
+    show_final_state,
+)
 
 FORMAT = "pdeflow-run/1"
-FEXTRA_LABEL = "fextra_over_rho1"
-STATE_LABELS = {"two_layer": ("h1", "h1u1", "h2", "h2u2"), "single_layer": ("h", "hu")}
 UNITS = {"h1": "m", "h2": "m", "h": "m", "u1": "m/s", "u2": "m/s", "u": "m/s",
          "h1u1": "m^2/s", "h2u2": "m^2/s", "hu": "m^2/s", FEXTRA_LABEL: "m^2/s^2",
          "x": "m", "t": "s"}
-DRY = 1e-12
 
 
 class StorageError(ValueError):
@@ -66,104 +73,7 @@ def require_h5py() -> None:
                            "pip install 'pdeflow[storage]'") from None
 
 
-def jsonable(value: Any) -> Any:
-    """``value`` with numpy scalars/arrays and tuples turned into JSON types."""
-    if isinstance(value, dict):
-        return {str(k): jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return jsonable(value.tolist())
-    if isinstance(value, np.generic):
-        return jsonable(value.item())
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, Path):
-        return str(value)
-    return value
-
-
-# --- helpers shared with the live plots ---------------------------------------------------
-class PendingFile:
-    """A file written under a temporary name next to ``path`` and renamed on commit.
-
-    The temporary name keeps the suffix (``.NAME.XXXX.part.SUFFIX``), so that writers
-    that choose a format by the file name (movies) still do so.
-    """
-
-    def __init__(self, path: str | Path):
-        self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.",
-                                   suffix=f".part{self.path.suffix}", dir=self.path.parent)
-        os.close(fd)
-        self.tmp = Path(tmp)
-        self.done = False
-
-    def commit(self) -> Path:
-        """Rename the temporary file onto the target; return the target.
-
-        The file gets the permissions of a file created normally (mkstemp makes
-        temporary files private to the user).
-        """
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(self.tmp, 0o666 & ~umask)
-        os.replace(self.tmp, self.path)
-        self.done = True
-        return self.path
-
-    def discard(self) -> None:
-        """Remove the temporary file (the target is left as it was)."""
-        self.tmp.unlink(missing_ok=True)
-        self.done = True
-
-    def __enter__(self) -> Path:
-        return self.tmp
-
-    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
-        if exc_type is None:
-            self.commit()
-        else:
-            self.discard()
-
-
-def final_time(info: InfoDict | None) -> float | None:
-    """End time [s] of a run from the controller's diagnostics: the rest time if the
-    ``fv-split`` solver stopped at rest, else the controller's final time."""
-    if not info:
-        return None
-    rest = info.get("solver", {}).get("rest_time")
-    if rest is not None:
-        return float(rest)
-    t = info.get("controller", {}).get("t_final")
-    return None if t is None else float(t)
-
-
-def show_final_state(tracker: Any, info: InfoDict | None) -> float | None:
-    """At ``finalize``: hand the run's last state to ``tracker.handle`` unless the
-    tracker already saw it (its ``last_time``); returns the end time [s] of the run.
-
-    py-pde calls a tracker only at its interrupts, so a run that stops at rest or at
-    t_end between two interrupts would otherwise miss its final state. ``tracker``
-    keeps the last field it handled in ``_field``."""
-    t_end = final_time(info)
-    state = (info or {}).get("last_state", tracker._field)
-    if state is not None and t_end is not None and t_end > tracker.last_time + 1e-12:
-        tracker.handle(state, t_end)
-    return t_end
-
-
-def model_of(field_or_rows: Any) -> str:
-    """'two_layer' for 4 state rows, 'single_layer' for 2."""
-    rows = getattr(field_or_rows, "data", field_or_rows).shape[0]
-    if rows == 4:
-        return "two_layer"
-    if rows == 2:
-        return "single_layer"
-    raise ValueError(f"a granular state has 2 or 4 fields, got {rows}")
-
-
+# --- metadata -----------------------------------------------------------------------------
 def _variant_parts(case: Any, eq: Any) -> list[str]:
     """What distinguishes this run's numerics and closure from the paper's defaults:
     the PDE's scheme (``eq.variant``, e.g. 'hll/first-order'), the splitting, and for
@@ -210,8 +120,10 @@ def run_metadata(case: Any, model: str, *, overrides: Sequence[str] = (),
 
 
 # --- writing ------------------------------------------------------------------------------
-class RunStorageTracker(TrackerBase):
-    """py-pde tracker writing a run to an HDF5 file through py-pde's ``FileStorage``.
+class RunStorageTracker(FextraStorageTracker):
+    """py-pde ``StorageTracker`` writing a run to an HDF5 file (py-pde's ``FileStorage``):
+    the frames of :class:`~pdeflow.trackers.FextraStorageTracker`, the metadata, and
+    the final state.
 
     Args:
         path: the HDF5 file to create (replaced only once the run has finished).
@@ -230,77 +142,54 @@ class RunStorageTracker(TrackerBase):
     def __init__(self, path: str | Path, interrupts: Any = 0.05, *,
                  metadata: dict[str, Any] | None = None, autocommit: bool = True,
                  compression: bool = True):
-        super().__init__(interrupts=interrupts)
+        super().__init__(interrupts)
+        self.storage = None  # a FileStorage on a temporary file, made when the run starts
         self.path = Path(path)
         self.metadata = dict(metadata or {})
         self.autocommit = autocommit
         self.compression = compression
         self._pending: PendingFile | None = None
-        self._storage: Any = None
-        self._info: InfoDict | None = None
-        self._field: Any = None
-        self._labels: tuple[str, ...] = ()
-        self.last_time = -math.inf
         self.frames = 0
 
-    def _collection(self, state: Any, fex: np.ndarray) -> Any:
-        from pde import FieldCollection, ScalarField
-
-        grid = state.grid
-        fields = [ScalarField(grid, state.data[k].copy(), label=name)
-                  for k, name in enumerate(self._labels)]
-        fields.append(ScalarField(grid, fex, label=FEXTRA_LABEL))
-        return FieldCollection(fields)
-
     def initialize(self, field: Any, info: InfoDict | None = None) -> float:
+        import pde
         from pde import FileStorage
 
-        require_h5py()
-        self._info = info
-        self._field = field
-        model = model_of(field)
-        self._labels = STATE_LABELS[model]
-        meta = {"format": FORMAT, "model": model, **self.metadata}
-        import pde
-
         from . import __version__
+
+        require_h5py()
+        model = model_of(field)
+        meta = {"format": FORMAT, "model": model, **self.metadata}
         meta.setdefault("pdeflow_version", __version__)
         meta["py_pde_version"] = pde.__version__
         meta["created"] = datetime.datetime.now(datetime.timezone.utc).isoformat(
             timespec="seconds")
-        meta["fields"] = [*self._labels, FEXTRA_LABEL]
+        meta["fields"] = [*STATE_LABELS[model], FEXTRA_LABEL]
         meta["units"] = {k: UNITS[k] for k in meta["fields"]}
         self._pending = PendingFile(self.path)
-        self._storage = FileStorage(self._pending.tmp, info={"pdeflow": jsonable(meta)},
-                                    write_mode="truncate_once",
-                                    compression=self.compression)
-        n = field.grid.shape[0]
-        self._storage.start_writing(self._collection(field, np.zeros(n)))
+        self.storage = FileStorage(self._pending.tmp, info={"pdeflow": jsonable(meta)},
+                                   write_mode="truncate_once",
+                                   compression=self.compression)
         return super().initialize(field, info)
 
     def handle(self, field: Any, t: float) -> None:
-        self._field = field
-        fex = fextra_over_rho1(self._info, field.grid.shape[0])
-        self._storage.append(self._collection(field, fex), time=float(t))
-        self.last_time = float(t)
+        super().handle(field, t)
         self.frames += 1
 
     def finalize(self, info: InfoDict | None = None) -> None:
-        super().finalize(info)
-        if self._storage is None:
+        if self.storage is None:
             return
         info = info or {}
         t_end = show_final_state(self, info)
         controller = info.get("controller", {})
-        self._storage.info["pdeflow"].update(jsonable({
+        self.storage.info["pdeflow"].update(jsonable({
             "t_final": t_end,
             "stop_reason": controller.get("stop_reason"),
             "successful": controller.get("successful"),
             "at_rest": "rest_time" in info.get("solver", {}),
             "frames": self.frames,
         }))
-        self._storage.end_writing()
-        self._storage.close()
+        super().finalize(info)  # py-pde writes the metadata and closes the file
         if self.autocommit:
             self.commit()
 
@@ -319,9 +208,9 @@ class RunStorageTracker(TrackerBase):
 
     def discard(self) -> None:
         """Abandon the run's file (used when a run fails): nothing is left behind."""
-        if self._storage is not None:
+        if self.storage is not None:
             try:
-                self._storage.close()
+                self.storage.close()
             except Exception:  # pragma: no cover - closing a broken file
                 pass
         if self._pending is not None and not self._pending.done:
@@ -353,6 +242,12 @@ class StoredRun:
         return self.model == "two_layer"
 
     @property
+    def dry_tolerance(self) -> float:
+        """The model's dry tolerance [m] (from the metadata; the default without it)."""
+        return float(self.metadata.get("parameters", {}).get("dry_tolerance",
+                                                             DRY_TOLERANCE))
+
+    @property
     def label(self) -> str:
         """File name and model, for legends."""
         return f"{self.path.name} ({self.model.replace('_', ' ')})"
@@ -369,9 +264,8 @@ class StoredRun:
         names = ("h1", "u1", "h2", "u2") if self.two_layer else ("h", "u")
         out: dict[str, np.ndarray] = {}
         for k in range(0, d.shape[0], 2):
-            h = d[k]
-            out[names[k]] = h.copy()
-            out[names[k + 1]] = np.where(h > DRY, d[k + 1] / np.where(h > DRY, h, 1), 0.0)
+            out[names[k]] = d[k].copy()
+            out[names[k + 1]] = velocity_profile(d[k], d[k + 1], self.dry_tolerance)
         if self.two_layer:
             out[FEXTRA_LABEL] = self.fextra[i].copy()
         return out
@@ -392,7 +286,7 @@ class StoredRun:
     def to_csv(self, path: str | Path) -> Path:
         """Write the long table as CSV (header t,x,...; units in docs/user_guide.md)."""
         header = ",".join(["t", "x", *self.columns()])
-        with PendingFile(path) as tmp:
+        with atomic_path(path) as tmp:
             np.savetxt(tmp, self.table(), delimiter=",", header=header, comments="",
                        fmt="%.10g")
         return Path(path)
@@ -404,7 +298,7 @@ class StoredRun:
         for name in self.columns():
             arrays[name] = np.stack([p[name] for p in per])
         arrays["metadata_json"] = np.array(json.dumps(self.metadata))
-        with PendingFile(path) as tmp, tmp.open("wb") as fh:
+        with atomic_path(path) as tmp, tmp.open("wb") as fh:
             np.savez(fh, **arrays)
         return Path(path)
 
@@ -431,7 +325,7 @@ class StoredRun:
     def to_netcdf(self, path: str | Path) -> Path:
         """Write :meth:`to_xarray` as NetCDF (engine chosen by xarray)."""
         ds = self.to_xarray()
-        with PendingFile(path) as tmp:
+        with atomic_path(path) as tmp:
             ds.to_netcdf(tmp)
         return Path(path)
 
@@ -500,5 +394,5 @@ def open_run(path: str | Path) -> StoredRun:
     return StoredRun(path, times, x, state, fextra, meta)
 
 
-__all__ = ["FORMAT", "PendingFile", "RunStorageTracker", "StorageError", "StoredRun",
-           "final_time", "fextra_over_rho1", "open_run", "open_storage", "run_metadata"]
+__all__ = ["FORMAT", "RunStorageTracker", "StorageError", "StoredRun", "open_run",
+           "open_storage", "run_metadata"]

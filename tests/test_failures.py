@@ -396,10 +396,10 @@ def test_npz_that_cannot_be_written_leaves_no_file(tmp_path):
 
 def test_interrupted_run_writes_no_file(tmp_path, monkeypatch):
     from pdeflow.cli import main
-    from pdeflow.trackers import SnapshotTracker
+    from pdeflow.trackers import FextraStorageTracker
 
     calls = []
-    handle = SnapshotTracker.handle
+    handle = FextraStorageTracker.handle
 
     def interrupt(self, field, t):
         calls.append(t)
@@ -407,7 +407,7 @@ def test_interrupted_run_writes_no_file(tmp_path, monkeypatch):
             raise KeyboardInterrupt  # Ctrl-C during the run
         return handle(self, field, t)
 
-    monkeypatch.setattr(SnapshotTracker, "handle", interrupt)
+    monkeypatch.setattr(FextraStorageTracker, "handle", interrupt)
     out = tmp_path / "s.json"
     try:
         rc = main(["run", str(CASE), "-q", "--set", "grid.dx=0.1", "--summary", str(out)])

@@ -14,7 +14,7 @@ from pde.trackers.base import TrackerBase
 
 import pdeflow
 from pdeflow.solvers import fv_split
-from pdeflow.trackers.live import ProgressBar
+from pdeflow.trackers import ProgressBar, progress
 
 ROOT = Path(__file__).parents[1]
 
@@ -49,8 +49,8 @@ def test_named_progress_tracker_is_replaced():
 def test_progress_bar_says_it_compiles_and_restarts_its_clock(monkeypatch, capsys):
     """While the kernels are compiled the bar says so; its clock starts after the
     first interval, so the remaining time comes from the run alone."""
-    monkeypatch.setattr(fv_split, "kernels_ready", lambda: False)
-    monkeypatch.setattr(fv_split, "kernels_cached", lambda: False)
+    monkeypatch.setattr(progress, "kernels_ready", lambda: False)
+    monkeypatch.setattr(progress, "kernels_cached", lambda: False)
     eq, state = _readme_state()
     bar = ProgressBar(0.5, label="two_layer")
     seen = []

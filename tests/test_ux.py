@@ -20,8 +20,8 @@ from pdeflow.analysis import mangeney, ritter  # noqa: E402
 from pdeflow.cases import SCHEMA, load_case  # noqa: E402
 from pdeflow.cli import build_parser, main  # noqa: E402
 from pdeflow.simulate import run_model  # noqa: E402
-from pdeflow.trackers import SnapshotTracker  # noqa: E402
-from pdeflow.trackers.live import LivePlotTracker, MovieError, ffmpeg_path  # noqa: E402
+from pdeflow.trackers import FextraStorageTracker  # noqa: E402
+from pdeflow.trackers.live import LayersPlotTracker, MovieError, ffmpeg_path  # noqa: E402
 
 ROOT = Path(__file__).parents[1]
 CASES = sorted((ROOT / "cases").glob("*.toml"))
@@ -121,7 +121,7 @@ def test_live_plot_headless_frames_gif_and_final_frame(tmp_path):
     from PIL import Image
 
     case = load_case(RITTER, COARSE)
-    live = LivePlotTracker(0.1, title="ritter", movie=tmp_path / "m.gif",
+    live = LayersPlotTracker(0.1, title="ritter", movie=tmp_path / "m.gif",
                            frames=tmp_path / "frames", display="none", dpi=50)
     res = run_model(case, "single_layer", tracker=live)
     assert live.display == "none"
@@ -141,7 +141,7 @@ def test_live_plot_headless_frames_gif_and_final_frame(tmp_path):
 def test_live_plot_last_frame_is_the_rest_state(tmp_path):
     case = load_case(ROOT / "cases" / "heap_slumping.toml",
                      ["output.snapshot_times=[]", "grid.dx=0.02"])
-    live = LivePlotTracker(0.2, display="none")
+    live = LayersPlotTracker(0.2, display="none")
     res = run_model(case, "single_layer", tracker=live)
     assert res.summary["at_rest"]
     assert live.times[-1] == pytest.approx(res.info["solver"]["rest_time"])
@@ -152,7 +152,7 @@ def test_live_plot_last_frame_is_the_rest_state(tmp_path):
 def test_live_plot_mp4(tmp_path):
     case = load_case(RITTER, COARSE)
     run_model(case, "single_layer",
-              tracker=LivePlotTracker(0.1, movie=tmp_path / "m.mp4", display="none",
+              tracker=LayersPlotTracker(0.1, movie=tmp_path / "m.mp4", display="none",
                                       dpi=50))
     data = (tmp_path / "m.mp4").read_bytes()
     assert len(data) > 1000 and data[4:8] == b"ftyp"  # an MP4 container
@@ -175,7 +175,7 @@ def test_live_plot_updates_in_place_in_jupyter(monkeypatch):
 
     monkeypatch.setattr(IPython.display, "display", fake_display)
     case = load_case(RITTER, COARSE)
-    live = LivePlotTracker(0.25, display="jupyter")
+    live = LayersPlotTracker(0.25, display="jupyter")
     run_model(case, "single_layer", tracker=live)
     assert [c[0] for c in calls] == ["display", "update", "update"]
     for _, image in calls:  # PNG images of the figure, one per frame
@@ -186,7 +186,7 @@ def test_live_plot_window_mode_uses_pyplot(recwarn):
     import matplotlib.pyplot as plt
 
     case = load_case(RITTER, COARSE)
-    live = LivePlotTracker(0.25, display="window")
+    live = LayersPlotTracker(0.25, display="window")
     run_model(case, "single_layer", tracker=live)
     assert plt.fignum_exists(live.figure.fig.number)  # left open for plt.show()
     live.figure.close()
@@ -194,18 +194,18 @@ def test_live_plot_window_mode_uses_pyplot(recwarn):
 
 
 def test_live_plot_display_auto_is_headless_under_agg():
-    assert LivePlotTracker(0.1).display == "none"
+    assert LayersPlotTracker(0.1).display == "none"
     with pytest.raises(ValueError, match="display"):
-        LivePlotTracker(0.1, display="screen")
+        LayersPlotTracker(0.1, display="screen")
     with pytest.raises(MovieError, match="unknown movie format"):
-        LivePlotTracker(0.1, movie="x.avi2")
+        LayersPlotTracker(0.1, movie="x.avi2")
 
 
 def test_live_plot_two_layer_draws_fextra(tmp_path):
     case = load_case(ROOT / "cases" / "paper_5_1_dam_break.toml",
                      ["grid.dx=0.1", "case.t_end=0.1", "output.snapshot_times=[]"])
-    snaps = SnapshotTracker([0.05, 0.1])
-    live = LivePlotTracker([0.05, 0.1], display="none")
+    snaps = FextraStorageTracker([0.05, 0.1])
+    live = LayersPlotTracker([0.05, 0.1], display="none")
     run_model(case, "two_layer", tracker=[snaps, live])
     drawn = live.figure._lines[0]["fextra"].get_ydata()
     np.testing.assert_array_equal(drawn, snaps.snapshots[0.1][1])
@@ -218,7 +218,7 @@ def test_store_reopen_metadata_and_fextra(tmp_path):
 
     case = load_case(ROOT / "cases" / "paper_5_1_dam_break.toml",
                      ["grid.dx=0.1", "case.t_end=0.2", "output.snapshot_times=[]"])
-    snaps = SnapshotTracker(0.05)
+    snaps = FextraStorageTracker(0.05)
     path = tmp_path / "run.h5"
     store = RunStorageTracker(path, 0.05, metadata=run_metadata(case, "two_layer"))
     res = run_model(case, "two_layer", tracker=[snaps, store])
@@ -303,7 +303,7 @@ def test_failed_run_leaves_no_files(tmp_path, monkeypatch):
     class Boom(RuntimeError):
         pass
 
-    class Fail(SnapshotTracker):
+    class Fail(FextraStorageTracker):
         def handle(self, field, t):
             if t > 0.2:
                 raise Boom("simulated failure")
@@ -335,7 +335,7 @@ def test_cli_user_errors_are_one_line(argv, words, capsys):
 
 def test_progress_bar_only_on_a_terminal_or_asked(monkeypatch):
     from pdeflow.cli import _run_trackers
-    from pdeflow.trackers.live import ProgressBar as ProgressTracker
+    from pdeflow.trackers import ProgressBar as ProgressTracker
 
     case = load_case(RITTER)
     parser = build_parser()

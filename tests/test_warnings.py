@@ -112,7 +112,7 @@ def test_long_run_is_estimated_warned_and_shows_progress(monkeypatch):
     assert cost_warning(load_case(CASE_51), "two_layer") is None  # 140 cells: silent
     # the progress bar is on by default for a long run, even without a terminal
     from pdeflow.cli import _run_trackers
-    from pdeflow.trackers.live import ProgressBar
+    from pdeflow.trackers import ProgressBar
 
     monkeypatch.setattr("sys.stdout.isatty", lambda: False)
     args = build_parser().parse_args(["run", str(CASE_51)])

@@ -3,7 +3,7 @@
 Every change runs each model of the case twice with :func:`pdeflow.simulate.run_model`:
 once exactly as ``pdeflow run`` does (the summary table, the same numbers as the command
 line printed under it, and the final state: these go to the browser at once), and then
-once with a :class:`~pdeflow.trackers.SnapshotTracker` that records the frames of the
+once with a :class:`~pdeflow.trackers.FextraStorageTracker` that records the frames of the
 animation. The solver lands on every frame time, so those frames come from a run whose
 steps differ a little from the first (by the order of the discretisation error, as any
 tracker's: docs/user_guide.md); the numbers and the last frame never come from it.
@@ -27,13 +27,11 @@ from bokeh.plotting import figure
 
 from ..cases import Case, CaseError
 from ..cli import print_summary
-from ..plotting import (
-    DRY,
-    _velocity,  # u = hu/h, NaN (a gap in a line) where dry
-)
+from ..numerics.state import velocity_profile
+from ..plotting import DRY
 from ..simulate import RunResult, run_model
 from ..solvers.fv_split import SimulationBlowUp
-from ..trackers import SnapshotTracker
+from ..trackers import FextraStorageTracker
 from .controls import ParameterControls, command_line, list_cases, served
 
 FRAMES_PER_T_END = 250
@@ -89,7 +87,7 @@ def _frames(case: Case, model: str) -> list[tuple[float, np.ndarray, np.ndarray]
     c = case.copy()
     c.data.setdefault("output", {})["snapshot_times"] = []
     c.validate()
-    snaps = SnapshotTracker(case.t_end / FRAMES_PER_T_END)
+    snaps = FextraStorageTracker(case.t_end / FRAMES_PER_T_END)
     run_model(c, model, tracker=snaps)
     return [(t, d, f) for t, (d, f) in sorted(snaps.snapshots.items())]
 
@@ -265,7 +263,7 @@ class DamBreakPage:
             self.show_frame(last)
         else:
             self.player.value = last  # the final state, the deposit: watched -> show_frame
-        us = [_velocity(s[:, k], s[:, k + 1]) for s in run.states.values()
+        us = [velocity_profile(s[:, k], s[:, k + 1], fill=np.nan) for s in run.states.values()
               for k in range(0, s.shape[1], 2)]
         lo = min(0.0, *(float(np.nanmin(u)) for u in us if np.isfinite(u).any()))
         hi = max(0.1, *(float(np.nanmax(u)) for u in us if np.isfinite(u).any()))
@@ -285,8 +283,8 @@ class DamBreakPage:
         if two is not None:
             h1, m1, h2, m2 = two[i]
             self.src_two.data = {"x": x, "zero": np.zeros_like(x), "h2": h2,
-                                 "top": h1 + h2, "u1": _velocity(h1, m1),
-                                 "u2": _velocity(h2, m2), "f": run.fextra[i]}
+                                 "top": h1 + h2, "u1": velocity_profile(h1, m1, fill=np.nan),
+                                 "u2": velocity_profile(h2, m2, fill=np.nan), "f": run.fextra[i]}
         else:
             self.src_two.data = {"x": x, "zero": nan, "h2": nan, "top": nan, "u1": nan,
                                  "u2": nan, "f": nan}
@@ -294,7 +292,7 @@ class DamBreakPage:
         if one is not None:
             h, m = one[i]
             self.src_one.data = {"x": x, "h": np.where(h > DRY, h, np.nan),
-                                 "u": _velocity(h, m)}
+                                 "u": velocity_profile(h, m, fill=np.nan)}
         else:
             self.src_one.data = {"x": x, "h": nan, "u": nan}
         self.fig_h.title.text = (f"{run.case.name}   t = {run.times[i]:.3f} s"

@@ -35,6 +35,7 @@ from ..numerics.hyperbolicity import (
     lower_bound_fl,
     upper_bound_fr,
 )
+from ..numerics.state import velocity_profile
 from ..plotting import DRY
 from .controls import Slider
 from .dam_break import COLOURS, FRAMES_PER_T_END, DamBreakRun, SharedRun
@@ -107,8 +108,8 @@ def cell_state(run: DamBreakRun, frame: int, cell: int) -> dict[str, float]:
     """h1, h2 [m], u1, u2, du [m/s], F_extra/rho1 [m^2/s^2], r and g_z of a run's cell."""
     h1, m1, h2, m2 = run.states["two_layer"][frame][:, cell]
     p = run.case.make_pde("two_layer").parameters
-    u1 = m1 / h1 if h1 > DRY else 0.0
-    u2 = m2 / h2 if h2 > DRY else 0.0
+    u1 = velocity_profile(h1, m1, p.dry_tolerance)
+    u2 = velocity_profile(h2, m2, p.dry_tolerance)
     return {"h1": float(h1), "h2": float(h2), "u1": float(u1), "u2": float(u2),
             "du": float(u1 - u2), "fextra": float(run.fextra[frame][cell]),
             "r": p.density_ratio, "g": p.g * math.cos(math.radians(p.theta_deg))}

@@ -53,13 +53,13 @@ def check_range(name: str, value: Any, low: float, high: float, *,
 
 def _named_progress(tracker: Any, t_range: Any) -> Any:
     """``tracker`` with the trackers named 'progress' (also inside 'auto') replaced by
-    :class:`pdeflow.trackers.live.ProgressBar` at 1/100 of the time range."""
+    :class:`pdeflow.trackers.ProgressBar` at 1/100 of the time range."""
     names = ["progress", "consistency"] if tracker == "auto" else tracker
     if isinstance(names, str):
         names = [names]
     if not isinstance(names, (list, tuple)) or "progress" not in names:
         return tracker
-    from ..trackers.live import ProgressBar
+    from ..trackers.progress import ProgressBar
 
     t0, t1 = (0.0, t_range) if np.isscalar(t_range) else t_range
     bar = ProgressBar((float(t1) - float(t0)) / 100)
@@ -151,7 +151,7 @@ class GranularPDE(PDEBase):
               tracker: Any = "auto", **kwargs: Any) -> Any:
         """py-pde's :meth:`~pde.pdes.base.PDEBase.solve`, except that the progress bar
         asked for by name (``tracker="auto"``, the default, or ``"progress"``) is
-        :class:`pdeflow.trackers.live.ProgressBar`: updated at 1/100 of ``t_range`` in
+        :class:`pdeflow.trackers.ProgressBar`: updated at 1/100 of ``t_range`` in
         simulation time, it fills up and says so when ``fv-split`` ends a run at rest
         (py-pde's own bar would stop where the run stopped)."""
         return super().solve(state, t_range, dt, _named_progress(tracker, t_range),

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..numerics import layout as L
+from ..numerics.state import DRY_TOLERANCE
 from .base import GranularPDE, ParametersBase, check_range
 
 
@@ -35,7 +36,7 @@ class SingleLayerParameters(ParametersBase):
     """bed slope [deg], x pointing down-slope"""
     phi_b_deg: float = 30.0
     """basal friction angle [deg] (paper: 30 in its comparisons)"""
-    dry_tolerance: float = 1e-6
+    dry_tolerance: float = DRY_TOLERANCE
     """layers thinner than this have zero velocity [m]"""
     rest_speed: float = 0.01
     """speed below which the layer counts as practically at rest [m/s]"""

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..numerics import layout as L
+from ..numerics.state import DRY_TOLERANCE
 from .base import GranularPDE, ParametersBase, check_range
 
 HYPERBOLICITY_MODES = {"none": 0, "exact": 1, "bound": 2}
@@ -56,7 +57,7 @@ class TwoLayerParameters(ParametersBase):
     """collisional (Voellmy) coefficient of eq. (17) [-] (calibrated)"""
     w: float = 1e-3
     """tolerance of the restoration (33)-(34) in du: restored |du| within w below F_c1 [m/s]"""
-    dry_tolerance: float = 1e-6
+    dry_tolerance: float = DRY_TOLERANCE
     """layers thinner than this have zero velocity [m]"""
     film_depth: float = 1e-3
     """upper-layer films thinner than this after an exchange are deposited whole [m]"""

@@ -72,11 +72,3 @@ class SplitDiagnostics:
             flux_fallbacks=int(diag[L.D_FLUX_FALLBACKS]),
             source_stages=int(diag[L.D_STEPS]),
             fextra_over_rho1=np.array(diag[L.N_DIAG:], dtype=float))
-
-    @staticmethod
-    def fextra_field(post_step_data: object, n: int) -> np.ndarray:
-        """F_extra/rho1 per cell [m^2/s^2] of the last step from a solver's post-step
-        data, zeros where the solver keeps none (py-pde solvers, one layer)."""
-        if isinstance(post_step_data, np.ndarray) and post_step_data.size == L.N_DIAG + n:
-            return post_step_data[L.N_DIAG:].copy()
-        return np.zeros(n)

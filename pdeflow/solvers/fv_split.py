@@ -28,6 +28,7 @@ from pde.trackers.base import FinishedSimulation
 from ..models.base import GranularPDE, check_range
 from ..numerics import layout as L
 from ..numerics import splitting as _splitting
+from ..numerics.compiled import kernels_cached, kernels_ready
 from ..numerics.splitting import STATUS_FAIL, STATUS_REST, advance_split
 
 
@@ -47,25 +48,6 @@ class _RestProfilerFilter(logging.Filter):
 
 
 logging.getLogger("pde.solvers.controller").addFilter(_RestProfilerFilter())
-
-
-def kernels_ready() -> bool:
-    """True if the ``fv-split`` stepping kernel is compiled (or loaded) in this process
-    (always with NUMBA_DISABLE_JIT=1: nothing to compile)."""
-    signatures = getattr(advance_split, "signatures", None)
-    return True if signatures is None else bool(signatures)
-
-
-def kernels_cached() -> bool:
-    """True if numba's disk cache holds the stepping kernel for this machine's CPU, so
-    that loading it takes a fraction of a second instead of compiling it (about 26 s
-    here: see docs/user_guide.md). Reads numba's cache index; False if it cannot."""
-    try:
-        index = advance_split._cache._cache_file._load_index()  # {} if source changed
-        magic = advance_split.targetctx.codegen().magic_tuple()
-    except Exception:  # pragma: no cover - numba internals moved: assume the worst
-        return False
-    return any(key[1] == magic for key in index)
 
 
 def load_kernels(log: Any = None) -> float:

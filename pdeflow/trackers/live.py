@@ -1,6 +1,6 @@
 """Live plots of a running simulation: a py-pde tracker, in a window, Jupyter or headless.
 
-:class:`LivePlotTracker` redraws, at its interrupts in *simulation* time, the two layers
+:class:`LayersPlotTracker` redraws, at its interrupts in *simulation* time, the two layers
 stacked on the bed (lower layer, upper layer, interface and free surface, filled), both
 velocities and F_extra/rho1, with the simulation time in the title (the figure is a
 :class:`pdeflow.plotting.RunFigure`). Where it shows the figure:
@@ -17,13 +17,13 @@ velocities and F_extra/rho1, with the simulation time in the title (the figure i
 
 Example::
 
-    from pdeflow.trackers.live import LivePlotTracker
-    live = LivePlotTracker(0.02, title="5.1", movie="dam_break.mp4")
+    from pdeflow.trackers.live import LayersPlotTracker
+    live = LayersPlotTracker(0.02, title="5.1", movie="dam_break.mp4")
     eq.solve(state, t_range=5, solver="fv-split", tracker=live)
 
 The last frame is the final state (the rest time if the run stopped at rest). Movies
 and frames are complete or absent: a movie is written under a temporary name and
-renamed when the run ends; :meth:`LivePlotTracker.discard` removes it if the run fails.
+renamed when the run ends; :meth:`LayersPlotTracker.discard` removes it if the run fails.
 Every interrupt makes the solver land exactly on that time, which shortens one step:
 results differ from a run without the tracker at the level of the discretisation error.
 """
@@ -37,11 +37,11 @@ from typing import Any
 
 import matplotlib
 import numpy as np
-from pde.trackers import ProgressTracker
 from pde.trackers.base import InfoDict, TrackerBase
 
+from ..io import PendingFile
 from ..plotting import RunFigure, Series
-from ..storage import PendingFile, fextra_over_rho1, model_of, show_final_state
+from .frames import fextra_over_rho1, model_of, show_final_state
 
 #: movie containers written with H.264 through ffmpeg (WebM cannot hold H.264)
 FFMPEG_SUFFIXES = (".mp4", ".m4v", ".mov", ".mkv", ".avi")
@@ -138,8 +138,14 @@ class MovieFile:
         self._pending.discard()
 
 
-class LivePlotTracker(TrackerBase):
+class LayersPlotTracker(TrackerBase):
     """py-pde tracker drawing the run while it goes (see the module docstring).
+
+    Not py-pde's ``PlotTracker``: that one draws ``state.plot()``, while this figure
+    stacks the layers and needs F_extra/rho1 (not part of the state) and the final
+    state of a run that stops at rest between two interrupts; it also draws every
+    frame (py-pde's drops frames by wall-clock rate while showing them) and writes
+    movies that are complete or absent.
 
     Args:
         interrupts: when to draw, in simulation time: an interval [s] (from t = 0),
@@ -248,72 +254,6 @@ class LivePlotTracker(TrackerBase):
             self.figure.close()
 
 
-class ProgressBar(ProgressTracker):
-    """py-pde's progress bar, updated at fixed *simulation* times (so that a run's
-    result does not depend on the wall clock), which says "at rest" and fills up when
-    the ``fv-split`` solver ends a run at rest before t_end.
-
-    While the ``fv-split`` kernels are compiled (the first run on a machine) or loaded
-    (the first run in a process), the bar says so; its clock and its estimate of the
-    remaining time start once the first interval has been computed, so the estimate is
-    simulated time per wall time of the run itself.
-
-    Args:
-        interrupts: simulation time between updates [s] (or anything py-pde accepts).
-        label: text in front of the bar (e.g. the model).
-    """
-
-    def __init__(self, interrupts: Any = 0.05, *, label: str = "", **kwargs: Any):
-        super().__init__(interrupts=interrupts, **kwargs)
-        self.label = label
-        self._clock_started = False
-
-    def initialize(self, field: Any, info: InfoDict | None = None) -> float:
-        result = super().initialize(field, info)
-        self._clock_started = False
-        solver = (info or {}).get("solver", {}).get("class")
-        waiting = ""
-        if solver == "FVSplitSolver":
-            from ..solvers.fv_split import kernels_cached, kernels_ready
-
-            if not kernels_ready():
-                waiting = ("compiling kernels (once per machine)" if not kernels_cached()
-                           else "loading compiled kernels")
-        self._waiting = ": ".join(p for p in (self.label, waiting) if p)
-        self.progress_bar.set_description(self._waiting)
-        return result
-
-    def handle(self, field: Any, t: float) -> None:
-        super().handle(field, t)
-        bar = self.progress_bar
-        if not self._clock_started and t > bar.initial:
-            if self._waiting != self.label:
-                # the first interval held the compilation: restart the clock here, so
-                # that the remaining time is estimated from the run alone
-                bar.start_t = bar.last_print_t = bar._time()
-                bar.initial = bar.n
-            self._clock_started = True
-        bar.set_description(self.label if self._clock_started else self._waiting)
-        bar.set_postfix_str(f"t = {t:.4g} s", refresh=False)
-
-    def finalize(self, info: InfoDict | None = None) -> None:
-        TrackerBase.finalize(self, info)
-        info = info or {}
-        bar = self.progress_bar
-        rest = info.get("solver", {}).get("rest_time")
-        controller = info.get("controller", {})
-        t_final = controller.get("t_final", -math.inf)
-        if bar.total and (rest is not None
-                          or t_final >= controller.get("t_end", math.inf) - self.atol):
-            bar.n = bar.total
-        if rest is not None:
-            bar.set_postfix_str(f"at rest at t = {rest:.4g} s", refresh=False)
-        elif not controller.get("successful", True):
-            bar.set_postfix_str(f"stopped at t = {t_final:.4g} s", refresh=False)
-        bar.set_description(self.label, refresh=False)
-        bar.close()
-
-
 def replay(frames: list[tuple[float, list[np.ndarray | None], list[np.ndarray | None]]],
            series: list[Series], path: str | Path, *, title: str = "", fps: float = 10,
            dpi: int = 100) -> Path:
@@ -333,5 +273,5 @@ def replay(frames: list[tuple[float, list[np.ndarray | None], list[np.ndarray | 
     return out
 
 
-__all__ = ["LivePlotTracker", "MovieError", "MovieFile", "ProgressBar", "check_movie_path",
+__all__ = ["LayersPlotTracker", "MovieError", "MovieFile", "check_movie_path",
            "display_mode", "ffmpeg_path", "replay"]

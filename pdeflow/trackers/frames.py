@@ -1,0 +1,132 @@
+"""Frames of a granular run: the state with F_extra/rho1, stored through py-pde storages.
+
+F_extra is not part of the state: :func:`fextra_over_rho1` reads it from the ``fv-split``
+solver's post-step data in the simulation ``info`` (zeros for other solvers and for one
+layer). :class:`FextraStorageTracker` is py-pde's ``StorageTracker`` whose frames are the
+state followed by that field, in any py-pde storage (a ``MemoryStorage`` by default; the
+HDF5 files of :mod:`pdeflow.storage` use a ``FileStorage``).
+
+Example::
+
+    from pdeflow.trackers import FextraStorageTracker
+    frames = FextraStorageTracker([0.5, 1.0])            # or an interval [s]
+    eq.solve(state, t_range=2, solver="fv-split", tracker=frames)
+    frames.storage                      # py-pde MemoryStorage: times, fields h1 ... F_extra
+    frames.snapshots[0.5]               # (state data, F_extra/rho1 per cell)
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from pde import FieldCollection, MemoryStorage, ScalarField
+from pde.storage.base import StorageBase, StorageTracker
+from pde.trackers.base import InfoDict
+
+from ..numerics import layout as L
+
+FEXTRA_LABEL = "fextra_over_rho1"
+"""Label of the F_extra/rho1 field [m^2/s^2] that follows the state in every frame."""
+STATE_LABELS = {"two_layer": ("h1", "h1u1", "h2", "h2u2"), "single_layer": ("h", "hu")}
+"""Labels of the state fields per model (depths in m, discharges in m^2/s)."""
+
+
+def fextra_over_rho1(info: InfoDict | None, n: int) -> np.ndarray:
+    """F_extra/rho1 per cell [m^2/s^2] of the last step, from the ``fv-split`` solver's
+    post-step data in the simulation ``info``; zeros if the solver keeps none (py-pde
+    solvers, one layer)."""
+    diag = None if info is None else info.get("solver", {}).get("post_step_data")
+    if isinstance(diag, np.ndarray) and diag.size == L.N_DIAG + n:
+        return diag[L.N_DIAG:].copy()
+    return np.zeros(n)
+
+
+def model_of(field_or_rows: Any) -> str:
+    """'two_layer' for 4 state rows, 'single_layer' for 2."""
+    rows = getattr(field_or_rows, "data", field_or_rows).shape[0]
+    if rows == 4:
+        return "two_layer"
+    if rows == 2:
+        return "single_layer"
+    raise ValueError(f"a granular state has 2 or 4 fields, got {rows}")
+
+
+def final_time(info: InfoDict | None) -> float | None:
+    """End time [s] of a run from the controller's diagnostics: the rest time if the
+    ``fv-split`` solver stopped at rest, else the controller's final time."""
+    if not info:
+        return None
+    rest = info.get("solver", {}).get("rest_time")
+    if rest is not None:
+        return float(rest)
+    t = info.get("controller", {}).get("t_final")
+    return None if t is None else float(t)
+
+
+def show_final_state(tracker: Any, info: InfoDict | None) -> float | None:
+    """At ``finalize``: hand the run's last state to ``tracker.handle`` unless the
+    tracker already saw it (its ``last_time``); returns the end time [s] of the run.
+
+    py-pde calls a tracker only at its interrupts, so a run that stops at rest or at
+    t_end between two interrupts would otherwise miss its final state. ``tracker``
+    keeps the state it was initialised with in ``_field``: py-pde's controller steps
+    that object in place, so at ``finalize`` it holds the final state."""
+    t_end = final_time(info)
+    state = (info or {}).get("last_state", tracker._field)
+    if state is not None and t_end is not None and t_end > tracker.last_time + 1e-12:
+        tracker.handle(state, t_end)
+    return t_end
+
+
+class FextraStorageTracker(StorageTracker):
+    """py-pde's ``StorageTracker`` storing, at its interrupts, the state followed by
+    F_extra/rho1 per cell (field ``fextra_over_rho1`` [m^2/s^2], see
+    :func:`fextra_over_rho1`).
+
+    Args:
+        interrupts: when to store, in simulation time: an interval [s] (from t = 0), a
+            list of times, or anything py-pde accepts.
+        storage: the py-pde storage written to (default: a new ``MemoryStorage``).
+    """
+
+    def __init__(self, interrupts: Any = 1, *, storage: StorageBase | None = None):
+        super().__init__(MemoryStorage() if storage is None else storage, interrupts)
+        self._info: InfoDict | None = None
+        self._field: Any = None
+        self._frame: FieldCollection | None = None
+        self.last_time = -np.inf
+
+    def initialize(self, field: Any, info: InfoDict | None = None) -> float:
+        self._info = info
+        self._field = field
+        grid = field.grid
+        labels = (*STATE_LABELS[model_of(field)], FEXTRA_LABEL)
+        self._frame = FieldCollection([ScalarField(grid, label=name) for name in labels])
+        return super().initialize(field, info)
+
+    def _transform(self, field: Any, t: float) -> FieldCollection:
+        """The frame: the state's fields (labelled as :data:`STATE_LABELS`), then
+        F_extra/rho1 of the last step. One collection is refilled for every frame (the
+        storage copies its data when appending): building one per frame would cost
+        more than the run between two frames of the app's animation."""
+        assert self._frame is not None, "initialize() first"
+        data = self._frame.data
+        data[:-1] = field.data
+        data[-1] = fextra_over_rho1(self._info, data.shape[1])
+        return self._frame
+
+    def handle(self, field: Any, t: float) -> None:
+        super().handle(field, t)
+        self.last_time = float(t)
+
+    @property
+    def snapshots(self) -> dict[float, tuple[np.ndarray, np.ndarray]]:
+        """Stored frames as t [s] (rounded to 1e-9 s) -> (state data, F_extra/rho1 per
+        cell), views of the storage's arrays."""
+        return {round(float(t), 9): (d[:-1], d[-1])
+                for t, d in zip(self.storage.times, self.storage.data, strict=True)}
+
+
+__all__ = ["FEXTRA_LABEL", "STATE_LABELS", "FextraStorageTracker", "fextra_over_rho1",
+           "final_time", "model_of", "show_final_state"]

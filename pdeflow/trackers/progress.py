@@ -1,0 +1,86 @@
+"""py-pde's progress bar for granular runs: fixed simulation-time updates, "at rest".
+
+Example::
+
+    from pdeflow.trackers import ProgressBar
+    eq.solve(state, t_range=5, solver="fv-split", tracker=ProgressBar(0.05, label="5.1"))
+
+``eq.solve(...)`` with its default trackers (``"auto"``) shows this bar
+(:meth:`pdeflow.models.base.GranularPDE.solve`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from pde.trackers import ProgressTracker
+from pde.trackers.base import InfoDict, TrackerBase
+
+from ..numerics.compiled import kernels_cached, kernels_ready
+
+
+class ProgressBar(ProgressTracker):
+    """py-pde's progress bar, updated at fixed *simulation* times (so that a run's
+    result does not depend on the wall clock), which says "at rest" and fills up when
+    the ``fv-split`` solver ends a run at rest before t_end.
+
+    While the ``fv-split`` kernels are compiled (the first run on a machine) or loaded
+    (the first run in a process), the bar says so; its clock and its estimate of the
+    remaining time start once the first interval has been computed, so the estimate is
+    simulated time per wall time of the run itself.
+
+    Args:
+        interrupts: simulation time between updates [s] (or anything py-pde accepts).
+        label: text in front of the bar (e.g. the model).
+    """
+
+    def __init__(self, interrupts: Any = 0.05, *, label: str = "", **kwargs: Any):
+        super().__init__(interrupts=interrupts, **kwargs)
+        self.label = label
+        self._clock_started = False
+
+    def initialize(self, field: Any, info: InfoDict | None = None) -> float:
+        result = super().initialize(field, info)
+        self._clock_started = False
+        solver = (info or {}).get("solver", {}).get("class")
+        waiting = ""
+        if solver == "FVSplitSolver" and not kernels_ready():
+            waiting = ("compiling kernels (once per machine)" if not kernels_cached()
+                       else "loading compiled kernels")
+        self._waiting = ": ".join(p for p in (self.label, waiting) if p)
+        self.progress_bar.set_description(self._waiting)
+        return result
+
+    def handle(self, field: Any, t: float) -> None:
+        super().handle(field, t)
+        bar = self.progress_bar
+        if not self._clock_started and t > bar.initial:
+            if self._waiting != self.label:
+                # the first interval held the compilation: restart the clock here, so
+                # that the remaining time is estimated from the run alone
+                bar.start_t = bar.last_print_t = bar._time()
+                bar.initial = bar.n
+            self._clock_started = True
+        bar.set_description(self.label if self._clock_started else self._waiting)
+        bar.set_postfix_str(f"t = {t:.4g} s", refresh=False)
+
+    def finalize(self, info: InfoDict | None = None) -> None:
+        TrackerBase.finalize(self, info)
+        info = info or {}
+        bar = self.progress_bar
+        rest = info.get("solver", {}).get("rest_time")
+        controller = info.get("controller", {})
+        t_final = controller.get("t_final", -math.inf)
+        if bar.total and (rest is not None
+                          or t_final >= controller.get("t_end", math.inf) - self.atol):
+            bar.n = bar.total
+        if rest is not None:
+            bar.set_postfix_str(f"at rest at t = {rest:.4g} s", refresh=False)
+        elif not controller.get("successful", True):
+            bar.set_postfix_str(f"stopped at t = {t_final:.4g} s", refresh=False)
+        bar.set_description(self.label, refresh=False)
+        bar.close()
+
+
+__all__ = ["ProgressBar"]
