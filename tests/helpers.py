@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -67,3 +68,10 @@ def skip_or_fail_in_ci(reason: str) -> None:
         pytest.fail(f"{reason} (in CI this is a failure, not a skip: .ci/run installs "
                     "the test extra, pip install '.[test]')", pytrace=False)
     pytest.skip(reason)
+
+
+def assert_no_temporaries(folder: Path) -> None:
+    """No file or directory below ``folder`` still has the ``.part`` of a file being
+    written (outputs are written under a temporary name and renamed when complete)."""
+    left = [p.name for p in folder.rglob("*") if ".part" in p.name]
+    assert not left, f"temporary files left behind: {left}"
