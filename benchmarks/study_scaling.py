@@ -18,6 +18,7 @@ Measured by ``python benchmarks/run_benchmarks.py --only studies`` (stored in
 from __future__ import annotations
 
 import statistics
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -25,58 +26,51 @@ from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = ROOT / "cases"
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
 
-STUDY_51 = """
-[study]
-name = "bench_51"
-case = "@CASES@/paper_5_1_dam_break.toml"
-set = ["grid.dx=0.05"]
-design = "lhs"
-samples = @SAMPLES@
-seed = 11
-quantities = ["two_layer.lower_slow_time", "two_layer.runout"]
-[parameters]
+from tests.helpers import ishigami_study  # noqa: E402
+
+PARAMETERS = """[parameters]
 "two_layer.phi_b_deg" = { range = [30, 46] }
 "two_layer.k" = { range = [0.2, 0.8] }
 "two_layer.c" = { range = [0.01, 3], scale = "log" }
 """
-
-STUDY_52 = """
-[study]
-name = "bench_52"
-case = "@CASES@/paper_5_1_dam_break.toml"
-sweep_case = "@CASES@/collapse_sweep.toml"
-set = ["grid.dx=0.0025", "two_layer.exchange_closure='relaxed'",
-       "numerics.reconstruction='muscl'", "numerics.limiter='mc'"]
-design = "lhs"
-samples = @SAMPLES@
-seed = 12
-quantities = ["sweep.two_layer.exponent"]
-[parameters]
-"two_layer.phi_b_deg" = { range = [30, 46] }
-"two_layer.k" = { range = [0.2, 0.8] }
-"two_layer.c" = { range = [0.01, 3], scale = "log" }
-"""
-
-STUDY_DELAY = """
-[study]
-name = "bench_overhead"
-function = "pdeflow.study.testfunctions:ishigami"
-design = "lhs"
-samples = @SAMPLES@
-seed = 13
-quantities = ["y"]
-[parameters]
-x1 = { range = [-3, 3] }
-x2 = { range = [-3, 3] }
-x3 = { range = [-3, 3] }
-delay = { values = [0.005] }
-"""
+"""the space of both case studies: the two-layer closure's phi_B [deg], k and c"""
 
 
-def _text(template: str, samples: int) -> str:
-    return (template.replace("@CASES@", CASES.as_posix())
-            .replace("@SAMPLES@", str(samples)))
+def case_study(name: str, samples: int, seed: int, settings: list[str],
+               quantities: list[str], sweep: bool = False) -> str:
+    """The text of a Latin-hypercube study over ``PARAMETERS`` of test 5.1 (with
+    ``sweep``, of the whole 5.2 sweep built on it), the case changed by ``settings``."""
+    lines = ["[study]", f'name = "{name}"', f'case = "{CASES.as_posix()}/paper_5_1_dam_break.toml"',
+             *([f'sweep_case = "{CASES.as_posix()}/collapse_sweep.toml"'] if sweep else []),
+             f"set = {_toml_strings(settings)}", 'design = "lhs"', f"samples = {samples}",
+             f"seed = {seed}", f"quantities = {_toml_strings(quantities)}"]
+    return "\n".join(lines) + "\n" + PARAMETERS
+
+
+def _toml_strings(items: list[str]) -> str:
+    return "[" + ", ".join(f'"{x}"' for x in items) + "]"
+
+
+def study_51(samples: int) -> str:
+    """5.1 at dx = 0.05 m: lower-layer stop time and run-out (two layers)."""
+    return case_study("bench_51", samples, 11, ["grid.dx=0.05"],
+                      ["two_layer.lower_slow_time", "two_layer.runout"])
+
+
+def study_52(samples: int, dx: float = 0.0025) -> str:
+    """The 5.2 sweep at ``dx`` [m], MUSCL/mc, relaxed closure: the run-out exponent."""
+    return case_study("bench_52", samples, 12,
+                      [f"grid.dx={dx}", "two_layer.exchange_closure='relaxed'",
+                       "numerics.reconstruction='muscl'", "numerics.limiter='mc'"],
+                      ["sweep.two_layer.exponent"], sweep=True)
+
+
+def study_delay(samples: int) -> str:
+    """``ishigami`` with a fixed 5 ms per evaluation: the scheduling overhead."""
+    return ishigami_study("lhs", samples, 13, delay=0.005, name="bench_overhead")
 
 
 def _run(text: str, workers: int, tmp: Path, tag: str) -> dict[str, Any]:
@@ -102,23 +96,22 @@ def measure(quick: bool = False, repeats: int = 3, sweeps: int = 20) -> dict[str
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
         # warm the numba cache of this process tree before anything is timed
-        _run(_text(STUDY_51, 4), 1, tmp, "warm")
+        _run(study_51(4), 1, tmp, "warm")
         rounds: dict[int, list[dict[str, Any]]] = {1: [], 2: []}
         for r in range(repeats):
             for w in (1, 2):
-                rounds[w].append(_run(_text(STUDY_51, n51), w, tmp, f"s51_{r}_{w}"))
+                rounds[w].append(_run(study_51(n51), w, tmp, f"s51_{r}_{w}"))
         out["study_51"] = rounds
         med = {w: statistics.median(x["wall_s"] for x in rounds[w]) for w in rounds}
         out["speedup_51"] = med[1] / med[2]
-        text52 = _text(STUDY_52, n52)
-        if quick:  # a smoke run of the code path, not a measurement
-            text52 = text52.replace("grid.dx=0.0025", "grid.dx=0.01")
+        # quick: a smoke run of the code path, not a measurement
+        text52 = study_52(n52, 0.01 if quick else 0.0025)
         s52 = {w: _run(text52, w, tmp, f"s52_{w}") for w in (1, 2)}
         out["study_52"] = s52
         out["speedup_52"] = s52[1]["wall_s"] / s52[2]["wall_s"]
         out["eval_52_s"] = s52[1]["evaluation_s"] / s52[1]["evaluations"]
         n_delay = 200 if quick else 2000
-        out["overhead"] = _run(_text(STUDY_DELAY, n_delay), 2, tmp, "delay")
+        out["overhead"] = _run(study_delay(n_delay), 2, tmp, "delay")
     return out
 
 

@@ -54,6 +54,19 @@ def median_time(fn: Callable[[], Any], repeats: int = 5, min_total: float = 0.2,
     return statistics.median(walls), walls
 
 
+def interleaved_walls(fns: Sequence[Callable[[], Any]], repeats: int) -> list[list[float]]:
+    """Wall times [s] of every ``fn`` over ``repeats`` rounds, the calls interleaved
+    (A B C A B C ...) so that a change of the machine's load hits all of them alike
+    (no warm-up: call each once before)."""
+    walls: list[list[float]] = [[] for _ in fns]
+    for _ in range(repeats):
+        for fn, w in zip(fns, walls, strict=True):
+            t0 = time.perf_counter()
+            fn()
+            w.append(time.perf_counter() - t0)
+    return walls
+
+
 # --- cases -----------------------------------------------------------------------------
 
 def sweep_length(H0: float, L0: float = SWEEP_L0) -> float:
@@ -76,9 +89,11 @@ def sweep_case(H0: float, model: str, length: float | None = None,
 
 
 def fv_stepper_run(case: Any, model: str, t_end: float | None = None,
-                   stop_at_rest: bool = True) -> Callable[[], dict[str, Any]]:
+                   stop_at_rest: bool = True,
+                   max_steps: int = 100_000_000) -> Callable[[], dict[str, Any]]:
     """A callable running ``model`` of ``case`` with the fv-split stepper directly
-    (no py-pde controller): returns steps, final time and the final state."""
+    (no py-pde controller), to ``t_end`` [s] or rest or ``max_steps`` steps: returns
+    steps, final time, the final state, cells and dx."""
     from pde.trackers.base import FinishedSimulation
 
     from pdeflow import FVSplitSolver
@@ -88,7 +103,7 @@ def fv_stepper_run(case: Any, model: str, t_end: float | None = None,
 
     def run() -> dict[str, Any]:
         solver = FVSplitSolver(eq, cfl=case.cfl, splitting=case.splitting,
-                               stop_at_rest=stop_at_rest)
+                               stop_at_rest=stop_at_rest, max_steps=max_steps)
         s = state.copy()
         stepper = solver.make_stepper(s)
         try:
@@ -96,7 +111,7 @@ def fv_stepper_run(case: Any, model: str, t_end: float | None = None,
         except FinishedSimulation:
             t = solver.info["rest_time"]
         return {"steps": int(solver.info["steps"]), "t": float(t), "data": s.data,
-                "cells": s.data.shape[1]}
+                "cells": s.data.shape[1], "dx": float(s.grid.discretization[0])}
 
     return run
 
@@ -114,28 +129,50 @@ def cell_update_rates(variants: Sequence[str] = BENCH_VARIANTS, dx: float = 0.01
     rows = []
     for model in ("single_layer", "two_layer"):
         for name in variants:
-            v = Variant.parse(name)
-            c = case_on_grid(base, dx, v)
-            run = fv_stepper_run(c, model, t_end)
-            out = run()
-            med, walls = median_time(run, repeats)
-            updates = out["steps"] * out["cells"]
-            rows.append({"model": model, "variant": name, "cells": out["cells"],
-                         "steps": out["steps"], "wall_s": med, "walls": walls,
-                         "cell_updates_per_s": updates / med,
-                         "ns_per_cell_update": 1e9 * med / updates})
+            c = case_on_grid(base, dx, Variant.parse(name))
+            rows.append({"model": model, "variant": name,
+                         **_cell_update_cost(fv_stepper_run(c, model, t_end), repeats)})
     # where the two-layer cost goes: the same run without restoring hyperbolicity
     c = case_on_grid(base, dx, Variant.parse("hll/first-order"))
     c.data.setdefault("two_layer", {})["hyperbolicity"] = "none"
-    run = fv_stepper_run(c, "two_layer", t_end)
+    rows.append({"model": "two_layer", "variant": "hll/first-order, hyperbolicity none",
+                 **_cell_update_cost(fv_stepper_run(c, "two_layer", t_end), repeats)})
+    return rows
+
+
+def _cell_update_cost(run: Callable[[], dict[str, Any]], repeats: int) -> dict[str, Any]:
+    """Cells, dx [m], steps, final time [s], median wall time [s] (and all walls) of
+    ``run`` (an ``fv_stepper_run``), cell updates per second and ns per cell update."""
     out = run()
     med, walls = median_time(run, repeats)
     updates = out["steps"] * out["cells"]
-    rows.append({"model": "two_layer", "variant": "hll/first-order, hyperbolicity none",
-                 "cells": out["cells"], "steps": out["steps"], "wall_s": med,
-                 "walls": walls, "cell_updates_per_s": updates / med,
-                 "ns_per_cell_update": 1e9 * med / updates})
-    return rows
+    return {"cells": out["cells"], "dx": out["dx"], "steps": out["steps"], "t": out["t"],
+            "wall_s": med, "walls": walls, "cell_updates_per_s": updates / med,
+            "ns_per_cell_update": 1e9 * med / updates}
+
+
+def large_grid_steps(repeats: int = 3, cells: int = 100_000,
+                     steps: int = 200) -> list[dict[str, Any]]:
+    """The first ``steps`` steps of the 5.1 column on ``cells`` cells (10^5: dx = 7e-5 m)
+    per model, with the compiled stepper: the size of the large-grid run whose results
+    tests/test_stress.py checks (``test_1e5_cells_short_run``: the same column and grid,
+    the models' default parameters).
+    Every cell counts as updated in every step, although after the first step (which
+    cleans the whole initial state) only the wet region, about a seventh of the domain
+    here, is visited."""
+    return [{"model": model, **_cell_update_cost(large_grid_run(model, cells, steps),
+                                                 repeats)}
+            for model in ("two_layer", "single_layer")]
+
+
+def large_grid_run(model: str, cells: int = 100_000,
+                   steps: int = 200) -> Callable[[], dict[str, Any]]:
+    """``fv_stepper_run`` of the first ``steps`` steps of the 5.1 case (7 m) on ``cells``
+    cells, not stopping at rest."""
+    from pdeflow.cases import load_case
+
+    case = load_case(CASE_5_1, ["output.snapshot_times=[]", f"grid.cells={cells}"])
+    return fv_stepper_run(case, model, stop_at_rest=False, max_steps=steps)
 
 
 _COMPILE_SCRIPT = r"""
@@ -279,13 +316,8 @@ def sweep(repeats: int = 5, heights: Sequence[float] = SWEEP_H0, pyclaw: bool = 
                 SWEEP_L0, H, L, SWEEP_DX, t)
         for fn in runs.values():
             fn()  # warm-up
-        walls: dict[str, list[float]] = {k: [] for k in runs}
-        for _ in range(repeats):
-            for key, fn in runs.items():
-                t0 = time.perf_counter()
-                fn()
-                walls[key].append(time.perf_counter() - t0)
-        for key, w in walls.items():
+        walls = interleaved_walls(list(runs.values()), repeats)
+        for key, w in zip(runs, walls, strict=True):
             row[key + "_s"] = statistics.median(w)
         if have_claw:
             _, hc, steps_c = pyclaw_run.collapse(SWEEP_L0, H0, row["length"], SWEEP_DX,
@@ -338,13 +370,7 @@ def wet_region_savings(repeats: int = 5, factor: int = 10) -> list[dict[str, Any
         long.validate()
         a, b = fv_stepper_run(case, model), fv_stepper_run(long, model)
         oa, ob = a(), b()
-        wa, wb = [], []
-        for _ in range(repeats):
-            for fn, w in ((a, wa), (b, wb)):
-                t0 = time.perf_counter()
-                fn()
-                w.append(time.perf_counter() - t0)
-        ma, mb = statistics.median(wa), statistics.median(wb)
+        ma, mb = map(statistics.median, interleaved_walls((a, b), repeats))
         rows.append({"model": model, "cells": case.cells, "cells_long": long.cells,
                      "steps": oa["steps"], "steps_long": ob["steps"], "wall_s": ma,
                      "wall_long_s": mb, "ratio": mb / ma})
@@ -361,15 +387,8 @@ def stop_at_rest_savings(repeats: int = 5) -> list[dict[str, Any]]:
         on, off = fv_stepper_run(case, model), fv_stepper_run(case, model,
                                                              stop_at_rest=False)
         o_on, o_off = on(), off()
-        won, woff = [], []
-        for _ in range(repeats):
-            for fn, w in ((on, won), (off, woff)):
-                t0 = time.perf_counter()
-                fn()
-                w.append(time.perf_counter() - t0)
+        m_on, m_off = map(statistics.median, interleaved_walls((on, off), repeats))
         rows.append({"model": model, "t_end": case.t_end, "t_rest": o_on["t"],
                      "steps_on": o_on["steps"], "steps_off": o_off["steps"],
-                     "wall_on_s": statistics.median(won),
-                     "wall_off_s": statistics.median(woff),
-                     "saving": 1 - statistics.median(won) / statistics.median(woff)})
+                     "wall_on_s": m_on, "wall_off_s": m_off, "saving": 1 - m_on / m_off})
     return rows

@@ -47,6 +47,14 @@ def test_case_5_1_to_rest(benchmark, model):
     assert res.summary["at_rest"]
 
 
+@pytest.mark.parametrize("model", ["single_layer", "two_layer"])
+def test_large_grid_steps(benchmark, model):
+    """200 steps of the 5.1 column on 10^5 cells (tests/test_stress.py checks the
+    results of a run of this size; its wall time is tracked here)."""
+    out = benchmark.pedantic(suite.large_grid_run(model), rounds=3, warmup_rounds=1)
+    assert out["steps"] == 200 and np.all(np.isfinite(out["data"]))
+
+
 @pytest.mark.parametrize("H0", [0.5, 2.0])
 def test_sweep_member_pdeflow(benchmark, H0):
     case = suite.sweep_case(H0, "single_layer")

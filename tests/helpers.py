@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 import numpy as np
+import pytest
 from pde import CartesianGrid
 
 import pdeflow
@@ -34,3 +38,40 @@ def two_layer_column(n: int = 140, length: float = 7.0, **params):
     h2 = np.where(x < 1, np.minimum(2.0, (1 - x) * np.tan(np.radians(60))), 0.0)
     h1 = np.where(x < 1, 2.0 - h2, 0.0)
     return eq, eq.make_state(g, h1=h1, h2=h2)
+
+
+def ishigami_study(design: str, samples: int, seed: int, bound: float = 3,
+                   delay: float | None = None, name: str | None = None) -> str:
+    """The text of a study file of ``pdeflow.study.testfunctions:ishigami`` (quantity
+    ``y``) over x1, x2, x3 uniform in [-bound, bound], with a fixed ``delay`` [s] per
+    evaluation if given (used by the benchmarks too: benchmarks/study_scaling.py)."""
+    lines = ["[study]", *([f'name = "{name}"'] if name else []),
+             'function = "pdeflow.study.testfunctions:ishigami"', f'design = "{design}"',
+             f"samples = {samples}", f"seed = {seed}", 'quantities = ["y"]', "[parameters]",
+             *(f"x{i} = {{ range = [-{bound!r}, {bound!r}] }}" for i in (1, 2, 3)),
+             *([f"delay = {{ values = [{delay!r}] }}"] if delay is not None else [])]
+    return "\n".join(lines) + "\n"
+
+
+def in_ci() -> bool:
+    """True in continuous integration: ``PDEFLOW_CI=1`` (set by .ci/run) or the ``CI``
+    variable that CI services set (``true`` or ``1``)."""
+    return (os.environ.get("PDEFLOW_CI") == "1"
+            or os.environ.get("CI", "").lower() in ("1", "true"))
+
+
+def skip_or_fail_in_ci(reason: str) -> None:
+    """Skip the calling test because ``reason`` (something it needs is missing here);
+    in CI (see in_ci) fail it instead: CI installs everything, so a missing piece there
+    is a broken installation, not a test to skip."""
+    if in_ci():
+        pytest.fail(f"{reason} (in CI this is a failure, not a skip: .ci/run installs "
+                    "the test extra, pip install '.[test]')", pytrace=False)
+    pytest.skip(reason)
+
+
+def assert_no_temporaries(folder: Path) -> None:
+    """No file or directory below ``folder`` still has the ``.part`` of a file being
+    written (outputs are written under a temporary name and renamed when complete)."""
+    left = [p.name for p in folder.rglob("*") if ".part" in p.name]
+    assert not left, f"temporary files left behind: {left}"

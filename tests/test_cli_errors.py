@@ -1,18 +1,14 @@
 """Usage errors of the command line: one line naming the problem, exit code 2, no
-traceback, nothing written (issue 14, part C)."""
+traceback, nothing written (issue 14, part C); and its help texts."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
+import pytest
 
-matplotlib.use("Agg")
-
-import pytest  # noqa: E402
-
-from pdeflow.cases import CaseError, load_case  # noqa: E402
-from pdeflow.cli import main  # noqa: E402
+from pdeflow.cases import CaseError, load_case
+from pdeflow.cli import build_parser, main
 
 ROOT = Path(__file__).parents[1]
 CASE_51 = ROOT / "cases" / "paper_5_1_dam_break.toml"
@@ -102,3 +98,13 @@ def test_movie_help_lists_exactly_the_formats_that_are_written(capsys):
         assert suffix in text, suffix
     assert ".webm" not in text
     assert check_movie_path("x.gif") == "pillow"
+
+
+def test_every_cli_option_has_help():
+    parser = build_parser()
+    subparsers = next(a for a in parser._actions if a.choices and "run" in a.choices)
+    for name in ("run", "plot", "export"):
+        sub = subparsers.choices[name]
+        assert sub.description, name
+        for action in sub._actions:
+            assert action.help and len(action.help) > 10, (name, action.dest)

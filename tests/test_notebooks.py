@@ -1,8 +1,10 @@
 """The teaching notebooks in docs/ execute from top to bottom (so they never rot).
 
 Each notebook checks its own results with ``assert`` statements; a failing cell fails
-the test. Needs the ``test`` extra (nbclient, nbformat, ipykernel, ipywidgets); the test
-is skipped, not failed, when those are missing or a Jupyter kernel cannot start here.
+the test. Needs the ``test`` extra (nbclient, nbformat, ipykernel, ipywidgets). When those
+are missing or a Jupyter kernel cannot start here, the notebook tests are skipped on a
+developer's machine but fail in CI (``PDEFLOW_CI=1``, set by .ci/run, or ``CI=true``):
+there a missing kernel means the installation is broken and the notebooks went untested.
 """
 
 from __future__ import annotations
@@ -13,9 +15,16 @@ from pathlib import Path
 
 import pytest
 
-nbformat = pytest.importorskip("nbformat")
-nbclient = pytest.importorskip("nbclient")
-pytest.importorskip("ipykernel")
+from .helpers import skip_or_fail_in_ci
+
+try:
+    import ipykernel  # noqa: F401  (the kernel the notebooks run in)
+    import nbclient
+    import nbformat
+except ImportError as err:  # reported by the kernel_available fixture
+    MISSING: ImportError | None = err
+else:
+    MISSING = None
 
 DOCS = Path(__file__).parents[1] / "docs"
 NOTEBOOKS = sorted(DOCS.glob("*.ipynb"))
@@ -38,15 +47,21 @@ def _kernel_env() -> dict[str, str]:
 
 @pytest.fixture(scope="module")
 def kernel_available() -> None:
+    if MISSING is not None:
+        skip_or_fail_in_ci(f"the notebooks cannot run: {MISSING} (nbformat, nbclient and "
+                           "ipykernel come with the test extra)")
     from jupyter_client.manager import start_new_kernel
 
     try:
         km, kc = start_new_kernel(kernel_name="python3", startup_timeout=60,
                                   env=_kernel_env())
     except Exception as err:  # no kernelspec, no zmq, sandbox without sockets, ...
-        pytest.skip(f"no Jupyter kernel can start here: {err!r}")
-    kc.stop_channels()
-    km.shutdown_kernel(now=True)
+        error = err
+    else:
+        kc.stop_channels()
+        km.shutdown_kernel(now=True)
+        return
+    skip_or_fail_in_ci(f"no Jupyter kernel can start here: {error!r}")
 
 
 def test_there_are_teaching_notebooks():
@@ -72,3 +87,17 @@ def test_notebook_executes(path, kernel_available):
     assert not [o for o in outputs if o.output_type == "error"]
     images = [o for o in outputs if "image/png" in o.get("data", {})]
     assert images, "the notebook should show figures"
+
+
+@pytest.mark.parametrize("env, outcome", [
+    ({}, pytest.skip.Exception),
+    ({"PDEFLOW_CI": "1"}, pytest.fail.Exception),
+    ({"CI": "true"}, pytest.fail.Exception),
+])
+def test_a_missing_kernel_skips_here_and_fails_in_ci(monkeypatch, env, outcome):
+    monkeypatch.delenv("PDEFLOW_CI", raising=False)
+    monkeypatch.delenv("CI", raising=False)
+    for key, value in env.items():
+        monkeypatch.setenv(key, value)
+    with pytest.raises(outcome, match="no Jupyter kernel"):
+        skip_or_fail_in_ci("no Jupyter kernel can start here")

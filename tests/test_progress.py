@@ -1,6 +1,7 @@
 """Progress while kernels compile and runs go (issue 14, part C): the first run says that
-it compiles, the estimate of the remaining time leaves the compilation out, and the bar
-of a plain ``eq.solve`` (the README's snippet) ends at rest."""
+it compiles, the estimate of the remaining time leaves the compilation out, the bar
+of a plain ``eq.solve`` (the README's snippet) ends at rest, and ``pdeflow run`` shows it
+on a terminal or when asked."""
 
 from __future__ import annotations
 
@@ -13,10 +14,13 @@ from pde import CartesianGrid
 from pde.trackers.base import TrackerBase
 
 import pdeflow
+from pdeflow.cases import load_case
+from pdeflow.cli import build_parser
 from pdeflow.solvers import fv_split
 from pdeflow.trackers import ProgressBar, progress
 
 ROOT = Path(__file__).parents[1]
+RITTER = ROOT / "cases" / "ritter_dam_break.toml"
 
 
 def _readme_state():
@@ -88,9 +92,28 @@ def test_cli_says_when_it_compiles(monkeypatch):
 
 
 def test_kernels_are_loaded_before_the_wall_time_starts():
-    from pdeflow.cases import load_case
     from pdeflow.simulate import run_model
 
-    run_model(load_case(ROOT / "cases" / "ritter_dam_break.toml",
-                        ["grid.cells=20", "output.snapshot_times=[]"]), "single_layer")
+    run_model(load_case(RITTER, ["grid.cells=20", "output.snapshot_times=[]"]),
+              "single_layer")
     assert fv_split.kernels_ready() and fv_split.kernels_cached()
+
+
+def test_progress_bar_only_on_a_terminal_or_asked(monkeypatch):
+    from pdeflow.cli import _run_trackers
+    from pdeflow.trackers import ProgressBar as ProgressTracker
+
+    case = load_case(RITTER)
+    parser = build_parser()
+
+    def kinds(argv):
+        args = parser.parse_args(["run", str(RITTER), *argv])
+        return [type(t) for t in _run_trackers(args, case, "single_layer", True)]
+
+    monkeypatch.setattr("sys.stdout.isatty", lambda: False)
+    assert ProgressTracker not in kinds([])
+    assert ProgressTracker in kinds(["--progress"])
+    monkeypatch.setattr("sys.stdout.isatty", lambda: True)
+    assert ProgressTracker in kinds([])
+    assert ProgressTracker not in kinds(["--no-progress"])
+    assert ProgressTracker not in kinds(["-q"])

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import math
 import os
-import time
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -119,6 +118,34 @@ def check_step_invariants(eq, q: np.ndarray, mass0: float, steps: int) -> None:
         assert non_hyperbolic_cells(eq, q) == []
 
 
+def check_single_layer_heap_stays_at_rest(h: np.ndarray, reconstruction: str) -> None:
+    """A single-layer heap h [m] on cells of 0.1 m (walls, phi_B = 10 deg, HLL, CFL 0.5)
+    whose one-sided slopes are all below 95 % of tan(phi_B) stays at rest, bit for bit,
+    for 10 steps."""
+    assert np.abs(np.diff(h)).max() / 0.1 < 0.95 * math.tan(math.radians(10.0))
+    eq, state = Scenario(False, {"phi_b_deg": 10.0}, {"flux": "hll",
+                                                      "reconstruction": reconstruction},
+                         "lie", 0.5, h.size / 10, {"h": h}).make()
+    stepper = stepper_for(eq, state, 0.5)
+    t = 0.0
+    for _ in range(10):
+        t = stepper(state, t, T_FAR)
+    np.testing.assert_array_equal(state.data[0], h)
+    assert np.all(state.data[1] == 0.0)
+
+def check_invariants_step_by_step(eq, state, cfl: float, splitting: str,
+                                  n_steps: int) -> None:
+    """Advance ``state`` in place one fv-split step at a time, checking the invariants
+    (check_step_invariants) and that time never goes back after every step."""
+    mass0 = total_mass(eq, state.data)
+    stepper = stepper_for(eq, state, cfl, splitting)
+    t = 0.0
+    for k in range(1, n_steps + 1):
+        t_new = stepper(state, t, T_FAR)
+        assert t_new >= t
+        t = t_new
+        check_step_invariants(eq, state.data, mass0, k)
+
 def random_depth(rng: np.random.Generator, n: int, scale: float, dry_fraction: float):
     """Depths [m] in [0, scale) with isolated dry cells and, sometimes, a dry gap."""
     h = scale * rng.random(n)
@@ -192,14 +219,7 @@ def test_random_states_keep_the_invariants(scenario, n_steps):
     eq, state = scenario.make()
     note(repr(scenario))
     note({k: v.tolist() for k, v in scenario.profiles.items()})
-    mass0 = total_mass(eq, state.data)
-    stepper = stepper_for(eq, state, scenario.cfl, scenario.splitting)
-    t = 0.0
-    for k in range(1, n_steps + 1):
-        t_new = stepper(state, t, T_FAR)
-        assert t_new >= t
-        t = t_new
-        check_step_invariants(eq, state.data, mass0, k)
+    check_invariants_step_by_step(eq, state, scenario.cfl, scenario.splitting, n_steps)
 
 
 @st.composite
@@ -283,12 +303,7 @@ def test_strang_step_keeps_the_cfl_condition():
          "h2": np.array([0.00606636, 0.00729497, 0.00543625]),
          "u2": np.array([-2.32503077, -0.21879166, -1.24591095])})
     eq, state = scenario.make()
-    mass0 = total_mass(eq, state.data)
-    stepper = stepper_for(eq, state, scenario.cfl, scenario.splitting)
-    t = 0.0
-    for k in range(1, 6):
-        t = stepper(state, t, T_FAR)
-        check_step_invariants(eq, state.data, mass0, k)
+    check_invariants_step_by_step(eq, state, scenario.cfl, scenario.splitting, 5)
 
 
 def test_strang_step_keeps_the_cfl_condition_under_erosion():
@@ -307,12 +322,7 @@ def test_strang_step_keeps_the_cfl_condition_under_erosion():
     for splitting in ("lie", "strang"):
         eq, state = Scenario(True, params, {"flux": "hll"}, splitting, 0.75, 1.0,
                              profiles).make()
-        mass0 = total_mass(eq, state.data)
-        stepper = stepper_for(eq, state, 0.75, splitting)
-        t = 0.0
-        for k in range(1, 6):
-            t = stepper(state, t, T_FAR)
-            check_step_invariants(eq, state.data, mass0, k)
+        check_invariants_step_by_step(eq, state, 0.75, splitting, 5)
 
 
 def test_muscl_heap_with_a_kink_stays_at_rest():
@@ -323,17 +333,8 @@ def test_muscl_heap_with_a_kink_stays_at_rest():
     tan 10 deg = 0.176), and the heap slumped. Cells at rest with their neighbours are
     now reconstructed at first order."""
     h = np.array([0.0290996, 0.02520256, 0.04186015, 0.05796915])
-    assert np.abs(np.diff(h)).max() / 0.1 < 0.95 * math.tan(math.radians(10.0))
     for rec in ("first-order", "muscl"):
-        eq, state = Scenario(False, {"phi_b_deg": 10.0}, {"flux": "hll",
-                                                          "reconstruction": rec},
-                             "lie", 0.5, 0.4, {"h": h}).make()
-        stepper = stepper_for(eq, state, 0.5)
-        t = 0.0
-        for _ in range(10):
-            t = stepper(state, t, T_FAR)
-        np.testing.assert_array_equal(state.data[0], h)
-        assert np.all(state.data[1] == 0.0)
+        check_single_layer_heap_stays_at_rest(h, rec)
 
 
 def test_ifcp_steps_that_are_not_positive_are_redone_with_hll():
@@ -373,17 +374,7 @@ def test_ifcp_steps_that_are_not_positive_are_redone_with_hll():
 def test_muscl_heap_below_friction_angle_stays_at_rest():
     """Found by test_states_at_rest_stay_at_rest (long profile)."""
     h = np.array([0.03200936, 0.02429672, 0.00891836, 0.0, 0.01049522, 0.02432341])
-    one_sided = np.abs(np.diff(h)) / 0.1
-    assert one_sided.max() < 0.95 * math.tan(math.radians(10.0))
-    eq, state = Scenario(False, {"phi_b_deg": 10.0}, {"flux": "hll",
-                                                      "reconstruction": "muscl"},
-                         "lie", 0.5, 0.6, {"h": h}).make()
-    stepper = stepper_for(eq, state, 0.5)
-    t = 0.0
-    for _ in range(10):
-        t = stepper(state, t, T_FAR)
-    np.testing.assert_array_equal(state.data[0], h)
-    assert np.all(state.data[1] == 0.0)
+    check_single_layer_heap_stays_at_rest(h, "muscl")
 
 
 # --- extremes: fast forms ----------------------------------------------------------------
@@ -505,18 +496,16 @@ def test_column_on_a_slope_below_stops_and_above_keeps_sliding(dtheta):
 
 
 def test_1e5_cells_short_run():
-    """10^5 cells: a few hundred steps of the 5.1 column (heavy form: slow test)."""
+    """10^5 cells: 200 steps of the 5.1 column (heavy form: slow test; its wall time is
+    measured by benchmarks/suite.py:large_grid_steps, docs/performance.md)."""
     eq, st0 = column(100_000, 7.0, 1.0, 2.0, bc=("wall", "wall"))
     stepper = FVSplitSolver(eq, cfl=0.3, stop_at_rest=False,
                             max_steps=200).make_stepper(st0)
     q = st0.copy()
-    t0 = time.perf_counter()
     t = stepper(q, 0.0, 1.0)
-    wall = time.perf_counter() - t0
     assert t > 0 and np.all(np.isfinite(q.data)) and np.all(q.data[::2] >= 0)
     m0 = total_mass(eq, st0.data)
     assert abs(total_mass(eq, q.data) - m0) <= 200 * 16 * EPS * m0
-    assert wall < 30.0
 
 
 # --- extremes: heavy forms (slow) ------------------------------------------------------------

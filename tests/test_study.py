@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import signal
 import socket
@@ -19,6 +20,8 @@ from pdeflow.cli import main  # noqa: E402
 from pdeflow.study import load_study  # noqa: E402
 from pdeflow.study.designs import design_points  # noqa: E402
 from pdeflow.study.testfunctions import ishigami, ishigami_indices  # noqa: E402
+
+from .helpers import ishigami_study  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE_51 = (ROOT / "cases" / "paper_5_1_dam_break.toml").as_posix()
@@ -148,18 +151,7 @@ quantities = ["single_layer.runout"]
 
 
 def test_sobol_indices_of_ishigami_through_the_pipeline(tmp_path):
-    text = """
-[study]
-function = "pdeflow.study.testfunctions:ishigami"
-design = "sobol"
-samples = 2048
-seed = 3
-quantities = ["y"]
-[parameters]
-x1 = { range = [-3.141592653589793, 3.141592653589793] }
-x2 = { range = [-3.141592653589793, 3.141592653589793] }
-x3 = { range = [-3.141592653589793, 3.141592653589793] }
-"""
+    text = ishigami_study("sobol", 2048, 3, bound=math.pi)
     out = tmp_path / "out"
     assert main(["study", str(_study(tmp_path, text)), "--out", str(out), "--workers",
                  "1", "-q"]) == 0
@@ -207,19 +199,7 @@ f2 = "f2"
 
 
 def test_killed_study_resumes_without_duplicates(tmp_path):
-    text = """
-[study]
-function = "pdeflow.study.testfunctions:ishigami"
-design = "lhs"
-samples = 60
-seed = 7
-quantities = ["y"]
-[parameters]
-x1 = { range = [-3, 3] }
-x2 = { range = [-3, 3] }
-x3 = { range = [-3, 3] }
-delay = { values = [0.1] }
-"""
+    text = ishigami_study("lhs", 60, 7, delay=0.1)
     study, out = _study(tmp_path, text), tmp_path / "out"
     cmd = [sys.executable, "-m", "pdeflow", "study", str(study), "--out", str(out),
            "--workers", "2", "-q"]

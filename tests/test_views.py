@@ -6,14 +6,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import matplotlib
+import numpy as np
+import pytest
 
-matplotlib.use("Agg")
-
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
-
-from pdeflow.analysis.convergence import header, richardson, table  # noqa: E402
-from pdeflow.cli import main  # noqa: E402
+from pdeflow.analysis.convergence import header, richardson, table
+from pdeflow.cli import main
 
 ROOT = Path(__file__).parents[1]
 CASE_51 = ROOT / "cases" / "paper_5_1_dam_break.toml"

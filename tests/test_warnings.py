@@ -7,22 +7,18 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import matplotlib
+import pytest
 
-matplotlib.use("Agg")
-
-import pytest  # noqa: E402
-
-from pdeflow.cases import load_case  # noqa: E402
-from pdeflow.checks import (  # noqa: E402
+from pdeflow.cases import load_case
+from pdeflow.checks import (
     LONG_RUN_CELL_UPDATES,
     RunWarning,
     cost_warning,
     result_warnings,
     run_cost,
 )
-from pdeflow.cli import build_parser, main  # noqa: E402
-from pdeflow.simulate import run_model  # noqa: E402
+from pdeflow.cli import build_parser, main
+from pdeflow.simulate import run_model
 
 ROOT = Path(__file__).parents[1]
 CASE_51 = ROOT / "cases" / "paper_5_1_dam_break.toml"
