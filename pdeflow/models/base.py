@@ -240,43 +240,34 @@ class GranularPDE(PDEBase):
         return float(P[L.DRY] if self.two_layer else P[L.S_DRY])
 
     def make_evolution_rate(self, state: FieldCollection, backend: Any) -> Callable:
-        """Compiled method-of-lines rate (numba backend)."""
+        """Compiled method-of-lines rate (numba backend): the advection rate of this
+        model's scheme (only that scheme is compiled) plus the sources (26)-(27)."""
         name = getattr(backend, "name", str(backend))
         if name not in ("numba",):
             raise NotImplementedError(f"no compiled rate for backend {name}")
         from numba import njit
 
-        from ..numerics.advection import rate_single, rate_two_layer
+        from ..numerics.advection import rate_kernel
+        from ..numerics.compiled import ready
         from ..numerics.mol import source_rate_single, source_rate_two_layer
 
         dx = self.check_grid(state.grid)
         P = self.parameter_array()
         bcl, bcr = self.bc_codes
-        g = P[L.G_Z]
+        g = float(P[L.G_Z])
+        r = float(P[L.R]) if self.two_layer else 0.0
         dry = self._dry(P)
-        flux, order, limiter = self.scheme_codes
+        advect = ready(rate_kernel(self.two_layer, *self.scheme_codes))
+        sources = ready(source_rate_two_layer if self.two_layer else source_rate_single)
         shape = (2, *state.data.shape)  # closure arrays are read-only in numba
-        if self.two_layer:
-            r = P[L.R]
 
-            @njit
-            def rate(state_data, t):  # pragma: no cover - compiled
-                out = np.empty_like(state_data)
-                work = np.empty(shape)
-                rate_two_layer(state_data, out, work, dx, bcl, bcr, g, r, dry, flux,
-                               order, limiter)
-                source_rate_two_layer(state_data, out, P)
-                return out
-        else:
-
-            @njit
-            def rate(state_data, t):  # pragma: no cover - compiled
-                out = np.empty_like(state_data)
-                work = np.empty(shape)
-                rate_single(state_data, out, work, dx, bcl, bcr, g, dry, flux, order,
-                            limiter)
-                source_rate_single(state_data, out, P)
-                return out
+        @njit
+        def rate(state_data, t):  # pragma: no cover - compiled
+            out = np.empty_like(state_data)
+            work = np.empty(shape)
+            advect(state_data, out, work, dx, bcl, bcr, g, r, dry)
+            sources(state_data, out, P)
+            return out
 
         return rate
 
@@ -287,7 +278,7 @@ class GranularPDE(PDEBase):
 
     def source_kernel(self) -> Callable:
         """The compiled source stage ``(q, dt, t, P, diag) -> None`` of this model."""
-        from ..numerics.splitting import source_stage_single, source_stage_two_layer
+        from ..numerics.source_stage import source_stage_single, source_stage_two_layer
 
         return source_stage_two_layer if self.two_layer else source_stage_single
 
@@ -297,12 +288,13 @@ class GranularPDE(PDEBase):
         Every py-pde solver builds this hook before its first step, so the initial
         state is validated here (:meth:`check_state`) whatever the solver.
         """
+        from ..numerics.compiled import ready
+
         self.check_state(state)
         P = self.parameter_array()
         kernel = self.source_kernel()
         name = getattr(backend, "name", str(backend))
-        if name == "numpy":
-            kernel = kernel.py_func
+        kernel = kernel.py_func if name == "numpy" else ready(kernel)
 
         def post_step_hook(state_data, t, post_step_data):
             dt = post_step_data[0]
