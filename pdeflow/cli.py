@@ -45,39 +45,6 @@ each quantity as (time, cell), plus the metadata as JSON. NetCDF needs xarray
 (pip install 'pdeflow[export]'); the metadata goes into its attributes."""
 
 
-def _fmt(v: Any, unit: str = "") -> str:
-    if v is None:
-        return "-"
-    if isinstance(v, float):
-        return f"{v:.4g}{unit}"
-    return f"{v}{unit}"
-
-
-def print_summary(summary: dict[str, Any], out: Any = None) -> None:
-    """A short human-readable table of the per-model results."""
-    out = out or sys.stdout
-    rows = [("stop time", "stop_time", " s"), ("lower stop", "lower_stop_time", " s"),
-            ("upper stop", "upper_stop_time", " s"), ("front", "front_position", " m"),
-            ("run-out", "runout", " m"), ("max F_extra/rho1", "max_fextra_over_rho1",
-                                           " m2/s2"),
-            ("mass error", "mass_relative_error", ""), ("steps", "steps", ""),
-            ("wall time", "wall_time_s", " s")]
-    models = summary["models"]
-    print(f"case {summary['case']}", file=out)
-    print(f"{'':18}" + "".join(f"{m:>16}" for m in models), file=out)
-    for label, key, unit in rows:
-        print(f"{label:18}" + "".join(f"{_cell(models[m], key, unit):>16}"
-                                      for m in models), file=out)
-
-
-def _cell(model_summary: dict[str, Any], key: str, unit: str) -> str:
-    """A table cell; a front or run-out cut off by the end of the domain reads '>= ...'."""
-    text = _fmt(model_summary.get(key), unit)
-    if key in ("front_position", "runout") and model_summary.get("runout_lower_bound"):
-        return ">= " + text
-    return text
-
-
 def _model_path(path: str | Path, model: str, first: bool) -> Path:
     """Per-model output name: PATH for the first model, NAME.<model>.SUFFIX after it."""
     path = Path(path)
@@ -132,7 +99,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .cases import load_case
     from .io import check_output, write_json, write_npz
     from .plotting import case_figures, deposit_figure, save
-    from .simulate import load_case_kernels, run_model
+    from .simulate import load_case_kernels, print_summary, run_model
 
     case = load_case(args.case, args.set)
     for name in ("live_every", "store_every", "fps"):
@@ -224,17 +191,6 @@ def cmd_run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _describe(run: Any) -> str:
-    m = run.metadata
-    t_final = m.get("t_final")
-    rest = " (at rest)" if m.get("at_rest") else ""
-    fmax = float(run.fextra.max()) if run.fextra.size else 0.0
-    return (f"{run.path}: {m.get('case_name', '?')}, {run.model}, {len(run.times)} frames "
-            f"t = {run.times[0]:g}..{run.times[-1]:.4g} s, "
-            f"end {'-' if t_final is None else f'{t_final:.4g} s'}{rest}, "
-            f"max stored F_extra/rho1 {fmax:.3g} m2/s2")
-
-
 def _plot_labels(runs: list[Any]) -> list[str]:
     """Legend names of stored runs: none where their models differ (the model names
     them), else the file names (their paths where the names repeat)."""
@@ -309,7 +265,7 @@ def cmd_plot(args: argparse.Namespace) -> int:
         fig.close()
     if not args.quiet:
         for r in runs:
-            print(_describe(r))
+            print(r.describe())
         for p in written:
             print(f"wrote {p}")
     return 0
@@ -323,7 +279,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     run = open_run(args.run)
     out = run.export(args.out)
     if not args.quiet:
-        print(_describe(run))
+        print(run.describe())
         print(f"wrote {out}")
     return 0
 
