@@ -361,41 +361,27 @@ def build_parser() -> argparse.ArgumentParser:
     export.add_argument("-q", "--quiet", action="store_true", help="print nothing")
     export.set_defaults(func=cmd_export)
 
-    # --- sweep, converge, compare ---------------------------------------------------------
-    from . import sweep as sweep_mod
-    from .analysis import convergence
+    # --- the commands whose module owns its options (add_arguments) and body ----------
+    from . import sweep
+    from .analysis import convergence, workprecision
+    from .app import server  # panel is imported only when the app runs
+    from .study import command as study
 
-    sw = sub.add_parser("sweep", help="aspect-ratio sweep and run-out law (paper 5.2)",
-                        description=sweep_mod.__doc__, formatter_class=raw)
-    sweep_mod.add_arguments(sw)
-    sw.set_defaults(func=sweep_mod.cmd_sweep)
-    cv = sub.add_parser("converge", help="grid-convergence study of a case",
-                        description=convergence.__doc__, formatter_class=raw)
-    convergence.add_arguments(cv)
-    cv.set_defaults(func=convergence.cmd_converge)
-    from .analysis import workprecision
-
-    cp = sub.add_parser("compare", help="work-precision study: error against wall time "
-                        "of solver variants (to compare runs, use plot)",
-                        description=workprecision.HELP, formatter_class=raw)
-    workprecision.add_arguments(cp)
-    cp.set_defaults(func=workprecision.cmd_compare)
-
-    # --- study ----------------------------------------------------------------------------
-    from .study import command as study_cmd
-
-    st = sub.add_parser("study", help="parameter study, sensitivity or calibration on Dask",
-                        description=study_cmd.__doc__, formatter_class=raw)
-    study_cmd.add_arguments(st)
-    st.set_defaults(func=study_cmd.cmd_study)
-
-    # --- app ------------------------------------------------------------------------------
-    from .app import server as app_server  # panel is imported only when the app runs
-
-    ap = sub.add_parser("app", help="teaching app in the browser (needs panel)",
-                        description=app_server.__doc__, formatter_class=raw)
-    app_server.add_arguments(ap)
-    ap.set_defaults(func=app_server.cmd_app)
+    for name, module, func, help_ in (
+            ("sweep", sweep, sweep.cmd_sweep,
+             "aspect-ratio sweep and run-out law (paper 5.2)"),
+            ("converge", convergence, convergence.cmd_converge,
+             "grid-convergence study of a case"),
+            ("compare", workprecision, workprecision.cmd_compare,
+             "work-precision study: error against wall time of solver variants (to "
+             "compare runs, use plot)"),
+            ("study", study, study.cmd_study,
+             "parameter study, sensitivity or calibration on Dask"),
+            ("app", server, server.cmd_app, "teaching app in the browser (needs panel)")):
+        cmd = sub.add_parser(name, help=help_, formatter_class=raw,
+                             description=getattr(module, "HELP", module.__doc__))
+        module.add_arguments(cmd)
+        cmd.set_defaults(func=func)
     return parser
 
 
