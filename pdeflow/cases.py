@@ -14,7 +14,7 @@ names the key and the file. Sections (all optional except ``[initial]``)::
     [two_layer]   any field of TwoLayerParameters
     [single_layer] any field of SingleLayerParameters
     [output]      snapshot_times [s], front_threshold [m]
-    [sweep]       aspect_ratios = [a, ...] (H0 = a L0; see pdeflow.sweep)
+    [sweep]       aspect_ratios = [a, ...] (H0 = a L0; see pdeflow.analysis.sweep)
 
 Initial shapes (x measured from the left end of the domain):
 

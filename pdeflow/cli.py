@@ -362,8 +362,7 @@ def build_parser() -> argparse.ArgumentParser:
     export.set_defaults(func=cmd_export)
 
     # --- the commands whose module owns its options (add_arguments) and body ----------
-    from . import sweep
-    from .analysis import convergence, workprecision
+    from .analysis import convergence, sweep, workprecision
     from .app import server  # panel is imported only when the app runs
     from .study import command as study
 

@@ -7,8 +7,8 @@ from pathlib import Path
 
 from pdeflow.analysis.convergence import converge
 from pdeflow.analysis.study import Point, Study, pool_executor, serial
+from pdeflow.analysis.sweep import run_sweep
 from pdeflow.cases import load_case
-from pdeflow.sweep import run_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 

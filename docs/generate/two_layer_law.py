@@ -39,16 +39,16 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from pdeflow.cases import load_case  # noqa: E402
-from pdeflow.io import atomic_path  # noqa: E402
-from pdeflow.plotting import ASPECT_TICKS, log_ticks, save  # noqa: E402
-from pdeflow.simulate import run_model  # noqa: E402
-from pdeflow.sweep import (  # noqa: E402
+from pdeflow.analysis.sweep import (  # noqa: E402
     PUBLISHED_EXPONENTS,
     PUBLISHED_LAWS,
     published_law,
     run_sweep,
 )
+from pdeflow.cases import load_case  # noqa: E402
+from pdeflow.io import atomic_path  # noqa: E402
+from pdeflow.plotting import ASPECT_TICKS, log_ticks, save  # noqa: E402
+from pdeflow.simulate import run_model  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 CASE_51 = ROOT / "cases" / "paper_5_1_dam_break.toml"

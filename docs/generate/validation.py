@@ -7,7 +7,7 @@ cases/ritter_dam_break.toml, mangeney_dam_break_slope.toml, stoker_dam_break.tom
 CFL 0.45, every flux and reconstruction), a smooth wave against a fine grid, the
 two-layer checks, and test 5.2's run-out against aspect ratio
 (cases/collapse_sweep.toml). Uses :mod:`pdeflow.analysis.validation` and
-:func:`pdeflow.sweep.run_sweep`.
+:func:`pdeflow.analysis.sweep.run_sweep`.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 
+from pdeflow.analysis.sweep import run_sweep, sweep_figure  # noqa: E402
 from pdeflow.analysis.validation import (  # noqa: E402
     exact_study,
     smooth_study,
@@ -27,7 +28,6 @@ from pdeflow.analysis.validation import (  # noqa: E402
 )
 from pdeflow.cases import load_case  # noqa: E402
 from pdeflow.io import atomic_path  # noqa: E402
-from pdeflow.sweep import run_sweep, sweep_figure  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES = ROOT / "cases"

@@ -22,9 +22,9 @@ from typing import Any
 
 import numpy as np
 
-from .analysis.study import Executor, Point, Study, serial, with_sets
-from .cases import Case, CaseError, load_case
-from .simulate import load_case_kernels
+from ..cases import Case, CaseError, load_case
+from ..simulate import load_case_kernels
+from .study import Executor, Point, Study, serial, with_sets
 
 PAPER_FITS = {"single_layer": (2.25, 1.06), "two_layer": (1.61, 0.84)}
 DEM_EXPONENT = 0.83
@@ -127,7 +127,7 @@ def sweep_figure(summary: dict[str, Any], path: str | Path) -> Path:
     """Log-log plot of r against a with the fits, the paper's fits and the DEM slope."""
     import matplotlib.pyplot as plt
 
-    from .plotting import ASPECT_TICKS, log_ticks, save
+    from ..plotting import ASPECT_TICKS, log_ticks, save
 
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
     styles = {"single_layer": ("k", "o", "single layer"),
@@ -178,7 +178,7 @@ def add_arguments(ap: Any) -> None:
 
 def cmd_sweep(args: Any) -> int:
     """``pdeflow sweep``: run the sweep described by parsed ``args``; print the fits."""
-    from . import io
+    from .. import io
 
     io.check_output(args.summary, "--summary")
     io.check_output(args.plot, "--plot")
