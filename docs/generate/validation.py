@@ -27,7 +27,7 @@ from pdeflow.analysis.validation import (  # noqa: E402
     two_layer_checks,
 )
 from pdeflow.cases import load_case  # noqa: E402
-from pdeflow.io import atomic_path  # noqa: E402
+from pdeflow.io import write_text  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES = ROOT / "cases"
@@ -154,8 +154,7 @@ def main(argv: list[str] | None = None) -> int:
     out.mkdir(parents=True, exist_ok=True)
     fig = "validation_runout.png"
     sweep_figure(res["sweep"], out / fig)
-    with atomic_path(out / "validation.md") as tmp:
-        tmp.write_text(markdown(res, fig))
+    write_text(out / "validation.md", markdown(res, fig))
     print(f"wrote {out / 'validation.md'}")
     return 0
 
