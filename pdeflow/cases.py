@@ -14,7 +14,7 @@ names the key and the file. Sections (all optional except ``[initial]``)::
     [two_layer]   any field of TwoLayerParameters
     [single_layer] any field of SingleLayerParameters
     [output]      snapshot_times [s], front_threshold [m]
-    [sweep]       aspect_ratios = [a, ...] (H0 = a L0; see pdeflow.sweep)
+    [sweep]       aspect_ratios = [a, ...] (H0 = a L0; see pdeflow.analysis.sweep)
 
 Initial shapes (x measured from the left end of the domain):
 
@@ -47,7 +47,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from .models.base import check_range
-from .variant import Variant, VariantError
+from .variant import Variant, VariantError, variant_of
 
 MODEL_NAMES = ("two_layer", "single_layer")
 
@@ -187,7 +187,7 @@ class Case:
         if "initial" not in self.data or "shape" not in self.data["initial"]:
             raise self._err("[initial] with a 'shape' is required")
         try:
-            Variant.from_case(self)  # solver, flux, reconstruction, limiter, splitting
+            self.variant  # noqa: B018 - checks solver, flux, reconstruction, limiter, ...
         except VariantError as err:
             raise self._err(str(err)) from None
         if self.initial["shape"] not in SHAPES:
@@ -323,6 +323,27 @@ class Case:
     @property
     def front_threshold(self) -> float:
         return float(self._get("output", "front_threshold", 1e-3))
+
+    @property
+    def variant(self) -> Variant:
+        """How the case is solved: the :class:`~pdeflow.variant.Variant` its
+        ``[numerics]`` and two-layer ``hyperbolicity`` select."""
+        return variant_of(self.data.get("numerics", {}),
+                          self.data.get("two_layer", {}).get("hyperbolicity", "exact"))
+
+    def with_variant(self, variant: Variant) -> Case:
+        """A copy solved with ``variant`` (its other numerics, e.g. cfl and dt, kept);
+        the two-layer ``hyperbolicity`` parameter is set unless it is the case's own."""
+        c = self.copy()
+        num = c.data.setdefault("numerics", {})
+        for key in ("flux", "reconstruction", "limiter", "splitting", "solver"):
+            num.pop(key, None)
+        num.update(variant.numerics())
+        if variant.hyperbolicity != c.data.get("two_layer", {}).get("hyperbolicity",
+                                                                    "exact"):
+            c.data.setdefault("two_layer", {})["hyperbolicity"] = variant.hyperbolicity
+        c.validate()
+        return c
 
     # --- model set-up ---------------------------------------------------------------------
     def make_grid(self):

@@ -45,39 +45,6 @@ each quantity as (time, cell), plus the metadata as JSON. NetCDF needs xarray
 (pip install 'pdeflow[export]'); the metadata goes into its attributes."""
 
 
-def _fmt(v: Any, unit: str = "") -> str:
-    if v is None:
-        return "-"
-    if isinstance(v, float):
-        return f"{v:.4g}{unit}"
-    return f"{v}{unit}"
-
-
-def print_summary(summary: dict[str, Any], out: Any = None) -> None:
-    """A short human-readable table of the per-model results."""
-    out = out or sys.stdout
-    rows = [("stop time", "stop_time", " s"), ("lower stop", "lower_stop_time", " s"),
-            ("upper stop", "upper_stop_time", " s"), ("front", "front_position", " m"),
-            ("run-out", "runout", " m"), ("max F_extra/rho1", "max_fextra_over_rho1",
-                                           " m2/s2"),
-            ("mass error", "mass_relative_error", ""), ("steps", "steps", ""),
-            ("wall time", "wall_time_s", " s")]
-    models = summary["models"]
-    print(f"case {summary['case']}", file=out)
-    print(f"{'':18}" + "".join(f"{m:>16}" for m in models), file=out)
-    for label, key, unit in rows:
-        print(f"{label:18}" + "".join(f"{_cell(models[m], key, unit):>16}"
-                                      for m in models), file=out)
-
-
-def _cell(model_summary: dict[str, Any], key: str, unit: str) -> str:
-    """A table cell; a front or run-out cut off by the end of the domain reads '>= ...'."""
-    text = _fmt(model_summary.get(key), unit)
-    if key in ("front_position", "runout") and model_summary.get("runout_lower_bound"):
-        return ">= " + text
-    return text
-
-
 def _model_path(path: str | Path, model: str, first: bool) -> Path:
     """Per-model output name: PATH for the first model, NAME.<model>.SUFFIX after it."""
     path = Path(path)
@@ -132,7 +99,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .cases import load_case
     from .io import check_output, write_json, write_npz
     from .plotting import case_figures, deposit_figure, save
-    from .simulate import load_case_kernels, run_model
+    from .simulate import load_case_kernels, print_summary, run_model
 
     case = load_case(args.case, args.set)
     for name in ("live_every", "store_every", "fps"):
@@ -224,17 +191,6 @@ def cmd_run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _describe(run: Any) -> str:
-    m = run.metadata
-    t_final = m.get("t_final")
-    rest = " (at rest)" if m.get("at_rest") else ""
-    fmax = float(run.fextra.max()) if run.fextra.size else 0.0
-    return (f"{run.path}: {m.get('case_name', '?')}, {run.model}, {len(run.times)} frames "
-            f"t = {run.times[0]:g}..{run.times[-1]:.4g} s, "
-            f"end {'-' if t_final is None else f'{t_final:.4g} s'}{rest}, "
-            f"max stored F_extra/rho1 {fmax:.3g} m2/s2")
-
-
 def _plot_labels(runs: list[Any]) -> list[str]:
     """Legend names of stored runs: none where their models differ (the model names
     them), else the file names (their paths where the names repeat)."""
@@ -309,7 +265,7 @@ def cmd_plot(args: argparse.Namespace) -> int:
         fig.close()
     if not args.quiet:
         for r in runs:
-            print(_describe(r))
+            print(r.describe())
         for p in written:
             print(f"wrote {p}")
     return 0
@@ -323,7 +279,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     run = open_run(args.run)
     out = run.export(args.out)
     if not args.quiet:
-        print(_describe(run))
+        print(run.describe())
         print(f"wrote {out}")
     return 0
 
@@ -405,41 +361,26 @@ def build_parser() -> argparse.ArgumentParser:
     export.add_argument("-q", "--quiet", action="store_true", help="print nothing")
     export.set_defaults(func=cmd_export)
 
-    # --- sweep, converge, compare ---------------------------------------------------------
-    from . import sweep as sweep_mod
-    from .analysis import convergence
+    # --- the commands whose module owns its options (add_arguments) and body ----------
+    from .analysis import convergence, sweep, workprecision
+    from .app import server  # panel is imported only when the app runs
+    from .study import command as study
 
-    sw = sub.add_parser("sweep", help="aspect-ratio sweep and run-out law (paper 5.2)",
-                        description=sweep_mod.__doc__, formatter_class=raw)
-    sweep_mod.add_arguments(sw)
-    sw.set_defaults(func=sweep_mod.cmd_sweep)
-    cv = sub.add_parser("converge", help="grid-convergence study of a case",
-                        description=convergence.__doc__, formatter_class=raw)
-    convergence.add_arguments(cv)
-    cv.set_defaults(func=convergence.cmd_converge)
-    from .analysis import workprecision
-
-    cp = sub.add_parser("compare", help="work-precision study: error against wall time "
-                        "of solver variants (to compare runs, use plot)",
-                        description=workprecision.HELP, formatter_class=raw)
-    workprecision.add_arguments(cp)
-    cp.set_defaults(func=workprecision.cmd_compare)
-
-    # --- study ----------------------------------------------------------------------------
-    from .study import command as study_cmd
-
-    st = sub.add_parser("study", help="parameter study, sensitivity or calibration on Dask",
-                        description=study_cmd.__doc__, formatter_class=raw)
-    study_cmd.add_arguments(st)
-    st.set_defaults(func=study_cmd.cmd_study)
-
-    # --- app ------------------------------------------------------------------------------
-    from .app import server as app_server  # panel is imported only when the app runs
-
-    ap = sub.add_parser("app", help="teaching app in the browser (needs panel)",
-                        description=app_server.__doc__, formatter_class=raw)
-    app_server.add_arguments(ap)
-    ap.set_defaults(func=app_server.cmd_app)
+    for name, module, func, help_ in (
+            ("sweep", sweep, sweep.cmd_sweep,
+             "aspect-ratio sweep and run-out law (paper 5.2)"),
+            ("converge", convergence, convergence.cmd_converge,
+             "grid-convergence study of a case"),
+            ("compare", workprecision, workprecision.cmd_compare,
+             "work-precision study: error against wall time of solver variants (to "
+             "compare runs, use plot)"),
+            ("study", study, study.cmd_study,
+             "parameter study, sensitivity or calibration on Dask"),
+            ("app", server, server.cmd_app, "teaching app in the browser (needs panel)")):
+        cmd = sub.add_parser(name, help=help_, formatter_class=raw,
+                             description=getattr(module, "HELP", module.__doc__))
+        module.add_arguments(cmd)
+        cmd.set_defaults(func=func)
     return parser
 
 

@@ -102,11 +102,16 @@ def jsonable(value: Any) -> Any:
     return value
 
 
+def write_text(path: str | Path, text: str) -> Path:
+    """Write ``text`` to ``path``, atomically."""
+    with atomic_path(path) as tmp:
+        tmp.write_text(text)
+    return Path(path)
+
+
 def write_json(path: str | Path, data: Any) -> Path:
     """Write ``data`` as indented JSON, atomically."""
-    with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps(jsonable(data), indent=2) + "\n")
-    return Path(path)
+    return write_text(path, json.dumps(jsonable(data), indent=2) + "\n")
 
 
 def write_npz(path: str | Path, arrays: dict[str, np.ndarray]) -> Path:

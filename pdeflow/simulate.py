@@ -9,6 +9,7 @@ typed view of the solver's diagnostics and the summary.
 
 from __future__ import annotations
 
+import sys
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -93,8 +94,8 @@ class Run:
                  backend: str = "numba"):
         if isinstance(variant, str):
             variant = Variant.parse(variant)
-        self.case = case if variant is None else variant.apply(case)
-        self.variant = variant or Variant.from_case(case)
+        self.case = case if variant is None else case.with_variant(variant)
+        self.variant = variant or case.variant
         self.model = model
         self.backend = backend
         self.pde, self.state = self.case.make_state(model)
@@ -263,3 +264,38 @@ def summarize(res: RunResult, mass0: float, wall: float,
         out["runout_lower_bound"] = out["domain_ends"]["runout_lower_bound"]
     out["warnings"] = result_warnings(case, res.model, out)
     return out
+
+
+# --- printing ---------------------------------------------------------------------------
+
+def _fmt(v: Any, unit: str = "") -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, float):
+        return f"{v:.4g}{unit}"
+    return f"{v}{unit}"
+
+
+def print_summary(summary: dict[str, Any], out: Any = None) -> None:
+    """A short human-readable table of the per-model results."""
+    out = out or sys.stdout
+    rows = [("stop time", "stop_time", " s"), ("lower stop", "lower_stop_time", " s"),
+            ("upper stop", "upper_stop_time", " s"), ("front", "front_position", " m"),
+            ("run-out", "runout", " m"), ("max F_extra/rho1", "max_fextra_over_rho1",
+                                           " m2/s2"),
+            ("mass error", "mass_relative_error", ""), ("steps", "steps", ""),
+            ("wall time", "wall_time_s", " s")]
+    models = summary["models"]
+    print(f"case {summary['case']}", file=out)
+    print(f"{'':18}" + "".join(f"{m:>16}" for m in models), file=out)
+    for label, key, unit in rows:
+        print(f"{label:18}" + "".join(f"{_cell(models[m], key, unit):>16}"
+                                      for m in models), file=out)
+
+
+def _cell(model_summary: dict[str, Any], key: str, unit: str) -> str:
+    """A table cell; a front or run-out cut off by the end of the domain reads '>= ...'."""
+    text = _fmt(model_summary.get(key), unit)
+    if key in ("front_position", "runout") and model_summary.get("runout_lower_bound"):
+        return ">= " + text
+    return text

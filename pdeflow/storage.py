@@ -247,6 +247,18 @@ class StoredRun:
         return float(self.metadata.get("parameters", {}).get("dry_tolerance",
                                                              DRY_TOLERANCE))
 
+    def describe(self) -> str:
+        """One line: file, case, model, frames and their times, end time [s], largest
+        stored F_extra/rho1 [m^2/s^2]."""
+        m = self.metadata
+        t_final = m.get("t_final")
+        rest = " (at rest)" if m.get("at_rest") else ""
+        fmax = float(self.fextra.max()) if self.fextra.size else 0.0
+        return (f"{self.path}: {m.get('case_name', '?')}, {self.model}, "
+                f"{len(self.times)} frames t = {self.times[0]:g}..{self.times[-1]:.4g} s, "
+                f"end {'-' if t_final is None else f'{t_final:.4g} s'}{rest}, "
+                f"max stored F_extra/rho1 {fmax:.3g} m2/s2")
+
     @property
     def label(self) -> str:
         """File name and model, for legends."""

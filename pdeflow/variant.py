@@ -21,12 +21,9 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from .numerics import layout as L
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .cases import Case
 
 FLUXES: tuple[str, ...] = tuple(L.FLUXES)
 RECONSTRUCTIONS: tuple[str, ...] = ("first-order", "muscl")
@@ -170,27 +167,6 @@ class Variant:
         """A copy with some fields changed (validated)."""
         return replace(self, **changes)
 
-    # --- cases ---------------------------------------------------------------------------
-    @classmethod
-    def from_case(cls, case: Case) -> Variant:
-        """The variant a case file selects (its ``[numerics]`` and the two-layer
-        ``hyperbolicity`` parameter); VariantError names the bad entry."""
-        num = case.data.get("numerics", {})
-        fields = {"solver": num.get("solver", "fv-split"), "flux": num.get("flux", "hll"),
-                  "reconstruction": num.get("reconstruction", "first-order"),
-                  "limiter": num.get("limiter", "minmod"),
-                  "splitting": num.get("splitting", "lie")}
-        allowed = {"solver": tuple(solver_names()), "flux": FLUXES,
-                   "reconstruction": RECONSTRUCTIONS, "limiter": LIMITERS,
-                   "splitting": SPLITTINGS}
-        for key, value in fields.items():  # errors name the case file's key
-            _choice(f"numerics.{key}", value, allowed[key], None)
-        if fields["solver"] != "fv-split":
-            fields["splitting"] = "lie"  # the method of lines does not split
-        hyp = case.data.get("two_layer", {}).get("hyperbolicity", "exact")
-        _choice("two_layer.hyperbolicity", hyp, HYPERBOLICITY, None)
-        return cls(hyperbolicity=hyp, **fields)
-
     def numerics(self) -> dict[str, Any]:
         """The case file's ``[numerics]`` entries that select this variant."""
         out: dict[str, Any] = {"solver": self.solver, "flux": self.flux,
@@ -200,17 +176,21 @@ class Variant:
             out["splitting"] = self.splitting
         return out
 
-    def apply(self, case: Case) -> Case:
-        """A copy of ``case`` solved with this variant (its other numerics, e.g. cfl and
-        dt, kept); the two-layer ``hyperbolicity`` parameter is set unless it is the
-        default that the case already has."""
-        c = case.copy()
-        num = c.data.setdefault("numerics", {})
-        for key in ("flux", "reconstruction", "limiter", "splitting", "solver"):
-            num.pop(key, None)
-        num.update(self.numerics())
-        two = c.data.get("two_layer", {})
-        if self.hyperbolicity != two.get("hyperbolicity", "exact"):
-            c.data.setdefault("two_layer", {})["hyperbolicity"] = self.hyperbolicity
-        c.validate()
-        return c
+
+def variant_of(numerics: dict[str, Any], hyperbolicity: str = "exact") -> Variant:
+    """The variant that a case file's ``[numerics]`` table and two-layer
+    ``hyperbolicity`` select; VariantError names the case file's key that is wrong."""
+    fields = {"solver": numerics.get("solver", "fv-split"),
+              "flux": numerics.get("flux", "hll"),
+              "reconstruction": numerics.get("reconstruction", "first-order"),
+              "limiter": numerics.get("limiter", "minmod"),
+              "splitting": numerics.get("splitting", "lie")}
+    allowed = {"solver": tuple(solver_names()), "flux": FLUXES,
+               "reconstruction": RECONSTRUCTIONS, "limiter": LIMITERS,
+               "splitting": SPLITTINGS}
+    for key, value in fields.items():  # errors name the case file's key
+        _choice(f"numerics.{key}", value, allowed[key], None)
+    if fields["solver"] != "fv-split":
+        fields["splitting"] = "lie"  # the method of lines does not split
+    _choice("two_layer.hyperbolicity", hyperbolicity, HYPERBOLICITY, None)
+    return Variant(hyperbolicity=hyperbolicity, **fields)

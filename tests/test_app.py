@@ -14,6 +14,7 @@ import pytest
 
 pn = pytest.importorskip("panel")  # the app extra (part of the test extra)
 
+from pdeflow.analysis.sweep import PUBLISHED_LAWS, published_law, run_sweep  # noqa: E402
 from pdeflow.app.controls import KNOBS, command_line, find_case_dir  # noqa: E402
 from pdeflow.app.dam_break import DamBreakPage, SharedRun, simulate  # noqa: E402
 from pdeflow.app.hyperbolicity import (  # noqa: E402
@@ -26,15 +27,14 @@ from pdeflow.app.hyperbolicity import (  # noqa: E402
 from pdeflow.app.kernels import WARMUP, KernelWarmup  # noqa: E402
 from pdeflow.app.runout import RunoutPage, format_r  # noqa: E402
 from pdeflow.cases import load_case  # noqa: E402
-from pdeflow.cli import main, print_summary  # noqa: E402
+from pdeflow.cli import main  # noqa: E402
 from pdeflow.numerics.hyperbolicity import (  # noqa: E402
     discriminant,
     eigenvalues,
     lower_bound_fl,
     upper_bound_fr,
 )
-from pdeflow.simulate import run_model  # noqa: E402
-from pdeflow.sweep import PUBLISHED_LAWS, published_law, run_sweep  # noqa: E402
+from pdeflow.simulate import print_summary, run_model  # noqa: E402
 
 ROOT = Path(__file__).parents[1]
 CASES = ROOT / "cases"

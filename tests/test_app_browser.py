@@ -19,6 +19,7 @@ from pathlib import Path
 
 import pytest
 
+from pdeflow.analysis.sweep import run_sweep
 from pdeflow.app.browser import (
     CHROMIUM,
     READY,
@@ -31,7 +32,6 @@ from pdeflow.app.browser import (
 )
 from pdeflow.cases import load_case
 from pdeflow.simulate import run_model
-from pdeflow.sweep import run_sweep
 
 pytestmark = pytest.mark.skipif(os.environ.get("PDEFLOW_SKIP_BROWSER") == "1",
                                 reason="PDEFLOW_SKIP_BROWSER=1")

@@ -63,8 +63,8 @@ def test_two_layer_law_case_reproduces_5_2_and_5_1_at_the_papers_grids():
     0.84 +- 0.05 and 1.61 +- 15 % at dx = 0.01 m; its [two_layer], [numerics] and wedge
     angle applied to test 5.1 bring it to rest with the lower layer first and an upper
     layer 0.2-1 m deep (its deepest cell) at the paper's figure times."""
+    from pdeflow.analysis.sweep import run_sweep
     from pdeflow.cases import tomllib
-    from pdeflow.sweep import run_sweep
 
     path = ROOT / "cases" / "paper_5_2_two_layer_law.toml"
     fit = run_sweep(load_case(path, ["case.models=['two_layer']"]))["models"]["two_layer"]

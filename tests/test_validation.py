@@ -7,9 +7,9 @@ import pytest
 
 from pdeflow.analysis import stoker
 from pdeflow.analysis.convergence import converge, richardson
+from pdeflow.analysis.sweep import fit_power_law, run_sweep
 from pdeflow.analysis.validation import exact_study, smooth_study, two_layer_checks
 from pdeflow.cases import load_case
-from pdeflow.sweep import fit_power_law, run_sweep
 
 ROOT = Path(__file__).parents[1]
 

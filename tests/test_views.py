@@ -131,7 +131,7 @@ def test_plot_says_which_frame_it_shows(stored_51, tmp_path, capsys):
 
 # --- pdeflow sweep ------------------------------------------------------------------------
 def test_sweep_axis_is_labelled_at_2_4_8_16_30(tmp_path):
-    from pdeflow.sweep import sweep_figure
+    from pdeflow.analysis.sweep import sweep_figure
 
     pts = [[a, 1.2 * a] for a in (2, 3, 4, 6, 8, 10, 14, 18, 24, 30)]
     summary = {"models": {"two_layer": {"points": pts, "prefactor": 1.2, "exponent": 1.0,

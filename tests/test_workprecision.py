@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from pdeflow.analysis import workprecision as wp
+from pdeflow.analysis.study import case_on_grid, resolve_case
 from pdeflow.analysis.timing import mol_time_step
 from pdeflow.cases import load_case
 from pdeflow.simulate import Run
@@ -69,14 +70,14 @@ def test_exact_reference_is_found_for_dam_breaks_only():
 
     assert exact_solution_for(RITTER, "single_layer").name == "ritter"
     assert exact_solution_for(RITTER, "two_layer") is None
-    assert exact_solution_for(wp.resolve_case(CASE_5_1), "single_layer") is None
+    assert exact_solution_for(resolve_case(CASE_5_1), "single_layer") is None
     with pytest.raises(ValueError, match="no exact solution"):
         wp.compare(CASE_5_1, ["hll/first-order"], [0.5], reference="exact", out_dir=None,
                    models=["single_layer"])
 
 
 def test_mol_time_step_is_cfl_bound_and_divides_t():
-    case = wp.case_on_grid(RITTER, 100, Variant.parse("mol-rk"))
+    case = case_on_grid(RITTER, 100, Variant.parse("mol-rk"))
     dt = mol_time_step(Run(case, "single_layer"), 0.5)
     c0 = np.sqrt(9.81 * 0.1)
     assert dt <= 0.45 * case.dx / (2 * c0) + 1e-15

@@ -94,7 +94,7 @@ def study_relaxed(case_51: str | Path, case_52: str | Path,
 
         (t_lower - 0.7)^2 + (t_upper - 1.45)^2 + max(0, R - 0.85 R_1)^2
     """
-    from pdeflow.sweep import run_sweep
+    from pdeflow.analysis.sweep import run_sweep
 
     single = run_model(load_case(case_51, [
         "case.models=['single_layer']", *RELAXED_SCHEME[1:], f"grid.dx={dx_51}",

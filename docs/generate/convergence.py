@@ -25,7 +25,7 @@ from pdeflow.analysis.convergence import (  # noqa: E402
     table,
 )
 from pdeflow.cases import load_case  # noqa: E402
-from pdeflow.io import atomic_path  # noqa: E402
+from pdeflow.io import write_text  # noqa: E402
 from pdeflow.plotting import save  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -188,8 +188,7 @@ def report(out_dir: str | Path, levels_51: int = 5, levels_52: int = 4,
         lines += [f"## Test 5.2 run-out fit, {name}", "",
                   table(res, SWEEP_VIEW), ""]
     path = out_dir / "convergence.md"
-    with atomic_path(path) as tmp:
-        tmp.write_text("\n".join(lines) + "\n")
+    write_text(path, "\n".join(lines) + "\n")
     return path
 
 

@@ -22,7 +22,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from pdeflow.cases import load_case  # noqa: E402
-from pdeflow.io import atomic_path  # noqa: E402
+from pdeflow.io import write_text  # noqa: E402
 from pdeflow.plotting import save  # noqa: E402
 from pdeflow.simulate import RunResult, run_model  # noqa: E402
 
@@ -158,7 +158,10 @@ def main(argv: list[str] | None = None) -> int:
     ]
     for label, extra in (("dx = 0.05 m, CFL 0.3", ()),
                          ("dx = 0.05 m, CFL 0.1", ("numerics.cfl=0.1",)),
-                         ("dx = 0.025 m, CFL 0.3", ("grid.dx=0.025",))):
+                         ("dx = 0.025 m, CFL 0.3", ("grid.dx=0.025",)),
+                         ("dx = 0.025 m, CFL 0.1", ("grid.dx=0.025", "numerics.cfl=0.1")),
+                         ("dx = 0.0125 m, CFL 0.3", ("grid.dx=0.0125",)),
+                         ("dx = 0.0125 m, CFL 0.1", ("grid.dx=0.0125", "numerics.cfl=0.1"))):
         s = run(46, 0.65, 3.0, *extra, t_end=30.0).summary
         lines.append(f"| {label}, t_end = 30 s | {_row(s)} | "
                      f"{_t(s['lower_stop_time'])} / {_t(s['upper_stop_time'])} |")
@@ -166,8 +169,7 @@ def main(argv: list[str] | None = None) -> int:
     forces_figure(run(46, 0.65, 3.0), fig)
     lines += ["", f"![moving cells and forces at t = 10 s](figures/{fig.name})", ""]
     out = args.docs / "rest_erosive_regime.md"
-    with atomic_path(out) as tmp:
-        Path(tmp).write_text("\n".join(lines))
+    write_text(out, "\n".join(lines))
     print(f"wrote {out} and {fig}")
     return 0
 

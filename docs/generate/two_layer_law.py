@@ -39,16 +39,16 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from pdeflow.cases import load_case  # noqa: E402
-from pdeflow.io import atomic_path  # noqa: E402
-from pdeflow.plotting import ASPECT_TICKS, log_ticks, save  # noqa: E402
-from pdeflow.simulate import run_model  # noqa: E402
-from pdeflow.sweep import (  # noqa: E402
+from pdeflow.analysis.sweep import (  # noqa: E402
     PUBLISHED_EXPONENTS,
     PUBLISHED_LAWS,
     published_law,
     run_sweep,
 )
+from pdeflow.cases import load_case  # noqa: E402
+from pdeflow.io import atomic_path, write_text  # noqa: E402
+from pdeflow.plotting import ASPECT_TICKS, log_ticks, save  # noqa: E402
+from pdeflow.simulate import run_model  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 CASE_51 = ROOT / "cases" / "paper_5_1_dam_break.toml"
@@ -720,8 +720,7 @@ def main(argv: list[str] | None = None) -> int:
               "", "The dotted lines show only the exponent-only laws' slopes (drawn "
               "through the paper's two-layer fit at a = 2).", ""]
     out = docs / "two_layer_law.md"
-    with atomic_path(out) as tmp:
-        Path(tmp).write_text("\n".join(lines))
+    write_text(out, "\n".join(lines))
     print(f"wrote {out}")
     return 0
 

@@ -7,7 +7,7 @@ cases/ritter_dam_break.toml, mangeney_dam_break_slope.toml, stoker_dam_break.tom
 CFL 0.45, every flux and reconstruction), a smooth wave against a fine grid, the
 two-layer checks, and test 5.2's run-out against aspect ratio
 (cases/collapse_sweep.toml). Uses :mod:`pdeflow.analysis.validation` and
-:func:`pdeflow.sweep.run_sweep`.
+:func:`pdeflow.analysis.sweep.run_sweep`.
 """
 
 from __future__ import annotations
@@ -20,14 +20,14 @@ import matplotlib
 
 matplotlib.use("Agg")
 
+from pdeflow.analysis.sweep import run_sweep, sweep_figure  # noqa: E402
 from pdeflow.analysis.validation import (  # noqa: E402
     exact_study,
     smooth_study,
     two_layer_checks,
 )
 from pdeflow.cases import load_case  # noqa: E402
-from pdeflow.io import atomic_path  # noqa: E402
-from pdeflow.sweep import run_sweep, sweep_figure  # noqa: E402
+from pdeflow.io import write_text  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES = ROOT / "cases"
@@ -154,8 +154,7 @@ def main(argv: list[str] | None = None) -> int:
     out.mkdir(parents=True, exist_ok=True)
     fig = "validation_runout.png"
     sweep_figure(res["sweep"], out / fig)
-    with atomic_path(out / "validation.md") as tmp:
-        tmp.write_text(markdown(res, fig))
+    write_text(out / "validation.md", markdown(res, fig))
     print(f"wrote {out / 'validation.md'}")
     return 0
 

@@ -119,7 +119,7 @@ def richardson(values: list[float | None]) -> dict[str, float | None]:
 
 def fit_row(point: Point) -> dict[str, Any]:
     """Measure of :func:`converge_sweep`: the run-out law fitted by one sweep."""
-    from ..sweep import run_sweep
+    from .sweep import run_sweep
 
     t0 = time.perf_counter()
     res = run_sweep(point.case, models=[point.model])["models"][point.model]

@@ -7,7 +7,7 @@ builds the point's :class:`~pdeflow.simulate.Run` and executes it, once or repea
 for timings), and an *executor* that maps the measure over the points. Convergence,
 work-precision, validation and aspect-ratio sweeps are thin definitions on it
 (:mod:`pdeflow.analysis.convergence`, :mod:`~pdeflow.analysis.workprecision`,
-:mod:`~pdeflow.analysis.validation`, :mod:`pdeflow.sweep`).
+:mod:`~pdeflow.analysis.validation`, :mod:`~pdeflow.analysis.sweep`).
 
 Execution is pluggable: an executor is any ``executor(fn, items) -> list`` that returns
 ``[fn(item) for item in items]`` in order. :func:`serial` is the default;
@@ -21,9 +21,12 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from functools import partial
+from pathlib import Path
 from typing import Any
 
-from ..cases import Case
+import numpy as np
+
+from ..cases import Case, load_case
 from ..simulate import Run
 from ..variant import Variant
 
@@ -89,6 +92,31 @@ def with_sets(case: Case, items: Iterable[str], validate: bool = True) -> Case:
     if validate:
         c.validate()
     return c
+
+
+def resolve_case(case_path: str | Path | Case) -> Case:
+    """A :class:`~pdeflow.cases.Case` from a case file path or a Case (copied)."""
+    if isinstance(case_path, Case):
+        return case_path.copy()
+    return load_case(case_path)
+
+
+def case_on_grid(case: Case, grid: float | int, variant: Variant,
+                 cfl: float | None = None) -> Case:
+    """Copy of ``case`` on the grid ``grid`` (int: cells, float: dx [m], rounded to a
+    whole number of cells) solved with ``variant`` (and ``cfl`` if given), without
+    snapshots."""
+    if isinstance(grid, (int, np.integer)) and not isinstance(grid, bool):
+        cells = int(grid)
+    else:  # nearest whole number of cells (case files require length/dx integral)
+        cells = max(1, round(case.length / float(grid)))
+    sets = [f"grid.cells={cells}", "output.snapshot_times=[]"]
+    if cfl is not None:
+        sets.append(f"numerics.cfl={float(cfl)!r}")
+    c = with_sets(case, sets, validate=False)
+    c.data["grid"].pop("dx", None)
+    c.data["numerics"].pop("dt", None)
+    return c.with_variant(variant)  # validates once, with every change made
 
 
 def _row(measure: Callable[[Point], dict[str, Any]], point: Point) -> dict[str, Any]:

@@ -68,7 +68,7 @@ import numpy as np
 from ..cases import Case, CaseError, load_case
 from ..variant import Variant
 from .exact import exact_solution_for
-from .study import Point, Study, with_sets
+from .study import Point, Study, case_on_grid, resolve_case
 from .timing import run_variant, timed
 
 DEFAULT_VARIANTS: tuple[str, ...] = (
@@ -81,31 +81,6 @@ limiters, Strang splitting, and the method of lines with RK4."""
 
 
 # --- cases and references --------------------------------------------------------------
-
-def resolve_case(case_path: str | Path | Case) -> Case:
-    """A :class:`~pdeflow.cases.Case` from a case file path or a Case (copied)."""
-    if isinstance(case_path, Case):
-        return case_path.copy()
-    return load_case(case_path)
-
-
-def case_on_grid(case: Case, grid: float | int, variant: Variant,
-                 cfl: float | None = None) -> Case:
-    """Copy of ``case`` on the grid ``grid`` (int: cells, float: dx [m], rounded to a
-    whole number of cells) solved with ``variant`` (and ``cfl`` if given), without
-    snapshots."""
-    if isinstance(grid, (int, np.integer)) and not isinstance(grid, bool):
-        cells = int(grid)
-    else:  # nearest whole number of cells (case files require length/dx integral)
-        cells = max(1, round(case.length / float(grid)))
-    sets = [f"grid.cells={cells}", "output.snapshot_times=[]"]
-    if cfl is not None:
-        sets.append(f"numerics.cfl={float(cfl)!r}")
-    c = with_sets(case, sets, validate=False)
-    c.data["grid"].pop("dx", None)
-    c.data["numerics"].pop("dt", None)
-    return variant.apply(c)  # validates once, with every change made
-
 
 def restrict(values: np.ndarray, fine_edges: np.ndarray,
              coarse_edges: np.ndarray) -> np.ndarray:

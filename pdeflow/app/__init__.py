@@ -1,7 +1,7 @@
 """Teaching app in the browser: ``pdeflow app`` (Panel on Bokeh's server), or in Jupyter.
 
 Three pages over pdeflow's public API (they run cases with
-:func:`pdeflow.simulate.run_model` and :func:`pdeflow.sweep.run_sweep`, and analyse states
+:func:`pdeflow.simulate.run_model` and :func:`pdeflow.analysis.sweep.run_sweep`, and analyse states
 with :mod:`pdeflow.numerics.hyperbolicity`):
 
 1. dam break (:mod:`.dam_break`): sliders for a case's parameters, both models animated,

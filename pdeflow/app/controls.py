@@ -254,7 +254,7 @@ class ParameterControls:
                 case, "two_layer.exchange_closure"):
             out.append(f"two_layer.exchange_closure={toml_value(self.closure.value)}")
         if not self.scheme.disabled and self.scheme.value != case_scheme(case):
-            own = Variant.from_case(case).numerics()
+            own = case.variant.numerics()
             for key, value in Variant.parse(self.scheme.value).numerics().items():
                 if own.get(key) != value:
                     out.append(f"numerics.{key}={toml_value(value)}")

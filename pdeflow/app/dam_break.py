@@ -26,10 +26,9 @@ from bokeh.models import ColumnDataSource, Div, Range1d, Span
 from bokeh.plotting import figure
 
 from ..cases import Case, CaseError
-from ..cli import print_summary
 from ..numerics.state import velocity_profile
 from ..plotting import DRY
-from ..simulate import RunResult, run_model
+from ..simulate import RunResult, print_summary, run_model
 from ..solvers.fv_split import SimulationBlowUp
 from ..trackers import FextraStorageTracker
 from .controls import ParameterControls, command_line, list_cases, served

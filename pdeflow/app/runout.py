@@ -1,9 +1,9 @@
 """Page 2, run-out law: r(a) of both models as the user sweeps a, against the paper's fits
 and the published planar-collapse laws, with the fit of the set updating live.
 
-A point is :func:`pdeflow.sweep.run_sweep` of the selected sweep case at one aspect ratio
+A point is :func:`pdeflow.analysis.sweep.run_sweep` of the selected sweep case at one aspect ratio
 a = H0/L0 (r = (R - L0)/L0, R the front), exactly what ``pdeflow sweep`` computes; the
-fit is :func:`pdeflow.sweep.fit_power_law` over the points at rest. The set starts as
+fit is :func:`pdeflow.analysis.sweep.fit_power_law` over the points at rest. The set starts as
 the case's ``sweep.aspect_ratios``; moving the a slider adds a point; changing a
 parameter recomputes every point of the set (they appear one by one).
 """
@@ -20,9 +20,7 @@ import panel as pn
 from bokeh.models import ColumnDataSource, Legend, Range1d, Span
 from bokeh.plotting import figure
 
-from ..cases import CaseError
-from ..solvers.fv_split import SimulationBlowUp
-from ..sweep import (
+from ..analysis.sweep import (
     PAPER_FITS,
     PUBLISHED_EXPONENTS,
     PUBLISHED_LAWS,
@@ -30,6 +28,8 @@ from ..sweep import (
     published_law,
     run_sweep,
 )
+from ..cases import CaseError
+from ..solvers.fv_split import SimulationBlowUp
 from .controls import KNOBS, ParameterControls, Slider, is_column, list_cases, served
 from .dam_break import COLOURS, LABELS
 

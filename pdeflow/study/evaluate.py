@@ -35,8 +35,8 @@ def _quantities(spec: StudySpec, point: dict[str, Any]) -> dict[str, Any]:
         if missing:
             raise KeyError(f"{spec.function} returned no {missing[0]!r}")
         return {q: out[q] for q in spec.quantities}
+    from ..analysis.sweep import run_sweep
     from ..simulate import run_model
-    from ..sweep import run_sweep
 
     _silence_run_warnings()
     values: dict[str, Any] = {}

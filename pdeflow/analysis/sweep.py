@@ -22,8 +22,9 @@ from typing import Any
 
 import numpy as np
 
-from .cases import Case, CaseError, load_case
-from .simulate import load_case_kernels, run_model
+from ..cases import Case, CaseError, load_case
+from ..simulate import load_case_kernels
+from .study import Executor, Point, Study, serial, with_sets
 
 PAPER_FITS = {"single_layer": (2.25, 1.06), "two_layer": (1.61, 0.84)}
 DEM_EXPONENT = 0.83
@@ -73,9 +74,24 @@ def sweep_ratios(case: Case) -> list[float]:
     return [float(a) for a in ratios]
 
 
+def runout_row(point: Point) -> dict[str, Any]:
+    """Measure of :func:`run_sweep`: the run-out of one column run to rest."""
+    s = point.run().execute().summary
+    L0 = point.case.L0
+    r = None if s["runout"] is None else s["runout"] / L0
+    return {"r": r, "runout": s["runout"], "stop_time": s["stop_time"],
+            "at_rest": s["at_rest"], "steps": s["steps"], "wall_time_s": s["wall_time_s"],
+            "mass_relative_error": s["mass_relative_error"]}
+
+
 def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
-              models: list[str] | None = None) -> dict[str, Any]:
-    """Run every model at every aspect ratio; return the sweep summary."""
+              models: list[str] | None = None,
+              executor: Executor = serial) -> dict[str, Any]:
+    """Run every model at every aspect ratio; return the sweep summary.
+
+    A :class:`~pdeflow.analysis.study.Study`: one point per model and aspect ratio a
+    (the case with H0 = a L0, no snapshots), measured by :func:`runout_row`.
+    """
     ratios = aspect_ratios or sweep_ratios(case)
     L0 = case.L0
     if L0 is None:
@@ -83,20 +99,15 @@ def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
     models = models or case.models
     out: dict[str, Any] = {"case": case.name, "L0": L0, "dx": case.dx,
                            "front_threshold": case.front_threshold, "models": {}}
+    points = [Point(with_sets(case, [f"initial.H0={float(a) * L0!r}",
+                                     "output.snapshot_times=[]"]), model,
+                    labels={"model": model, "a": float(a)})
+              for model in models for a in ratios]
     wall0 = time.perf_counter()
+    table = Study(points, runout_row).execute(executor)
     for model in models:
-        rows = []
-        for a in ratios:
-            c = case.copy()
-            c.data["initial"]["H0"] = float(a) * L0
-            c.data.setdefault("output", {})["snapshot_times"] = []
-            c.validate()
-            s = run_model(c, model).summary
-            r = None if s["runout"] is None else s["runout"] / L0
-            rows.append({"a": float(a), "r": r, "runout": s["runout"],
-                         "stop_time": s["stop_time"], "at_rest": s["at_rest"],
-                         "steps": s["steps"], "wall_time_s": s["wall_time_s"],
-                         "mass_relative_error": s["mass_relative_error"]})
+        rows = [{k: v for k, v in row.items() if k != "model"} for row in table
+                if row["model"] == model]
         good = [(row["a"], row["r"]) for row in rows if row["r"] and row["at_rest"]]
         p, e = fit_power_law(*zip(*good, strict=True)) if len(good) >= 2 else (None, None)
         out["models"][model] = {
@@ -116,7 +127,7 @@ def sweep_figure(summary: dict[str, Any], path: str | Path) -> Path:
     """Log-log plot of r against a with the fits, the paper's fits and the DEM slope."""
     import matplotlib.pyplot as plt
 
-    from .plotting import ASPECT_TICKS, log_ticks, save
+    from ..plotting import ASPECT_TICKS, log_ticks, save
 
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
     styles = {"single_layer": ("k", "o", "single layer"),
@@ -155,21 +166,8 @@ def sweep_figure(summary: dict[str, Any], path: str | Path) -> Path:
     return save(fig, path)
 
 
-def main(argv: list[str] | None = None) -> int:
-    """``python -m pdeflow.sweep CASE.toml [--set k=v] [--summary out.json] [--plot f.png]``"""
-    import argparse
-
-    from .io import write_json
-
-    ap = argparse.ArgumentParser(prog="pdeflow sweep", description=__doc__,
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_arguments(ap)
-    args = ap.parse_args(argv)
-    return cmd_sweep(args, write_json)
-
-
 def add_arguments(ap: Any) -> None:
-    """The sweep command's options (shared by ``pdeflow sweep`` and ``-m``)."""
+    """The options of ``pdeflow sweep``."""
     ap.add_argument("case", help="sweep case file (a column case with a [sweep] section)")
     ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                     help="override a case value (repeatable)")
@@ -178,11 +176,10 @@ def add_arguments(ap: Any) -> None:
     ap.add_argument("-q", "--quiet", action="store_true", help="print nothing")
 
 
-def cmd_sweep(args: Any, write_json: Any = None) -> int:
-    """Run the sweep described by parsed ``args``; print the fits."""
-    from . import io
+def cmd_sweep(args: Any) -> int:
+    """``pdeflow sweep``: run the sweep described by parsed ``args``; print the fits."""
+    from .. import io
 
-    write_json = write_json or io.write_json
     io.check_output(args.summary, "--summary")
     io.check_output(args.plot, "--plot")
     case = load_case(args.case, args.set)
@@ -190,7 +187,7 @@ def cmd_sweep(args: Any, write_json: Any = None) -> int:
     load_case_kernels(case, None if args.quiet else sys.stderr)
     summary = run_sweep(case)
     if args.summary:
-        write_json(args.summary, summary)
+        io.write_json(args.summary, summary)
     if args.plot:
         sweep_figure(summary, args.plot)
     if not args.quiet:
@@ -202,7 +199,3 @@ def cmd_sweep(args: Any, write_json: Any = None) -> int:
                   f"a^{res['paper_exponent']})   a:r {pts}")
         print(f"wall time {summary['wall_time_s']:.2f} s")
     return 0
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
