@@ -38,7 +38,7 @@ from .pvm import face_single, face_two_layer, fluctuation_kernel
 from .state import velocity
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _is_wet(q: np.ndarray, i: int, dry: float) -> bool:
     for k in range(0, q.shape[0], 2):
         if q[k, i] > dry:
@@ -61,7 +61,7 @@ def wet_cells(q: np.ndarray, dry: float, start: int, stop: int) -> tuple[int, in
     return lo, hi
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _limited(a: float, b: float, limiter: int) -> float:
     if a * b <= 0.0:
         return 0.0
@@ -178,9 +178,11 @@ def advection_kernel(two_layer: bool, flux: int, order: int, limiter: int) -> An
     """
     fluct = fluctuation_kernel(two_layer, flux)
     face = face_two_layer if two_layer else face_single
-    cell_jump = cell_jump_two_layer if two_layer else cell_jump_single
     fields = 4 if two_layer else 2
     muscl = order == 2
+    # the MUSCL kernels, only where they are called (see compiled.ready)
+    reconstruct = reconstruct_muscl if muscl else None
+    cell_jump = (cell_jump_two_layer if two_layer else cell_jump_single) if muscl else None
 
     def advect(q, rate, work, dx, bc_left, bc_right, g, r, dry, start, stop):
         lo, hi = wet_cells(q, dry, start, stop)
@@ -191,7 +193,7 @@ def advection_kernel(two_layer: bool, flux: int, order: int, limiter: int) -> An
         r_hi = min(hi + 1, n - 1)
         rate[:, r_lo:r_hi + 1] = 0.0
         if muscl:
-            reconstruct_muscl(q, work, r_lo, r_hi, bc_left, bc_right, dry, limiter)
+            reconstruct(q, work, r_lo, r_hi, bc_left, bc_right, dry, limiter)
             qm = work[0]
             qp = work[1]
         else:

@@ -69,20 +69,25 @@ def kernel(*arg_types: Any) -> Callable:
     return wrap
 
 
-def specialise(func: Callable, *arg_types: Any, entry: bool = False) -> Any:
+def specialise(func: Callable, *arg_types: Any) -> Any:
     """A numba kernel of the closure ``func`` with the one signature ``arg_types``,
     disk-cached under its constants (see the module docstring); compiled by
-    :func:`ready`. ``entry``: a kernel that a solver calls (e.g. a stepping loop), which
-    :func:`kernels_ready` waits for."""
+    :func:`ready`."""
     if config.DISABLE_JIT:
         return func
     compiled = njit(func)
     compiled._cache = _ConstantsKeyedCache(func)
     _SIGNATURES[compiled] = tuple(arg_types)
     _SPECIALISED.append(compiled)
-    if entry:
-        _ENTRIES.append(compiled)
     return compiled
+
+
+def entry(*kernels: Any) -> None:
+    """Register kernels that a solver is about to call (e.g. the stepping loop of a
+    scheme and the model's kernels it is given): :func:`kernels_ready` waits for them."""
+    for compiled in kernels:
+        if isinstance(compiled, Dispatcher) and compiled not in _ENTRIES:
+            _ENTRIES.append(compiled)
 
 
 def ready(compiled: Any) -> Any:
@@ -101,14 +106,16 @@ def ready(compiled: Any) -> Any:
 
 
 def _callees(compiled: Any) -> Iterator[Any]:
-    """The kernels that ``compiled`` closes over or names as globals."""
+    """The kernels that ``compiled`` closes over, and the module-level kernels with a
+    declared signature that it names. (A factory closes over what its scheme calls
+    only, None for the rest, so that nothing here is compiled for nothing.)"""
     func = compiled.py_func
     for cell in func.__closure__ or ():
         if isinstance(cell.cell_contents, Dispatcher):
             yield cell.cell_contents
     for name in func.__code__.co_names:
         value = func.__globals__.get(name)
-        if isinstance(value, Dispatcher):
+        if isinstance(value, Dispatcher) and value in _SIGNATURES:
             yield value
 
 
@@ -128,7 +135,7 @@ def kernels() -> list[Any]:
 
 def _pending() -> list[Any]:
     """Entry kernels built but not compiled yet, and what they call."""
-    todo = [k for k in _ENTRIES if _SIGNATURES[k] not in k.signatures]
+    todo = [k for k in _ENTRIES if _SIGNATURES.get(k) not in k.signatures]
     seen: dict[int, Any] = {}
     while todo:
         k = todo.pop()

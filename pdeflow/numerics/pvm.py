@@ -40,7 +40,7 @@ IFCP_MIN_FRACTION = 0.05
 depth; elsewhere (near a layer's front or where a layer thins out) the HLL line."""
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _roe_velocity(hL: float, uL: float, hR: float, uR: float) -> float:
     sl = math.sqrt(max(hL, 0.0))
     sr = math.sqrt(max(hR, 0.0))

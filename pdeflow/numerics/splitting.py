@@ -8,9 +8,15 @@ One step of length dt (Lie splitting, as in the paper):
    source stage of :mod:`pdeflow.numerics.source_stage`.
 
 With MUSCL the advection is integrated with SSP-RK2 (Heun); with Strang splitting half
-a source step is applied before and after it. :func:`stepping_kernel` compiles the loop
-for one scheme (model, flux, reconstruction, limiter, splitting) and caches it on disk;
-all parameters are arrays and the grid an argument, so that sweeps never recompile.
+a source step is applied before and after it.
+
+The loop is compiled once per reconstruction order, splitting and IFCP fallback
+(:func:`stepping_kernel`) and takes the model's kernels as arguments: its advection
+stage (:func:`pdeflow.numerics.advection.advection_kernel`, one per model, flux,
+reconstruction and limiter), source stage and MUSCL predictor, called once or twice per
+step through a function pointer. :func:`scheme_stepper` puts the two together for one
+scheme. Everything is cached on disk; all parameters are arrays and the grid an
+argument, so that sweeps never recompile.
 """
 
 from __future__ import annotations
@@ -23,8 +29,21 @@ import numpy as np
 from numba import njit
 
 from . import layout as L
-from .advection import advection_kernel, wet_cells
-from .compiled import FIELDS, PARAMS, STATE, VECTOR, WORK, f8, flag, i8, ready, specialise
+from .advection import ADVECT_SIGNATURE, advection_kernel, wet_cells
+from .compiled import (
+    FIELDS,
+    PARAMS,
+    STATE,
+    VECTOR,
+    WORK,
+    entry,
+    f8,
+    flag,
+    i8,
+    ready,
+    specialise,
+    types,
+)
 from .friction import predictor_single, predictor_two_layer
 from .source_stage import (
     source_stage_single,
@@ -34,8 +53,8 @@ from .source_stage import (
 )
 
 # the full-grid source stages are imported from here by analysis.stability's mol_run
-__all__ = ["source_stage_single", "source_stage_two_layer", "stepping_kernel",
-           "advance_split", "STATUS_END", "STATUS_REST", "STATUS_FAIL"]
+__all__ = ["source_stage_single", "source_stage_two_layer", "stepping_kernel", "Stepper",
+           "scheme_stepper", "advance_split", "STATUS_END", "STATUS_REST", "STATUS_FAIL"]
 
 STATUS_END = 0  #: reached t_end
 STATUS_REST = 1  #: everything at rest: nothing will change any more
@@ -81,32 +100,26 @@ def _copy_range(dst, src, lo, hi):
         dst[i] = src[i]
 
 
-def advect_step_function(two_layer: bool, order: int, strang: bool, advect: Any,
-                         update: Any = update) -> Any:
+def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
     """The advection stage of one step of the stepping loop, with Strang the first half
-    source step before it, as a Python closure (compiled by :func:`stepping_kernel`;
+    source step before it, as a Python closure (compiled inside :func:`stepping_kernel`;
     the blow-up diagnosis runs it in Python with an instrumented ``update``):
 
-    ``advect_step(q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, rec,
-    q0, diag_keep, fex_keep, first, lo, hi, b_lo, b_hi)`` advances from the wet cells
-    ``lo..hi``; ``b_lo..b_hi`` are the cells the step may change, saved in ``backup``
-    (and, for Strang, the bookkeeping in ``diag_keep``, ``fex_keep``).
+    ``advect_step(advect, sources, predictor, q, t, t_end, dx, bc_left, bc_right, P, g,
+    r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, lo, hi, b_lo,
+    b_hi)`` advances from the wet cells ``lo..hi`` with the model's kernels (see
+    :func:`stepping_kernel`); ``b_lo..b_hi`` are the cells the step may change, saved in
+    ``backup`` (and, for Strang, the bookkeeping in ``diag_keep``, ``fex_keep``).
 
     Returns ``(dt, mass_rate, ok, a_lo, a_hi, changed)``: the step [s], the largest mass
     rate, whether the state is finite and non-negative, the cells the update touched and
-    whether the half source step changed anything. ``advect`` is the scheme's
-    :func:`~pdeflow.numerics.advection.advection_kernel`.
+    whether the half source step changed anything.
     """
-    sources = sources_two_layer if two_layer else sources_single
-    predictor = predictor_two_layer if two_layer else predictor_single
     muscl = order == 2
 
-    def advect_step(q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, rec,
-                    q0, diag_keep, fex_keep, first, lo, hi, b_lo, b_hi):
-        if two_layer:
-            g, r, dry = P[L.G_Z], P[L.R], P[L.DRY]
-        else:
-            g, r, dry = P[L.S_G_Z], 0.0, P[L.S_DRY]
+    def advect_step(advect, sources, predictor, q, t, t_end, dx, bc_left, bc_right, P, g,
+                    r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first,
+                    lo, hi, b_lo, b_hi):
         fex = diag[L.N_DIAG:]
         smax, a_lo, a_hi = advect(q, rate, rec, dx, bc_left, bc_right, g, r, dry, lo, hi)
         dt = t_end - t
@@ -164,19 +177,13 @@ def advect_step_function(two_layer: bool, order: int, strang: bool, advect: Any,
     return advect_step
 
 
-def stepping_function(two_layer: bool, ifcp: bool, strang: bool, advect_step: Any,
-                      hll_step: Any) -> Any:
-    """The stepping loop as a Python closure (compiled by :func:`stepping_kernel`):
-    ``advance(q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, work,
-    max_steps, stop_at_rest) -> (t, steps, status)``, see :func:`stepping_kernel`.
-    ``advect_step`` is the scheme's :func:`advect_step_function`; with the IFCP flux,
-    ``hll_step`` is the same with HLL, which redoes a step that IFCP left negative."""
-    sources = sources_two_layer if two_layer else sources_single
+def stepping_function(ifcp: bool, strang: bool, advect_step: Any) -> Any:
+    """The stepping loop as a Python closure (compiled by :func:`stepping_kernel`, which
+    documents it); ``advect_step`` is :func:`advect_step_function`."""
 
-    def advance(q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, work,
-                max_steps, stop_at_rest):
+    def advance(q, t, t_end, dx, bc_left, bc_right, P, g, r, dry, cfl, diag, rate, backup,
+                work, max_steps, stop_at_rest, advect, sources, predictor, fallback):
         n = q.shape[1]
-        dry = P[L.DRY] if two_layer else P[L.S_DRY]
         steps = 0
         rec = work[:2]
         q0 = work[2]
@@ -211,8 +218,9 @@ def stepping_function(two_layer: bool, ifcp: bool, strang: bool, advect_step: An
                 _copy_range(diag_keep, diag, 0, L.N_DIAG - 1)
                 _copy_range(fex_keep, fex, b_lo, b_hi)
             dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
-                q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, rec, q0,
-                diag_keep, fex_keep, first, lo, hi, b_lo, b_hi)
+                advect, sources, predictor, q, t, t_end, dx, bc_left, bc_right, P, g, r,
+                dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, lo, hi,
+                b_lo, b_hi)
             if ifcp and not ok:
                 # IFCP is Roe's linearisation for one layer: not positive where cells
                 # move apart fast. Redo the step with HLL, which is, and count it.
@@ -220,9 +228,10 @@ def stepping_function(two_layer: bool, ifcp: bool, strang: bool, advect_step: An
                 _copy_range(diag, diag_keep, 0, L.N_DIAG - 1)
                 _copy_range(fex, fex_keep, b_lo, b_hi)
                 diag[L.D_FLUX_FALLBACKS] += 1.0
-                dt, mass_rate, ok, a_lo, a_hi, changed = hll_step(
-                    q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, rec,
-                    q0, diag_keep, fex_keep, first, lo, hi, b_lo, b_hi)
+                dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
+                    fallback, sources, predictor, q, t, t_end, dx, bc_left, bc_right, P, g,
+                    r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first,
+                    lo, hi, b_lo, b_hi)
             t_new = t + dt if dt < t_end - t else t_end
             if not ok:
                 _copy_cells(q, backup, b_lo, b_hi)
@@ -256,70 +265,116 @@ def stepping_function(two_layer: bool, ifcp: bool, strang: bool, advect_step: An
     return advance
 
 
-STEPPING_SIGNATURE = (STATE, f8, f8, f8, i8, i8, PARAMS, f8, VECTOR, FIELDS, FIELDS, WORK,
-                      i8, flag)
-ADVECT_STEP_SIGNATURE = (STATE, f8, f8, f8, i8, i8, PARAMS, f8, VECTOR, FIELDS, FIELDS,
-                         WORK, FIELDS, VECTOR, VECTOR, flag, i8, i8, i8, i8)
+ADVECT = types.FunctionType(types.Tuple((f8, i8, i8))(*ADVECT_SIGNATURE))
+"""type of an advection stage passed to the loop (a function pointer)"""
+SOURCES = types.FunctionType(types.none(STATE, f8, f8, PARAMS, VECTOR, i8, i8))
+"""type of a source stage on a range of cells (:mod:`pdeflow.numerics.source_stage`)"""
+PREDICTOR = types.FunctionType(types.none(STATE, f8, PARAMS, i8, i8))
+"""type of a MUSCL predictor (:mod:`pdeflow.numerics.friction`)"""
 
 
 @functools.cache
-def advect_step_kernel(two_layer: bool, flux: int, order: int, limiter: int,
-                       strang: bool) -> Any:
-    """:func:`advect_step_function` of one scheme, compiled."""
-    advect = advection_kernel(two_layer, flux, order, limiter)
-    return specialise(advect_step_function(two_layer, order, strang, advect),
-                      *ADVECT_STEP_SIGNATURE)
+def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
+    """The ``fv-split`` stepping loop for one reconstruction order, splitting and flux
+    fallback, for any model (compiled on first use, see
+    :func:`pdeflow.numerics.compiled.ready`): advance ``q`` from ``t`` to ``t_end`` with
+    the CFL-limited splitting scheme,
 
+    ``advance(q, t, t_end, dx, bc_left, bc_right, P, g, r, dry, cfl, diag, rate, backup,
+    work, max_steps, stop_at_rest, advect, sources, predictor, fallback) ->
+    (t, steps, status)``.
 
-@functools.cache
-def stepping_kernel(two_layer: bool, flux: int, order: int, limiter: int,
-                    strang: bool) -> Any:
-    """The ``fv-split`` stepping loop of one scheme (compiled on first use, see
-    :func:`pdeflow.numerics.compiled.ready`): advance ``q`` from ``t`` to ``t_end``
-    with the CFL-limited splitting scheme,
-
-    ``advance(q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, work,
-    max_steps, stop_at_rest) -> (t, steps, status)``.
-
-    ``rate`` and ``backup`` have the shape of ``q``; ``work`` has shape (3, *q.shape).
-    ``flux`` (layout.FLUX_*), ``order`` (1: first order with forward Euler; 2: MUSCL
-    with the SSP-RK2/Heun integrator, see
-    :func:`~pdeflow.numerics.friction.predictor_two_layer`) and ``limiter``
-    (layout.LIMITER_*) choose the advection stage; ``strang`` applies half a source
-    step before and after it (else Lie, as in the paper). With Strang, dt is chosen
-    before the first half source step; if that half step makes the waves faster than
-    dt allows (erosion deepens the upper layer), it is undone and the step retried
-    with a shorter dt.
+    ``rate`` and ``backup`` have the shape of ``q``; ``work`` has shape (3, *q.shape);
+    ``g`` = g_z [m/s^2], ``r`` = rho1/rho2 (0 for one layer) and ``dry`` [m] are the
+    model's. The model's kernels: ``advect`` (its advection stage), ``sources`` (its
+    source stage), ``predictor`` (MUSCL, ``order`` 2: the friction predictor of the
+    SSP-RK2/Heun integrator, see :func:`~pdeflow.numerics.friction.predictor_two_layer`;
+    else None) and ``fallback`` (``ifcp``: the HLL advection stage that redoes a step
+    IFCP left negative; else None). ``strang`` applies half a source step before and
+    after the advection (else Lie, as in the paper). With Strang, dt is chosen before
+    the first half source step; if that half step makes the waves faster than dt
+    allows (erosion deepens the upper layer), it is undone and the step retried with a
+    shorter dt.
 
     Returns ``(t, steps, status)``: status :data:`STATUS_END`; :data:`STATUS_REST`
     (everything at rest and unchanged: stationary from ``t`` on); or
     :data:`STATUS_FAIL` (the last step produced a non-finite or negative state and was
     undone; ``q`` holds the last good state).
     """
-    ifcp = flux == L.FLUX_IFCP
-    step = advect_step_kernel(two_layer, flux, order, limiter, strang)
-    hll_step = advect_step_kernel(two_layer, L.FLUX_HLL, order, limiter, strang) \
-        if ifcp else step
-    return specialise(stepping_function(two_layer, ifcp, strang, step, hll_step),
-                      *STEPPING_SIGNATURE, entry=True)
+    step = njit(inline="always")(advect_step_function(order, strang))
+    return specialise(stepping_function(ifcp, strang, step), STATE, f8, f8, f8, i8, i8,
+                      PARAMS, f8, f8, f8, f8, VECTOR, FIELDS, FIELDS, WORK, i8, flag,
+                      ADVECT, SOURCES, PREDICTOR if order == 2 else types.none,
+                      ADVECT if ifcp else types.none)
+
+
+class Stepper:
+    """The stepping loop of one scheme with its model's kernels:
+    ``stepper(q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, work,
+    max_steps, stop_at_rest) -> (t, steps, status)`` (see :func:`stepping_kernel`).
+    Nothing is compiled before the first call (or :meth:`ready`)."""
+
+    def __init__(self, two_layer: bool, flux: int, order: int, limiter: int,
+                 strang: bool):
+        self.two_layer = two_layer
+        self.ifcp = flux == L.FLUX_IFCP
+        self.loop = stepping_kernel(order, strang, self.ifcp)
+        self.advect = advection_kernel(two_layer, flux, order, limiter)
+        self.sources = sources_two_layer if two_layer else sources_single
+        self.predictor = ((predictor_two_layer if two_layer else predictor_single)
+                          if order == 2 else None)
+        self.fallback = advection_kernel(two_layer, L.FLUX_HLL, order, limiter) \
+            if self.ifcp else None
+        self.kernels = [k for k in (self.loop, self.advect, self.sources, self.predictor,
+                                    self.fallback) if k is not None]
+        entry(*self.kernels)
+
+    def ready(self) -> Stepper:
+        """Compile (or load) every kernel of this scheme now."""
+        for kernel in self.kernels:
+            ready(kernel)
+        return self
+
+    def model_constants(self, P: np.ndarray) -> tuple[float, float, float]:
+        """(g_z [m/s^2], rho1/rho2 (0 for one layer), dry tolerance [m]) from ``P``."""
+        if self.two_layer:
+            return float(P[L.G_Z]), float(P[L.R]), float(P[L.DRY])
+        return float(P[L.S_G_Z]), 0.0, float(P[L.S_DRY])
+
+    def __call__(self, q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int,
+                 bc_right: int, P: np.ndarray, cfl: float, diag: np.ndarray,
+                 rate: np.ndarray, backup: np.ndarray, work: np.ndarray, max_steps: int,
+                 stop_at_rest: bool) -> tuple[float, int, int]:
+        return self.ready().loop(q, t, t_end, dx, bc_left, bc_right, P,
+                                 *self.model_constants(P), cfl, diag, rate, backup, work,
+                                 max_steps, stop_at_rest, self.advect, self.sources,
+                                 self.predictor, self.fallback)
+
+
+@functools.cache
+def scheme_stepper(two_layer: bool, flux: int, order: int, limiter: int,
+                   strang: bool) -> Stepper:
+    """The :class:`Stepper` of one scheme (one per process)."""
+    return Stepper(two_layer, flux, order, limiter, strang)
 
 
 def python_stepping(two_layer: bool, flux: int, order: int, limiter: int, strang: bool,
                     update: Any) -> Any:
-    """:func:`stepping_kernel` as plain Python around the compiled advection and source
+    """:func:`scheme_stepper` as plain Python around the compiled advection and source
     kernels, with ``update`` for :func:`update` (the blow-up diagnosis replays a step
-    with an update that records what it wrote)."""
+    with an update that records what it wrote); called as the stepper."""
+    compiled = scheme_stepper(two_layer, flux, order, limiter, strang).ready()
+    loop = stepping_function(compiled.ifcp, strang, advect_step_function(order, strang,
+                                                                         update))
 
-    # compiled (and closed to other signatures) before Python calls its kernels
-    ready(stepping_kernel(two_layer, flux, order, limiter, strang))
+    def advance(q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, work,
+                max_steps, stop_at_rest):
+        return loop(q, t, t_end, dx, bc_left, bc_right, P, *compiled.model_constants(P),
+                    cfl, diag, rate, backup, work, max_steps, stop_at_rest,
+                    compiled.advect, compiled.sources, compiled.predictor,
+                    compiled.fallback)
 
-    def step(fl: int) -> Any:
-        advect = advection_kernel(two_layer, fl, order, limiter)
-        return advect_step_function(two_layer, order, strang, advect, update)
-
-    ifcp = flux == L.FLUX_IFCP
-    return stepping_function(two_layer, ifcp, strang, step(flux),
-                             step(L.FLUX_HLL) if ifcp else None)
+    return advance
 
 
 def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int,
@@ -327,9 +382,9 @@ def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int
                   rate: np.ndarray, backup: np.ndarray, work: np.ndarray, max_steps: int,
                   two_layer: bool, stop_at_rest: bool, flux: int, order: int,
                   limiter: int, strang: bool) -> tuple[float, int, int]:
-    """:func:`stepping_kernel` of the scheme given by the last five codes, called on the
-    other arguments: ``(t, steps, status)``."""
-    kernel = ready(stepping_kernel(bool(two_layer), int(flux), int(order), int(limiter),
-                                   bool(strang)))
-    return kernel(q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, work,
-                  max_steps, stop_at_rest)
+    """:func:`scheme_stepper` of the scheme given by ``two_layer``, ``flux``, ``order``,
+    ``limiter`` and ``strang``, called on the other arguments: ``(t, steps, status)``."""
+    return scheme_stepper(bool(two_layer), int(flux), int(order), int(limiter),
+                          bool(strang))(
+        q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, work, max_steps,
+        stop_at_rest)

@@ -10,9 +10,9 @@ message names the time, the step, the cell and the state there, and the variant,
 the last good state is kept (see :func:`diagnose_blowup`).
 
 With the numba backend the whole stepping loop between two tracker interrupts runs in
-one compiled, disk-cached kernel (:func:`pdeflow.numerics.splitting.stepping_kernel`,
-compiled for the model's scheme only), which calls the same source-stage kernel that
-the hook wraps.
+one compiled, disk-cached kernel (:func:`pdeflow.numerics.splitting.scheme_stepper`: the loop
+and the kernels of the model's scheme only), which calls the same source-stage kernel
+that the hook wraps.
 """
 
 from __future__ import annotations
@@ -28,8 +28,8 @@ from pde.trackers.base import FinishedSimulation
 
 from ..models.base import GranularPDE, check_range
 from ..numerics import layout as L
-from ..numerics.compiled import kernels_cached, kernels_ready, ready
-from ..numerics.splitting import STATUS_FAIL, STATUS_REST, python_stepping, stepping_kernel
+from ..numerics.compiled import kernels_cached, kernels_ready
+from ..numerics.splitting import STATUS_FAIL, STATUS_REST, python_stepping, scheme_stepper
 
 
 class _RestProfilerFilter(logging.Filter):
@@ -53,7 +53,7 @@ logging.getLogger("pde.solvers.controller").addFilter(_RestProfilerFilter())
 def scheme_codes(pde: GranularPDE, splitting: str = "lie") -> tuple[bool, int, int, int,
                                                                      bool]:
     """(two_layer, flux, order, limiter, strang): the scheme of ``pde`` with
-    ``splitting``, as :func:`pdeflow.numerics.splitting.stepping_kernel` takes it."""
+    ``splitting``, as :func:`pdeflow.numerics.splitting.scheme_stepper` takes it."""
     return (bool(pde.two_layer), *pde.scheme_codes, splitting == "strang")
 
 
@@ -70,7 +70,7 @@ def load_kernels(log: Any = None, pdes: Sequence[GranularPDE] = (),
         pdes: the models of the runs to come.
         splitting: 'lie' or 'strang'.
     """
-    kernels = [stepping_kernel(*scheme_codes(pde, splitting)) for pde in pdes]
+    steppers = [scheme_stepper(*scheme_codes(pde, splitting)) for pde in pdes]
     if kernels_ready():
         return 0.0
     compiling = not kernels_cached()
@@ -78,8 +78,8 @@ def load_kernels(log: Any = None, pdes: Sequence[GranularPDE] = (),
         print("pdeflow: compiling numba kernels (once per machine) ...", end="",
               file=log, flush=True)
     t0 = time.perf_counter()
-    for kernel in kernels:
-        ready(kernel)
+    for scheme in steppers:
+        scheme.ready()
     seconds = time.perf_counter() - t0
     if compiling and log is not None:
         print(f" done in {seconds:.1f} s", file=log, flush=True)
@@ -270,10 +270,10 @@ class FVSplitSolver(SolverBase):
                           max_steps, stop)
 
         if self.backend_name == "numba":
-            kernel = stepping_kernel(*scheme)  # compiled (or loaded) at its first call
+            kernel = scheme_stepper(*scheme)  # compiled (or loaded) at its first call
 
             def advance(q: np.ndarray, t0: float, t1: float):
-                return run_kernel(ready(kernel), q, t0, t1, diag, rate, backup, work,
+                return run_kernel(kernel, q, t0, t1, diag, rate, backup, work,
                                   self.max_steps)
         else:
             advance = self._numpy_loop(state, dx, P, hook, diag)
