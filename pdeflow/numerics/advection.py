@@ -200,22 +200,28 @@ def advection_kernel(two_layer: bool, flux: int, order: int, limiter: int) -> An
             qm = q  # first order: both face values are the cell average
             qp = q
         inv_dx = 1.0 / dx
-        # the ghost cell beyond a wall mirrors the face value next to it, an open end
-        # copies it
+        # at the ends of the grid a ghost cell: a wall mirrors the face value next to
+        # it, an open end copies it
         s_left = -1.0 if bc_left == L.BC_WALL else 1.0
         s_right = -1.0 if bc_right == L.BC_WALL else 1.0
         smax = 0.0
-        for i in range(lo, hi + 2):
-            # face i - 1/2, between cells i - 1 and i (a ghost cell at 0 and n)
-            left = face(qp, i - 1, 1.0) if i > 0 else face(qm, 0, s_left)
-            right = face(qm, i, 1.0) if i < n else face(qp, n - 1, s_right)
-            dm, dp, s = fluct(left, right, g, r, dry)
+        for i in range(max(lo, 1), min(hi + 1, n - 1) + 1):
+            # face i - 1/2, between cells i - 1 and i
+            dm, dp, s = fluct(face(qp, i - 1, 1.0), face(qm, i, 1.0), g, r, dry)
             smax = max(smax, s)
             for k in range(fields):
-                if i > 0:
-                    rate[k, i - 1] -= dm[k] * inv_dx
-                if i < n:
-                    rate[k, i] -= dp[k] * inv_dx
+                rate[k, i - 1] -= dm[k] * inv_dx
+                rate[k, i] -= dp[k] * inv_dx
+        if lo == 0:
+            dm, dp, s = fluct(face(qm, 0, s_left), face(qm, 0, 1.0), g, r, dry)
+            smax = max(smax, s)
+            for k in range(fields):
+                rate[k, 0] -= dp[k] * inv_dx
+        if hi == n - 1:
+            dm, dp, s = fluct(face(qp, n - 1, 1.0), face(qp, n - 1, s_right), g, r, dry)
+            smax = max(smax, s)
+            for k in range(fields):
+                rate[k, n - 1] -= dm[k] * inv_dx
         if muscl:
             cell_jump(qm, qp, rate, r_lo, r_hi, inv_dx, g, r, dry)
         return smax, r_lo, r_hi

@@ -182,15 +182,16 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any) -> Any:
     documents it); ``advect_step`` is :func:`advect_step_function`."""
 
     def advance(q, t, t_end, dx, bc_left, bc_right, P, g, r, dry, cfl, diag, rate, backup,
-                work, max_steps, stop_at_rest, advect, sources, predictor, fallback):
+                diag_backup, work, max_steps, stop_at_rest, advect, sources, predictor,
+                fallback):
         n = q.shape[1]
         steps = 0
         rec = work[:2]
         q0 = work[2]
         fex = diag[L.N_DIAG:]
         # to undo a Strang half source step that broke the CFL, or an IFCP step
-        diag_keep = np.empty(L.N_DIAG)
-        fex_keep = np.empty(n)
+        diag_keep = diag_backup[:L.N_DIAG]
+        fex_keep = diag_backup[L.N_DIAG:]
         # Cells outside the wet region plus the stencil are dry and at rest, which every
         # stage leaves unchanged: only the active cells are visited. The first step
         # visits all cells (the source stage cleans the initial state); the wet region
@@ -281,10 +282,11 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
     the CFL-limited splitting scheme,
 
     ``advance(q, t, t_end, dx, bc_left, bc_right, P, g, r, dry, cfl, diag, rate, backup,
-    work, max_steps, stop_at_rest, advect, sources, predictor, fallback) ->
+    diag_backup, work, max_steps, stop_at_rest, advect, sources, predictor, fallback) ->
     (t, steps, status)``.
 
-    ``rate`` and ``backup`` have the shape of ``q``; ``work`` has shape (3, *q.shape);
+    ``rate`` and ``backup`` have the shape of ``q``, ``diag_backup`` that of ``diag``;
+    ``work`` has shape (3, *q.shape);
     ``g`` = g_z [m/s^2], ``r`` = rho1/rho2 (0 for one layer) and ``dry`` [m] are the
     model's. The model's kernels: ``advect`` (its advection stage), ``sources`` (its
     source stage), ``predictor`` (MUSCL, ``order`` 2: the friction predictor of the
@@ -303,7 +305,7 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
     """
     step = njit(inline="always")(advect_step_function(order, strang))
     return specialise(stepping_function(ifcp, strang, step), STATE, f8, f8, f8, i8, i8,
-                      PARAMS, f8, f8, f8, f8, VECTOR, FIELDS, FIELDS, WORK, i8, flag,
+                      PARAMS, f8, f8, f8, f8, VECTOR, FIELDS, FIELDS, VECTOR, WORK, i8, flag,
                       ADVECT, SOURCES, PREDICTOR if order == 2 else types.none,
                       ADVECT if ifcp else types.none)
 
@@ -346,9 +348,9 @@ class Stepper:
                  rate: np.ndarray, backup: np.ndarray, work: np.ndarray, max_steps: int,
                  stop_at_rest: bool) -> tuple[float, int, int]:
         return self.ready().loop(q, t, t_end, dx, bc_left, bc_right, P,
-                                 *self.model_constants(P), cfl, diag, rate, backup, work,
-                                 max_steps, stop_at_rest, self.advect, self.sources,
-                                 self.predictor, self.fallback)
+                                 *self.model_constants(P), cfl, diag, rate, backup,
+                                 np.empty_like(diag), work, max_steps, stop_at_rest,
+                                 self.advect, self.sources, self.predictor, self.fallback)
 
 
 @functools.cache
@@ -370,8 +372,8 @@ def python_stepping(two_layer: bool, flux: int, order: int, limiter: int, strang
     def advance(q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, work,
                 max_steps, stop_at_rest):
         return loop(q, t, t_end, dx, bc_left, bc_right, P, *compiled.model_constants(P),
-                    cfl, diag, rate, backup, work, max_steps, stop_at_rest,
-                    compiled.advect, compiled.sources, compiled.predictor,
+                    cfl, diag, rate, backup, np.empty_like(diag), work, max_steps,
+                    stop_at_rest, compiled.advect, compiled.sources, compiled.predictor,
                     compiled.fallback)
 
     return advance
