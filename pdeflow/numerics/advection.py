@@ -30,7 +30,7 @@ import functools
 from typing import Any
 
 import numpy as np
-from numba import njit
+from numba import literal_unroll, njit
 
 from . import layout as L
 from .compiled import FIELDS, STATE, WORK, f8, i8, kernel, specialise
@@ -247,41 +247,27 @@ def rate_kernel(two_layer: bool, flux: int, order: int, limiter: int) -> Any:
 @functools.cache
 def _any_scheme_rate(two_layer: bool) -> Any:
     """:func:`rate_kernel` with the scheme given at run time (every scheme compiled)."""
-    schemes = [rate_kernel(two_layer, flux, order, limiter)
-               for flux in (L.FLUX_HLL, L.FLUX_RUSANOV, L.FLUX_IFCP)
-               for order, limiter in ((1, L.LIMITER_MINMOD), (2, L.LIMITER_MINMOD),
-                                      (2, L.LIMITER_MC))]
-    k0, k1, k2, k3, k4, k5, k6, k7, k8 = schemes
+    schemes = tuple((3 * flux + recon, rate_kernel(two_layer, flux, order, limiter))
+                    for flux in (L.FLUX_HLL, L.FLUX_RUSANOV, L.FLUX_IFCP)
+                    for recon, (order, limiter) in enumerate(
+                        ((1, L.LIMITER_MINMOD), (2, L.LIMITER_MINMOD), (2, L.LIMITER_MC))))
 
     def rate(q, out, work, dx, bc_left, bc_right, g, r, dry, flux, order, limiter):
         j = 3 * flux + (0 if order == 1 else (2 if limiter == L.LIMITER_MC else 1))
-        args = (q, out, work, dx, bc_left, bc_right, g, r, dry)
-        if j == 0:
-            return k0(*args)
-        if j == 1:
-            return k1(*args)
-        if j == 2:
-            return k2(*args)
-        if j == 3:
-            return k3(*args)
-        if j == 4:
-            return k4(*args)
-        if j == 5:
-            return k5(*args)
-        if j == 6:
-            return k6(*args)
-        if j == 7:
-            return k7(*args)
-        return k8(*args)
+        smax = 0.0
+        for scheme in literal_unroll(schemes):
+            if scheme[0] == j:
+                smax = scheme[1](q, out, work, dx, bc_left, bc_right, g, r, dry)
+        return smax
 
+    any_rate = specialise(rate, *ADVECT_SIGNATURE[:-2], i8, i8, i8)
     if two_layer:
-        return specialise(rate, *ADVECT_SIGNATURE[:-2], i8, i8, i8)
+        return any_rate
 
     def rate_single(q, out, work, dx, bc_left, bc_right, g, dry, flux, order, limiter):
         return any_rate(q, out, work, dx, bc_left, bc_right, g, 0.0, dry, flux, order,
                         limiter)
 
-    any_rate = specialise(rate, *ADVECT_SIGNATURE[:-2], i8, i8, i8)
     return specialise(rate_single, STATE, FIELDS, WORK, f8, i8, i8, f8, f8, i8, i8, i8)
 
 
