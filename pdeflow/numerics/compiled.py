@@ -2,11 +2,12 @@
 
 A run compiles only what its scheme calls. The kernels that depend on the scheme (the
 stepping loop, the advection stage, the face fluctuations) are built by factories such
-as :func:`pdeflow.numerics.splitting.stepping_kernel` as closures over the scheme's
+as :func:`pdeflow.numerics.advection.advection_kernel` as closures over the scheme's
 choices, held as Python booleans and integers: numba drops the branches of every other
 flux, reconstruction, limiter, splitting and model before it types anything, so their
-kernels are never compiled. Parameters and grids stay arguments: a sweep over them
-never recompiles.
+kernels are never compiled. The stepping loop takes the model's kernels as arguments
+(:func:`pdeflow.numerics.splitting.stepping_kernel`), so that one loop serves both
+models. Parameters and grids stay arguments: a sweep over them never recompiles.
 
 What the factories and the kernels share is kept here:
 

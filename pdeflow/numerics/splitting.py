@@ -26,7 +26,7 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import njit
+from numba import njit, types
 
 from . import layout as L
 from .advection import ADVECT_SIGNATURE, advection_kernel, wet_cells
@@ -42,7 +42,6 @@ from .compiled import (
     i8,
     ready,
     specialise,
-    types,
 )
 from .friction import predictor_single, predictor_two_layer
 from .source_stage import (
@@ -286,17 +285,16 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
     (t, steps, status)``.
 
     ``rate`` and ``backup`` have the shape of ``q``, ``diag_backup`` that of ``diag``;
-    ``work`` has shape (3, *q.shape);
-    ``g`` = g_z [m/s^2], ``r`` = rho1/rho2 (0 for one layer) and ``dry`` [m] are the
-    model's. The model's kernels: ``advect`` (its advection stage), ``sources`` (its
-    source stage), ``predictor`` (MUSCL, ``order`` 2: the friction predictor of the
-    SSP-RK2/Heun integrator, see :func:`~pdeflow.numerics.friction.predictor_two_layer`;
-    else None) and ``fallback`` (``ifcp``: the HLL advection stage that redoes a step
-    IFCP left negative; else None). ``strang`` applies half a source step before and
-    after the advection (else Lie, as in the paper). With Strang, dt is chosen before
-    the first half source step; if that half step makes the waves faster than dt
-    allows (erosion deepens the upper layer), it is undone and the step retried with a
-    shorter dt.
+    ``work`` has shape (3, *q.shape); ``g`` = g_z [m/s^2], ``r`` = rho1/rho2 (0 for one
+    layer) and ``dry`` [m] are the model's. The model's kernels: ``advect`` (its
+    advection stage), ``sources`` (its source stage), ``predictor`` (MUSCL, ``order``
+    2: the friction predictor of the SSP-RK2/Heun integrator, see
+    :func:`~pdeflow.numerics.friction.predictor_two_layer`; else None) and
+    ``fallback`` (``ifcp``: the HLL advection stage that redoes a step IFCP left
+    negative; else None). ``strang`` applies half a source step before and after the
+    advection (else Lie, as in the paper). With Strang, dt is chosen before the first
+    half source step; if that half step makes the waves faster than dt allows (erosion
+    deepens the upper layer), it is undone and the step retried with a shorter dt.
 
     Returns ``(t, steps, status)``: status :data:`STATUS_END`; :data:`STATUS_REST`
     (everything at rest and unchanged: stationary from ``t`` on); or
@@ -347,10 +345,18 @@ class Stepper:
                  bc_right: int, P: np.ndarray, cfl: float, diag: np.ndarray,
                  rate: np.ndarray, backup: np.ndarray, work: np.ndarray, max_steps: int,
                  stop_at_rest: bool) -> tuple[float, int, int]:
-        return self.ready().loop(q, t, t_end, dx, bc_left, bc_right, P,
-                                 *self.model_constants(P), cfl, diag, rate, backup,
-                                 np.empty_like(diag), work, max_steps, stop_at_rest,
-                                 self.advect, self.sources, self.predictor, self.fallback)
+        return self.run(self.ready().loop, q, t, t_end, dx, bc_left, bc_right, P, cfl,
+                        diag, rate, backup, work, max_steps, stop_at_rest)
+
+    def run(self, loop: Any, q: np.ndarray, t: float, t_end: float, dx: float,
+            bc_left: int, bc_right: int, P: np.ndarray, cfl: float, diag: np.ndarray,
+            rate: np.ndarray, backup: np.ndarray, work: np.ndarray, max_steps: int,
+            stop_at_rest: bool) -> tuple[float, int, int]:
+        """``loop`` (the compiled loop, or its Python code) with this scheme's kernels
+        on the stepper's arguments."""
+        return loop(q, t, t_end, dx, bc_left, bc_right, P, *self.model_constants(P), cfl,
+                    diag, rate, backup, np.empty_like(diag), work, max_steps,
+                    stop_at_rest, self.advect, self.sources, self.predictor, self.fallback)
 
 
 @functools.cache
@@ -366,17 +372,9 @@ def python_stepping(two_layer: bool, flux: int, order: int, limiter: int, strang
     kernels, with ``update`` for :func:`update` (the blow-up diagnosis replays a step
     with an update that records what it wrote); called as the stepper."""
     compiled = scheme_stepper(two_layer, flux, order, limiter, strang).ready()
-    loop = stepping_function(compiled.ifcp, strang, advect_step_function(order, strang,
-                                                                         update))
-
-    def advance(q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, work,
-                max_steps, stop_at_rest):
-        return loop(q, t, t_end, dx, bc_left, bc_right, P, *compiled.model_constants(P),
-                    cfl, diag, rate, backup, np.empty_like(diag), work, max_steps,
-                    stop_at_rest, compiled.advect, compiled.sources, compiled.predictor,
-                    compiled.fallback)
-
-    return advance
+    loop = stepping_function(compiled.ifcp, strang,
+                             advect_step_function(order, strang, update))
+    return functools.partial(compiled.run, loop)
 
 
 def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int,
