@@ -38,68 +38,52 @@ ROOT = Path(__file__).resolve().parents[1]
 CASE = "cases/paper_5_1_dam_break.toml"
 
 _SPLIT = r"""
-import builtins, json, sys, time
-t_start = time.perf_counter()
-spent = {"imports": 0.0, "compile": 0.0}
-depth = {"import": 0, "compile": 0}
-compile_in_import = [0.0]
-_real_import = builtins.__import__
+import builtins, functools, inspect, json, sys, time
+# exclusive times: each moment is booked on the innermost of import, compilation,
+# figures (an import inside a figure function counts as import), else on the rest
+spent = {"imports": 0.0, "compile": 0.0, "figures": 0.0, "rest": 0.0}
+stack = [["rest", time.perf_counter()]]
 
-def _timed_import(*args, **kwargs):
-    if depth["import"]:
-        return _real_import(*args, **kwargs)
-    depth["import"] += 1
-    c0 = spent["compile"]
-    t0 = time.perf_counter()
-    try:
-        return _real_import(*args, **kwargs)
-    finally:
-        spent["imports"] += time.perf_counter() - t0
-        compile_in_import[0] += spent["compile"] - c0
-        depth["import"] -= 1
+def _enter(category):
+    now = time.perf_counter()
+    spent[stack[-1][0]] += now - stack[-1][1]
+    stack.append([category, now])
 
-builtins.__import__ = _timed_import
+def _leave():
+    now = time.perf_counter()
+    category, t0 = stack.pop()
+    spent[category] += now - t0
+    stack[-1][1] = now
+
+def _timed(category, f):
+    @functools.wraps(f)
+    def wrapper(*args, **kwargs):
+        _enter(category)
+        try:
+            return f(*args, **kwargs)
+        finally:
+            _leave()
+    return wrapper
+
+builtins.__import__ = _timed("imports", builtins.__import__)
 from numba.core import event
 
 kernels = []
 class _Compiles(event.Listener):
     def on_start(self, ev):
-        if depth["compile"] == 0:
-            self.t0 = time.perf_counter()
-        depth["compile"] += 1
+        _enter("compile")
     def on_end(self, ev):
-        depth["compile"] -= 1
+        _leave()
         d = ev.data["dispatcher"]
         name = f"{d.py_func.__module__}.{d.py_func.__qualname__}"
         if name.startswith("pdeflow"):
             kernels.append([name, str(ev.data["args"])])
-        if depth["compile"] == 0:
-            spent["compile"] += time.perf_counter() - self.t0
 
 event.register("numba:compile", _Compiles())
-
-# the figures: every function of pdeflow.plotting, outermost calls
-import functools, inspect
 import pdeflow.plotting as _plotting
-spent["figures"] = 0.0
-depth["figures"] = 0
-
-def _timed(f):
-    @functools.wraps(f)
-    def wrapper(*args, **kwargs):
-        depth["figures"] += 1
-        t0 = time.perf_counter()
-        try:
-            return f(*args, **kwargs)
-        finally:
-            depth["figures"] -= 1
-            if depth["figures"] == 0:
-                spent["figures"] += time.perf_counter() - t0
-    return wrapper
-
 for _name, _f in list(vars(_plotting).items()):
     if inspect.isfunction(_f) and _f.__module__ == _plotting.__name__:
-        setattr(_plotting, _name, _timed(_f))
+        setattr(_plotting, _name, _timed("figures", _f))
 import runpy
 sys.argv = ["pdeflow", *sys.argv[1:]]
 try:
@@ -108,12 +92,12 @@ except SystemExit as err:
     code = err.code
 else:
     code = 0
-total = time.perf_counter() - t_start
-imports = spent["imports"] - compile_in_import[0]
+spent[stack[-1][0]] += time.perf_counter() - stack[-1][1]
 print("RESULT" + json.dumps({
-    "imports_s": imports, "compile_s": spent["compile"], "figures_s": spent["figures"],
-    "other_s": total - imports - spent["compile"] - spent["figures"],
-    "in_process_s": total, "kernels": kernels, "code": code}), file=sys.stderr)
+    "imports_s": spent["imports"], "compile_s": spent["compile"],
+    "figures_s": spent["figures"], "other_s": spent["rest"],
+    "in_process_s": sum(spent.values()), "kernels": kernels, "code": code}),
+    file=sys.stderr)
 """
 
 
