@@ -6,11 +6,14 @@ Usage (from the repository root)::
     python benchmarks/run_benchmarks.py --only wp       # work precision only
     python benchmarks/run_benchmarks.py --only bench    # benchmark suite only
     python benchmarks/run_benchmarks.py --only studies  # pdeflow study on Dask (~25 min)
+    python benchmarks/run_benchmarks.py --only cold --label after  # cold first run (~3 min)
     python benchmarks/run_benchmarks.py --render        # re-render the doc from JSON
     python benchmarks/run_benchmarks.py --quick         # smoke run into TMPDIR, ~3 min
 
-Measurements go to ``benchmarks/measurements/{workprecision,bench}.json`` (each part can be
-re-measured alone; the doc is rendered from both files), figures to
+Measurements go to ``benchmarks/measurements/{workprecision,bench,studies,cold_start}.json``
+(each part can be re-measured alone; the doc is rendered from all of them; the cold
+first run is kept per ``--label``, e.g. before and after a change, and ``--tree`` measures
+another checkout with this harness), figures to
 ``docs/figures/workprecision_*.png``, the report to ``docs/performance.md``. PyClaw is
 used when ``clawpack`` imports (``--no-pyclaw`` to skip).
 """
@@ -35,6 +38,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 sys.path.insert(0, str(ROOT))
 
+import cold_start  # noqa: E402
 import study_scaling  # noqa: E402
 import suite  # noqa: E402
 
@@ -130,7 +134,7 @@ def measure_wp(quick: bool, repeats: int, results: Path = RESULTS) -> dict[str, 
 
 def measure_bench(quick: bool, repeats: int, pyclaw: bool) -> dict[str, Any]:
     """The benchmark suite (see suite.py)."""
-    from pdeflow.numerics.splitting import advance_split
+    from pdeflow.numerics import compiled
 
     out: dict[str, Any] = {"conditions": conditions()}
     t0 = time.perf_counter()
@@ -150,7 +154,7 @@ def measure_bench(quick: bool, repeats: int, pyclaw: bool) -> dict[str, Any]:
     _log("wet region and stop at rest ...")
     out["wet_region"] = suite.wet_region_savings(repeats)
     out["stop_at_rest"] = suite.stop_at_rest_savings(repeats)
-    out["advance_split_signatures_end"] = [str(s) for s in advance_split.signatures]
+    out["max_signatures_end"] = max(len(k.signatures) for k in compiled.kernels())
     out["elapsed_s"] = time.perf_counter() - t0
     out["conditions"]["load_avg_at_end"] = os.getloadavg()
     return out
@@ -220,7 +224,8 @@ def _best(rows: list[dict[str, Any]], model: str) -> str:
 
 
 def render(wp: dict[str, Any] | None, bench: dict[str, Any] | None,
-           studies: dict[str, Any] | None = None) -> str:
+           studies: dict[str, Any] | None = None,
+           cold: dict[str, Any] | None = None) -> str:
     """docs/performance.md from the stored measurements."""
     L: list[str] = []
     a = L.append
@@ -265,11 +270,19 @@ def render(wp: dict[str, Any] | None, bench: dict[str, Any] | None,
         a(_render_wp(wp))
     if bench:
         a(_render_bench(bench))
+    if cold:
+        a(cold_start.render(cold))
     if studies:
         a(f"Studies conditions: {_cond(studies['conditions'])}.\n")
         a(study_scaling.render(studies))
     a(_findings(wp, bench))
     return "\n".join(L) + "\n"
+
+
+def _most_signatures(sweep: dict[str, Any]) -> int:
+    """Most signatures of one kernel after the sweep (measurements before the kernels
+    were specialised counted those of the one stepping kernel, ``advance_split``)."""
+    return sweep.get("max_signatures", len(sweep.get("advance_split_signatures", [])))
 
 
 def _render_targets(b: dict[str, Any]) -> str:
@@ -294,11 +307,11 @@ def _render_targets(b: dict[str, Any]) -> str:
     c = b["compile"]
     cold = c.get("cold", {})
     sw, sig = cold.get("signatures_sweep"), cold.get("signatures")
+    most = _most_signatures(s)
     L.append(f"| no kernel compiled more than once per process for a sweep | "
-             f"advance_split: {sw} signature(s) after a run_model sweep in a fresh "
-             f"process, {sig} once a run with snapshot times follows; "
-             f"{len(s['advance_split_signatures'])} in the benchmark process | "
-             f"{_met(sig == 1 and len(s['advance_split_signatures']) == 1)} |")
+             f"stepping loop: {sw} signature(s) after a run_model sweep in a fresh "
+             f"process, {sig} once a run with snapshot times follows; at most {most} per "
+             f"kernel in the benchmark process | {_met(sig == 1 and most == 1)} |")
     warm = c.get("warm", {})
     ok = warm.get("cache_misses") == 0 and warm.get("cache_hits", 0) > 0
     L.append(f"| numba cache reused across processes | warm process: "
@@ -386,9 +399,12 @@ def _render_bench(b: dict[str, Any]) -> str:
                  f"{_f(r.get('single_layer_second_s'))} | {_f(r.get('two_layer_first_s'))} "
                  f"| {_f(r.get('two_layer_second_s'))} | {_f(r.get('process_s'))} | "
                  f"{r.get('cache_hits')} / {r.get('cache_misses')} |")
-    L += ["", "The cold first run compiles every kernel reached from `advance_split` "
-          "(both models share one dispatcher; the first run of either model compiles it, "
-          "the other then finds it compiled).\n",
+    L += ["", ("The cold first run compiles the stepping loop (one kernel for both "
+               "models) and the kernels of the case's scheme (see the cold first run "
+               "below)." if "max_signatures" in b["sweep"] else
+               "The cold first run compiles every kernel reached from `advance_split` "
+               "(both models share one dispatcher; the first run of either model compiles "
+               "it, the other then finds it compiled).") + "\n",
           "### The 5.1 case to rest (dx = 0.05 m, 140 cells)\n"]
     L += _table(["model", "steps", "rest at [s]", "run_model [ms]", "stepper alone [ms]"],
                 "lrrrr",
@@ -500,10 +516,10 @@ def _crawl(wp: dict[str, Any]) -> str:
 def _findings(wp: dict[str, Any] | None, b: dict[str, Any] | None) -> str:
     L = ["## Findings\n"]
     if b:
-        sigs = b["sweep"]["advance_split_signatures"]
-        if len(sigs) > 1:
+        most = _most_signatures(b["sweep"])
+        if most > 1:
             L.append(
-                f"* **advance_split is compiled {len(sigs)} times per process.** py-pde's "
+                f"* **A kernel is compiled {most} times per process.** py-pde's "
                 "controller passes `t_start = 0` as an int when the run starts (a float "
                 "after a tracker interrupt, or from a direct stepper call), and "
                 "`FVSplitSolver.make_stepper` hands it to the kernel unconverted, so numba "
@@ -529,7 +545,7 @@ def _findings(wp: dict[str, Any] | None, b: dict[str, Any] | None) -> str:
         L.append(
             f"* **Dry cells: a 10x longer domain (same collapse, same dx) costs {wet}** "
             "(it was 4.6x for one layer and 1.8x for two on 2026-11-22, when only the "
-            "advection loops skipped dry cells). Every stage of `advance_split` now "
+            "advection loops skipped dry cells). Every stage of the stepping loop now "
             "visits only the wet region plus the stencil (the state backup, the update, "
             "the source stage, the MUSCL predictor); the first step visits all cells once "
             "to clean the initial state, and the wet region is searched in a window two "
@@ -537,11 +553,13 @@ def _findings(wp: dict[str, Any] | None, b: dict[str, Any] | None) -> str:
             "nothing, bit for bit (`tests/test_active_region.py`).")
         r1 = b["sweep"]["ratio_single_vs_baseline_stepper"]
         L.append(
-            "* **Scene specialisation happens at run time, not by recompiling.** Model, "
-            "flux, reconstruction, limiter, splitting and hyperbolicity mode are arguments "
-            "of one compiled `advance_split` (one signature per process, cached on disk), "
-            "so a sweep over models, variants and grids never recompiles (a cold compile "
-            f"is {_f(b['compile'].get('cold', {}).get('single_layer_first_s'))} s). What "
+            "* **A scheme is compiled once; parameters and grids never recompile.** The "
+            "stepping loop is one kernel per reconstruction order and splitting, for "
+            "both models and every flux; the model's advection stage (one per model, "
+            "flux, reconstruction and limiter), source stage and predictor are its "
+            "arguments. Parameters are an array and the grid an argument, so a sweep "
+            "over them never recompiles, and a run compiles only what its scheme calls "
+            "(cold first run below). What "
             "a scene does not need is skipped by branches: dry cells and absent layers "
             "(the loops' range and per-cell tests), the hyperbolicity stage where a layer "
             "is absent, F_extra writes except where it is applied, the time after rest "
@@ -581,7 +599,13 @@ def _findings(wp: dict[str, Any] | None, b: dict[str, Any] | None) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--only", choices=("wp", "bench", "studies"), default=None)
+    p.add_argument("--only", choices=("wp", "bench", "studies", "cold"), default=None)
+    p.add_argument("--label", default="after",
+                   help="name of the cold-start measurement (e.g. before, after)")
+    p.add_argument("--tree", default=str(ROOT),
+                   help="checkout whose cold first run is measured (default: this one)")
+    p.add_argument("--commit", default=None,
+                   help="commit of --tree, if it is no git checkout")
     p.add_argument("--sweeps", type=int, default=20,
                    help="5.2 sweeps at dx = 0.0025 m in the studies benchmark")
     p.add_argument("--render", action="store_true", help="only re-render the doc")
@@ -598,6 +622,7 @@ def main(argv: list[str] | None = None) -> int:
     doc = args.doc or str(results / "performance.md" if args.quick else DOC)
     wp_path, bench_path = results / "workprecision.json", results / "bench.json"
     studies_path = results / "studies.json"
+    cold_path = results / "cold_start.json"
     if not args.render:
         import pyclaw_run
 
@@ -611,6 +636,11 @@ def main(argv: list[str] | None = None) -> int:
             st = study_scaling.measure(args.quick, max(3, repeats // 2 + 1), args.sweeps)
             st["conditions"] = conditions()
             studies_path.write_text(json.dumps(st, indent=1, default=str))
+        if args.only in (None, "cold"):
+            c = json.loads(cold_path.read_text()) if cold_path.exists() else {}
+            c[args.label] = cold_start.measure(max(3, repeats // 2 + 1), Path(args.tree),
+                                               log=sys.stderr, commit_id=args.commit)
+            cold_path.write_text(json.dumps(c, indent=1, default=str))
         if args.only in (None, "wp"):
             w = measure_wp(args.quick, max(3, repeats) if not args.quick else repeats,
                            results)
@@ -618,7 +648,8 @@ def main(argv: list[str] | None = None) -> int:
     wp = json.loads(wp_path.read_text()) if wp_path.exists() else None
     bench = json.loads(bench_path.read_text()) if bench_path.exists() else None
     studies = json.loads(studies_path.read_text()) if studies_path.exists() else None
-    Path(doc).write_text(render(wp, bench, studies))
+    cold = json.loads(cold_path.read_text()) if cold_path.exists() else None
+    Path(doc).write_text(render(wp, bench, studies, cold))
     _log(f"written {doc}")
     return 0
 

@@ -181,8 +181,10 @@ t0 = time.perf_counter()
 import pdeflow
 from pdeflow.cases import load_case
 from pdeflow.simulate import run_model
-from pdeflow.numerics.splitting import advance_split
+from pdeflow.numerics import compiled, layout as L
+from pdeflow.numerics.splitting import scheme_stepper
 t_import = time.perf_counter() - t0
+loop = scheme_stepper(True, L.FLUX_HLL, 1, L.LIMITER_MINMOD, False).loop  # both models
 c = load_case(sys.argv[1], ["output.snapshot_times=[]", "grid.dx=0.05"])
 out = {"import_s": t_import}
 for model in ("single_layer", "two_layer"):
@@ -196,15 +198,16 @@ for H0 in (0.5, 1.0, 2.0):
         cc = load_case(sys.argv[1], ["output.snapshot_times=[]", "initial.L0=0.1",
                                      f"initial.H0={H0}", "grid.length=4.0", "grid.dx=0.02"])
         run_model(cc, model)
-out["signatures_sweep"] = len(advance_split.signatures)
+out["signatures_sweep"] = len(loop.signatures)
 # the case as `pdeflow run` runs it: with snapshot times (tracker interrupts)
 t0 = time.perf_counter()
 run_model(load_case(sys.argv[1]), "two_layer")
 out["with_snapshots_s"] = time.perf_counter() - t0
-sigs = [str(s) for s in advance_split.signatures]
-st = advance_split.stats
+sigs = [str(s) for s in loop.signatures]
+st = loop.stats
 out.update(signatures=len(sigs), signature_list=sigs,
-           cache_hits=sum(st.cache_hits.values()), cache_misses=sum(st.cache_misses.values()))
+           cache_hits=sum(st.cache_hits.values()), cache_misses=sum(st.cache_misses.values()),
+           max_signatures=max(len(k.signatures) for k in compiled.kernels()))
 print("RESULT" + json.dumps(out))
 """
 
@@ -212,10 +215,11 @@ print("RESULT" + json.dumps(out))
 def compile_times(cache_dir: str | None = None) -> dict[str, Any]:
     """Compile cost in fresh subprocesses: cold (empty ``NUMBA_CACHE_DIR``) and warm
     (the same cache again). Each runs the 5.1 case (dx 0.05 m) twice per model, a
-    small sweep (``signatures_sweep``: signatures of ``advance_split`` after it), then
-    the 5.1 case with its snapshot times as ``pdeflow run`` does; reports import time,
-    first and second run [s], the signatures of ``advance_split`` compiled or loaded,
-    and numba's cache hits/misses."""
+    small sweep (``signatures_sweep``: signatures of the stepping loop after it, one
+    kernel for both models), then the 5.1 case with its snapshot times as ``pdeflow
+    run`` does; reports import time, first and second run [s], the signatures of the
+    stepping loop compiled or loaded, numba's cache hits/misses of it and the most
+    signatures of any kernel (``max_signatures``)."""
     own = cache_dir is None
     tmp = tempfile.mkdtemp(prefix="pdeflow-numba-") if own else cache_dir
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp)}
@@ -290,7 +294,7 @@ def sweep(repeats: int = 5, heights: Sequence[float] = SWEEP_H0, pyclaw: bool = 
     """
     import pyclaw_run
 
-    from pdeflow.numerics.splitting import advance_split
+    from pdeflow.numerics import compiled
     from pdeflow.simulate import run_model
 
     have_claw = pyclaw and pyclaw_run.available()
@@ -342,7 +346,7 @@ def sweep(repeats: int = 5, heights: Sequence[float] = SWEEP_H0, pyclaw: bool = 
         "ns_per_update_two": 1e9 * tot["two_stepper_s"] / upd2,
         "ns_per_update_baseline": 1e9 * tot["baseline_s"] / sum(
             r["steps_baseline"] * r["cells"] for r in rows),
-        "advance_split_signatures": [str(s) for s in advance_split.signatures],
+        "max_signatures": max(len(k.signatures) for k in compiled.kernels()),
     }
     out["ratio_single_vs_baseline_stepper"] = tot["single_stepper_s"] / tot["baseline_s"]
     out["ratio_single_vs_baseline_run_model"] = tot["single_run_model_s"] / tot["baseline_s"]

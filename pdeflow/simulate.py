@@ -74,7 +74,9 @@ def load_case_kernels(case: Case, log: Any = None) -> float:
     """Compile or load the compiled kernels that ``case`` needs, before its runs, so
     that neither its wall times nor its progress bars include it; ``log`` (a stream) is
     told when they are compiled (the first run on a machine). Returns seconds spent."""
-    return load_kernels(log) if case.solver == "fv-split" else 0.0
+    if case.solver != "fv-split":
+        return 0.0
+    return load_kernels(log, [case.make_pde(m) for m in case.models], case.splitting)
 
 
 class Run:
@@ -146,7 +148,7 @@ class Run:
         if not self.variant.is_mol and self.backend == "numba":
             # compiling (first run on a machine) or loading the kernels is not the run's
             # wall time, nor should it hold up its progress bar
-            load_kernels()
+            load_kernels(pdes=[self.pde], splitting=self.variant.splitting)
         wall0 = time.perf_counter()
         final, info = self.pde.solve(self.state, t_range=case.t_end, tracker=trackers,
                                      ret_info=True, **self.solver_arguments())

@@ -80,14 +80,15 @@ def test_cli_says_when_it_compiles(monkeypatch):
     monkeypatch.setattr(fv_split, "kernels_ready", lambda: False)
     monkeypatch.setattr(fv_split, "kernels_cached", lambda: False)
     log = io.StringIO()
-    seconds = fv_split.load_kernels(log)
+    eq, _ = _readme_state()
+    seconds = fv_split.load_kernels(log, [eq])
     assert seconds > 0
     text = log.getvalue()
     assert text.startswith("pdeflow: compiling numba kernels (once per machine) ...")
     assert f"done in {seconds:.1f} s" in text
     monkeypatch.setattr(fv_split, "kernels_cached", lambda: True)
     log = io.StringIO()
-    fv_split.load_kernels(log)
+    fv_split.load_kernels(log, [eq])
     assert log.getvalue() == ""  # loading from the disk cache is quick: nothing to say
 
 

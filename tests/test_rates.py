@@ -92,3 +92,30 @@ def test_method_of_lines_rate_honours_the_relaxed_closure():
     # dh1/dt: the paper's closure at du = 0 is -(1 - k) g h1 tan(phi_int)/mol_eps
     assert rates["paper"][0, 1] < -100
     assert rates["relaxed"][0, 1] == pytest.approx(-0.3 / tau, rel=1e-12)
+
+
+def test_method_of_lines_rate_bounds_erosion_by_the_relaxation():
+    """Where the layers shear hard, the paper's closure erodes faster than the
+    relaxation towards h1_eq allows: the relaxed rate is then the relaxation bound
+    r (min(h1_eq, h1 + h2/r) - h1)/tau, in the numpy and the numba rate alike (an
+    interior cell of a uniform state: no advection)."""
+    g = grid(4)
+    h1, h2, u1, c, tau_star = 0.05, 0.5, 3.0, 0.5, 3.0
+    prof = dict(h1=np.full(4, h1), u1=np.full(4, u1), h2=np.full(4, h2), u2=np.zeros(4))
+    rates = {}
+    for closure in ("paper", "relaxed"):
+        eq = pdeflow.TwoLayerGranular(bc=("wall", "wall"), exchange_closure=closure,
+                                      tau_star=tau_star, c=c)
+        st = eq.make_state(g, **prof)
+        numpy_rate = eq.evolution_rate(st).data
+        numba_rate = eq.make_evolution_rate(st, get_backend("numba"))(st.data, 0.0)
+        np.testing.assert_allclose(numba_rate, numpy_rate, rtol=1e-12, atol=1e-12)
+        rates[closure] = numpy_rate[0, 1]
+    p = pdeflow.TwoLayerParameters()
+    r, tan_int = p.density_ratio, np.tan(np.radians(p.phi_int_deg))
+    paper = (c * u1**2 - (1 - p.k) * r * p.g * h1 * tan_int) / u1 / r
+    h1_eq = c * u1**2 / ((1 - p.k) * r * p.g * tan_int)
+    bound = (min(h1_eq, h1 + h2 / r) - h1) / (tau_star * np.sqrt((h1 + h2) / p.g))
+    assert rates["paper"] == pytest.approx(paper, rel=1e-12)
+    assert bound < paper
+    assert rates["relaxed"] == pytest.approx(bound, rel=1e-12)

@@ -344,7 +344,7 @@ def test_ifcp_steps_that_are_not_positive_are_redone_with_hll():
     cells move apart fast (no positivity for any CFL number); HLL and Rusanov, whose
     wave speeds bound the physical ones, stay positive on the same state. The stepper
     therefore redoes such an IFCP step with HLL and counts it."""
-    from pdeflow.numerics.splitting import _advect_step
+    from pdeflow.numerics.splitting import advect_step_function, scheme_stepper
 
     profiles = {"h": np.array([0.51182162, 0.9504637, 0.14415961]),
                 "u": np.array([-5.36953235, 5.81118104, 3.64572396])}
@@ -359,11 +359,13 @@ def test_ifcp_steps_that_are_not_positive_are_redone_with_hll():
             n = q.shape[1]
             diag = eq.new_diagnostics(n)
             # the bare advection update of this flux from the current state
-            *_, ok, _, _, _ = _advect_step(
-                q, 0.0, T_FAR, 1.0 / 3, *eq.bc_codes, eq.parameter_array(), 0.5, diag,
-                np.zeros_like(q), q.copy(), np.zeros((2, *q.shape)), np.zeros_like(q),
-                np.zeros(L.N_DIAG), np.zeros(n), False, *eq.scheme_codes, False, True,
-                0, n - 1, 0, n - 1)
+            kernels = scheme_stepper(False, *eq.scheme_codes, False).ready()
+            P = eq.parameter_array()
+            *_, ok, _, _, _ = advect_step_function(1, False)(
+                kernels.advect, kernels.sources, None, q, 0.0, T_FAR, 1.0 / 3,
+                *eq.bc_codes, P, *kernels.model_constants(P), 0.5, diag, np.zeros_like(q),
+                q.copy(), np.zeros((2, *q.shape)), np.zeros_like(q), np.zeros(L.N_DIAG),
+                np.zeros(n), True, 0, n - 1, 0, n - 1)
             if not ok:
                 assert flux == "ifcp"  # only IFCP is not positive
             t = stepper(state, t, T_FAR)

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, fields
+from dataclasses import asdict, dataclass, fields
 from typing import Any
 
 import numpy as np
@@ -23,6 +23,7 @@ from pde import CartesianGrid, FieldCollection, ScalarField
 from pde.pdes.base import PDEBase
 
 from ..numerics import layout as L
+from ..numerics.state import DRY_TOLERANCE
 
 BC_NAMES = {"wall": L.BC_WALL, "open": L.BC_OPEN}
 RECONSTRUCTIONS = {"first-order": 1, "muscl": 2}
@@ -92,6 +93,41 @@ class ParametersBase:
         return asdict(self)  # type: ignore[call-overload]
 
 
+@dataclass
+class SharedParameters(ParametersBase):
+    """The parameters both models have: gravity, slope, the dry and rest tolerances
+    and the regularisation of the method-of-lines rate. A model's class adds its own
+    and checks them in :meth:`validate_model`."""
+
+    g: float = 9.81
+    """gravitational acceleration [m/s^2]"""
+    theta_deg: float = 0.0
+    """bed slope [deg], x pointing down-slope"""
+    dry_tolerance: float = DRY_TOLERANCE
+    """layers thinner than this have zero velocity [m]"""
+    rest_speed: float = 0.01
+    """speed below which a layer counts as practically at rest [m/s]"""
+    rest_depth: float = 1e-3
+    """depth above which the practical-rest test looks at a cell [m]"""
+    mol_eps: float = 1e-3
+    """velocity scale regularising sgn() in the method-of-lines rate [m/s]"""
+
+    def validate(self) -> None:
+        """Raise ValueError naming the first parameter outside its allowed range."""
+        check_range("g", self.g, 0, math.inf, low_open=True, unit="m/s^2")
+        check_range("theta_deg", self.theta_deg, -90, 90, low_open=True,
+                    high_open=True, unit="deg")
+        self.validate_model()
+        check_range("dry_tolerance", self.dry_tolerance, 0, 1, low_open=True, unit="m")
+        check_range("rest_speed", self.rest_speed, 0, math.inf, low_open=True,
+                    unit="m/s")
+        check_range("rest_depth", self.rest_depth, 0, math.inf, unit="m")
+        check_range("mol_eps", self.mol_eps, 0, math.inf, low_open=True, unit="m/s")
+
+    def validate_model(self) -> None:  # pragma: no cover - overridden
+        """Check the model's own parameters (see :meth:`validate`)."""
+
+
 class GranularPDE(PDEBase):
     """Base of :class:`TwoLayerGranular` and :class:`SingleLayerGranular`."""
 
@@ -101,16 +137,24 @@ class GranularPDE(PDEBase):
     field_names: tuple[str, ...] = ()
     two_layer: bool = False
 
-    def __init__(self, bc: Sequence[str] = ("wall", "open"), *, flux: str = "hll",
-                 reconstruction: str = "first-order", limiter: str = "minmod"):
+    #: the parameter dataclass of the model
+    parameters_class: type[SharedParameters] = SharedParameters
+
+    def __init__(self, parameters: SharedParameters | dict | None = None, *,
+                 bc: Sequence[str] = ("wall", "open"), flux: str = "hll",
+                 reconstruction: str = "first-order", limiter: str = "minmod",
+                 **kwargs: Any):
         """
         Args:
+            parameters: the model's parameters (a :attr:`parameters_class` or a dict of
+                its fields).
             bc: boundary at (left, right): 'wall' (reflective) or 'open' (transmissive).
             flux: interface flux: 'hll' (the paper's), 'rusanov', or 'ifcp' (sharper;
                 Roe's scheme for one layer).
             reconstruction: 'first-order' (the paper's) or 'muscl' (second order in
                 space; the fv-split solver then advects with SSP-RK2).
             limiter: slope limiter of 'muscl': 'minmod' or 'mc' (monotonised central).
+            **kwargs: individual parameters overriding ``parameters``.
         """
         super().__init__()
         if isinstance(bc, str) or len(bc) != 2 or any(b not in BC_NAMES for b in bc):
@@ -128,6 +172,14 @@ class GranularPDE(PDEBase):
         self.flux = flux
         self.reconstruction = reconstruction
         self.limiter = limiter
+        if isinstance(parameters, self.parameters_class):
+            parameters = parameters.to_dict()
+        self.parameters = self.parameters_class.from_dict({**(parameters or {}),
+                                                           **kwargs})
+
+    def __repr__(self) -> str:
+        return (f"{type(self).__name__}({self.parameters}, bc={self.bc}, "
+                f"{self.variant})")
 
     @property
     def scheme_codes(self) -> tuple[int, int, int]:
@@ -144,7 +196,7 @@ class GranularPDE(PDEBase):
     # --- parameters -----------------------------------------------------------------------
     def parameter_array(self) -> np.ndarray:
         """Flat float64 parameter vector read by the kernels (see numerics.layout)."""
-        raise NotImplementedError
+        return self.parameters.to_array()
 
     # --- solving --------------------------------------------------------------------------
     def solve(self, state: Any, t_range: Any, dt: float | None = None,
@@ -240,43 +292,34 @@ class GranularPDE(PDEBase):
         return float(P[L.DRY] if self.two_layer else P[L.S_DRY])
 
     def make_evolution_rate(self, state: FieldCollection, backend: Any) -> Callable:
-        """Compiled method-of-lines rate (numba backend)."""
+        """Compiled method-of-lines rate (numba backend): the advection rate of this
+        model's scheme (only that scheme is compiled) plus the sources (26)-(27)."""
         name = getattr(backend, "name", str(backend))
         if name not in ("numba",):
             raise NotImplementedError(f"no compiled rate for backend {name}")
         from numba import njit
 
-        from ..numerics.advection import rate_single, rate_two_layer
+        from ..numerics.advection import rate_kernel
+        from ..numerics.compiled import ready
         from ..numerics.mol import source_rate_single, source_rate_two_layer
 
         dx = self.check_grid(state.grid)
         P = self.parameter_array()
         bcl, bcr = self.bc_codes
-        g = P[L.G_Z]
+        g = float(P[L.G_Z])
+        r = float(P[L.R]) if self.two_layer else 0.0
         dry = self._dry(P)
-        flux, order, limiter = self.scheme_codes
+        advect = ready(rate_kernel(self.two_layer, *self.scheme_codes))
+        sources = ready(source_rate_two_layer if self.two_layer else source_rate_single)
         shape = (2, *state.data.shape)  # closure arrays are read-only in numba
-        if self.two_layer:
-            r = P[L.R]
 
-            @njit
-            def rate(state_data, t):  # pragma: no cover - compiled
-                out = np.empty_like(state_data)
-                work = np.empty(shape)
-                rate_two_layer(state_data, out, work, dx, bcl, bcr, g, r, dry, flux,
-                               order, limiter)
-                source_rate_two_layer(state_data, out, P)
-                return out
-        else:
-
-            @njit
-            def rate(state_data, t):  # pragma: no cover - compiled
-                out = np.empty_like(state_data)
-                work = np.empty(shape)
-                rate_single(state_data, out, work, dx, bcl, bcr, g, dry, flux, order,
-                            limiter)
-                source_rate_single(state_data, out, P)
-                return out
+        @njit
+        def rate(state_data, t):  # pragma: no cover - compiled
+            out = np.empty_like(state_data)
+            work = np.empty(shape)
+            advect(state_data, out, work, dx, bcl, bcr, g, r, dry)
+            sources(state_data, out, P)
+            return out
 
         return rate
 
@@ -287,7 +330,7 @@ class GranularPDE(PDEBase):
 
     def source_kernel(self) -> Callable:
         """The compiled source stage ``(q, dt, t, P, diag) -> None`` of this model."""
-        from ..numerics.splitting import source_stage_single, source_stage_two_layer
+        from ..numerics.source_stage import source_stage_single, source_stage_two_layer
 
         return source_stage_two_layer if self.two_layer else source_stage_single
 
@@ -300,12 +343,13 @@ class GranularPDE(PDEBase):
         ``data[D_BAD_STEPS]`` before the kernel clips it (generic solvers have no other
         check; fv-split rejects such steps itself).
         """
+        from ..numerics.compiled import ready
+
         self.check_state(state)
         P = self.parameter_array()
         kernel = self.source_kernel()
         name = getattr(backend, "name", str(backend))
-        if name == "numpy":
-            kernel = kernel.py_func
+        kernel = kernel.py_func if name == "numpy" else ready(kernel)
 
         def post_step_hook(state_data, t, post_step_data):
             dt = post_step_data[0]

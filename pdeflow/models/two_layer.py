@@ -20,20 +20,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from ..numerics import layout as L
-from ..numerics.state import DRY_TOLERANCE
-from .base import GranularPDE, ParametersBase, check_range
+from .base import GranularPDE, SharedParameters, check_range
 
 HYPERBOLICITY_MODES = {"none": 0, "exact": 1, "bound": 2}
 
 
 @dataclass
-class TwoLayerParameters(ParametersBase):
-    """Physical and numerical parameters of :class:`TwoLayerGranular`.
+class TwoLayerParameters(SharedParameters):
+    """Physical and numerical parameters of :class:`TwoLayerGranular` (and those of
+    :class:`~pdeflow.models.base.SharedParameters`).
 
     The paper's Table 1 is lost; defaults marked *calibrated* were chosen to reproduce
     the paper's reported results of test 5.1 (see ``docs/parameters.md``).
@@ -41,10 +40,6 @@ class TwoLayerParameters(ParametersBase):
 
     kind = "two-layer"
 
-    g: float = 9.81
-    """gravitational acceleration [m/s^2]"""
-    theta_deg: float = 0.0
-    """bed slope [deg], x pointing down-slope"""
     density_ratio: float = 0.67
     """rho1/rho2 in (0, 1): the paper's value for dense-collisional flows [-]"""
     phi_int_deg: float = 30.0
@@ -57,8 +52,6 @@ class TwoLayerParameters(ParametersBase):
     """collisional (Voellmy) coefficient of eq. (17) [-] (calibrated)"""
     w: float = 1e-3
     """tolerance of the restoration (33)-(34) in du: restored |du| within w below F_c1 [m/s]"""
-    dry_tolerance: float = DRY_TOLERANCE
-    """layers thinner than this have zero velocity [m]"""
     film_depth: float = 1e-3
     """upper-layer films thinner than this after an exchange are deposited whole [m]"""
     du_reg: float = 0.0
@@ -72,18 +65,8 @@ class TwoLayerParameters(ParametersBase):
     """relaxation time of the 'relaxed' closure in units of sqrt(H/g) [-]"""
     hyperbolicity: str = "exact"
     """restoration of hyperbolicity: 'exact' (paper), 'bound' (F_L), 'none'"""
-    rest_speed: float = 0.01
-    """speed below which a layer counts as practically at rest [m/s]"""
-    rest_depth: float = 1e-3
-    """depth above which the practical-rest test looks at a cell [m]"""
-    mol_eps: float = 1e-3
-    """velocity scale regularising sgn() in the method-of-lines rate [m/s]"""
 
-    def validate(self) -> None:
-        """Raise ValueError naming the first parameter outside its allowed range."""
-        check_range("g", self.g, 0, math.inf, low_open=True, unit="m/s^2")
-        check_range("theta_deg", self.theta_deg, -90, 90, low_open=True,
-                    high_open=True, unit="deg")
+    def validate_model(self) -> None:
         check_range("density_ratio", self.density_ratio, 0, 1, low_open=True,
                     high_open=True)
         check_range("phi_int_deg", self.phi_int_deg, 0, 90, low_open=True,
@@ -93,13 +76,8 @@ class TwoLayerParameters(ParametersBase):
         check_range("k", self.k, 0, 1, high_open=True)
         check_range("c", self.c, 0, math.inf)
         check_range("w", self.w, 0, math.inf, low_open=True, unit="m/s")
-        check_range("dry_tolerance", self.dry_tolerance, 0, 1, low_open=True, unit="m")
         check_range("film_depth", self.film_depth, 0, 1, unit="m")
         check_range("du_reg", self.du_reg, 0, math.inf, unit="m/s")
-        check_range("rest_speed", self.rest_speed, 0, math.inf, low_open=True,
-                    unit="m/s")
-        check_range("rest_depth", self.rest_depth, 0, math.inf, unit="m")
-        check_range("mol_eps", self.mol_eps, 0, math.inf, low_open=True, unit="m/s")
         check_range("tau_star", self.tau_star, 0, math.inf, low_open=True)
         if self.exchange_closure not in ("paper", "relaxed", "none"):
             raise ValueError("exchange_closure must be 'paper', 'relaxed' or 'none', got "
@@ -142,27 +120,4 @@ class TwoLayerGranular(GranularPDE):
 
     field_names = ("h1", "h1u1", "h2", "h2u2")
     two_layer = True
-
-    def __init__(self, parameters: TwoLayerParameters | dict | None = None, *,
-                 bc: tuple[str, str] = ("wall", "open"), flux: str = "hll",
-                 reconstruction: str = "first-order", limiter: str = "minmod",
-                 **kwargs: Any):
-        """
-        Args:
-            parameters: a :class:`TwoLayerParameters` or a dict of its fields.
-            bc: boundary at (left, right): 'wall' (reflective) or 'open' (transmissive).
-            flux, reconstruction, limiter: the spatial scheme (see GranularPDE).
-            **kwargs: individual parameters overriding ``parameters``.
-        """
-        super().__init__(bc, flux=flux, reconstruction=reconstruction, limiter=limiter)
-        if parameters is None:
-            parameters = {}
-        if isinstance(parameters, TwoLayerParameters):
-            parameters = parameters.to_dict()
-        self.parameters = TwoLayerParameters.from_dict({**parameters, **kwargs})
-
-    def parameter_array(self) -> np.ndarray:
-        return self.parameters.to_array()
-
-    def __repr__(self) -> str:
-        return f"TwoLayerGranular({self.parameters}, bc={self.bc}, {self.variant})"
+    parameters_class = TwoLayerParameters

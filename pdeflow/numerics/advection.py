@@ -18,19 +18,27 @@ Boundaries use one ghost cell: a wall mirrors the state (h -> h, hu -> -hu), an 
 (transmissive) boundary copies it. Only faces next to a wet cell are visited: a face
 between two cells that are dry in every layer carries no fluctuation, so the loops run
 over the wet region plus the stencil (most of the domain is dry for most of a collapse).
+
+:func:`advection_kernel` builds this stage for one model, flux, reconstruction and
+limiter (nothing of the others is compiled); :func:`rate_kernel` is the same on the
+whole grid, the method-of-lines rate.
 """
 
 from __future__ import annotations
 
+import functools
+from typing import Any
+
 import numpy as np
-from numba import njit
+from numba import literal_unroll, njit
 
 from . import layout as L
-from .pvm import fluct_single, fluct_two_layer
+from .compiled import FIELDS, STATE, WORK, f8, i8, kernel, specialise
+from .pvm import face_single, face_two_layer, fluctuation_kernel
 from .state import velocity
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _is_wet(q: np.ndarray, i: int, dry: float) -> bool:
     for k in range(0, q.shape[0], 2):
         if q[k, i] > dry:
@@ -38,7 +46,7 @@ def _is_wet(q: np.ndarray, i: int, dry: float) -> bool:
     return False
 
 
-@njit(cache=True)
+@kernel(STATE, f8, i8, i8)
 def wet_cells(q: np.ndarray, dry: float, start: int, stop: int) -> tuple[int, int]:
     """First and last index in ``start..stop`` of a cell where some layer's depth
     (rows 0, 2, ... of ``q``) exceeds ``dry``; ``(1, 0)`` if there is none."""
@@ -53,7 +61,7 @@ def wet_cells(q: np.ndarray, dry: float, start: int, stop: int) -> tuple[int, in
     return lo, hi
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _limited(a: float, b: float, limiter: int) -> float:
     if a * b <= 0.0:
         return 0.0
@@ -65,26 +73,18 @@ def _limited(a: float, b: float, limiter: int) -> float:
     return s * min(a, b)
 
 
-@njit(cache=True)
-def reconstruct(q: np.ndarray, work: np.ndarray, lo: int, hi: int, bc_left: int,
-                bc_right: int, dry: float, order: int, limiter: int) -> None:
-    """Face values of cells lo..hi into work[0] (left face) and work[1] (right face).
-
-    Order 1 copies the averages; order 2 reconstructs (h, u) of each layer linearly
-    with limited slopes (ghost neighbours from the boundary conditions).
-    """
+@kernel(STATE, WORK, i8, i8, i8, i8, f8, i8)
+def reconstruct_muscl(q: np.ndarray, work: np.ndarray, lo: int, hi: int, bc_left: int,
+                      bc_right: int, dry: float, limiter: int) -> None:
+    """Face values of cells lo..hi into work[0] (left face) and work[1] (right face):
+    (h, u) of each layer reconstructed linearly with limited slopes (ghost neighbours
+    from the boundary conditions)."""
     n = q.shape[1]
     nf = q.shape[0]
     for i in range(lo, hi + 1):
         for k in range(0, nf, 2):
             h = q[k, i]
             m = q[k + 1, i]
-            if order == 1:
-                work[0, k, i] = h
-                work[0, k + 1, i] = m
-                work[1, k, i] = h
-                work[1, k + 1, i] = m
-                continue
             u = velocity(h, m, dry)
             if i > 0:
                 hl = q[k, i - 1]
@@ -123,163 +123,160 @@ def reconstruct(q: np.ndarray, work: np.ndarray, lo: int, hi: int, bc_left: int,
             work[1, k + 1, i] = hp * (u + 0.5 * su) if hp > dry else 0.0
 
 
-@njit(cache=True, inline="always")
-def _ghost(value: float, is_momentum: bool, bc: int) -> float:
-    if bc == L.BC_WALL and is_momentum:
-        return -value
-    return value
+@njit(cache=True)
+def cell_jump_single(qm: np.ndarray, qp: np.ndarray, rate: np.ndarray, lo: int, hi: int,
+                     inv_dx: float, g: float, r: float, dry: float) -> None:
+    """Subtract the flux difference across the reconstruction inside cells lo..hi
+    (single layer; ``r`` unused)."""
+    for i in range(lo, hi + 1):
+        hl, hr = qm[0, i], qp[0, i]
+        ul = velocity(hl, qm[1, i], dry)
+        ur = velocity(hr, qp[1, i], dry)
+        rate[0, i] -= (ur * hr - ul * hl) * inv_dx
+        rate[1, i] -= (ur * ur * hr + 0.5 * g * hr * hr
+                       - ul * ul * hl - 0.5 * g * hl * hl) * inv_dx
 
 
 @njit(cache=True)
-def rate_single(q: np.ndarray, rate: np.ndarray, work: np.ndarray, dx: float,
-                bc_left: int, bc_right: int, g: float, dry: float, flux: int,
-                order: int, limiter: int) -> float:
-    """Advection rate of the single-layer state ``q[(h, hu), cell]`` into ``rate``.
+def cell_jump_two_layer(qm: np.ndarray, qp: np.ndarray, rate: np.ndarray, lo: int,
+                        hi: int, inv_dx: float, g: float, r: float, dry: float) -> None:
+    """Subtract the path-conservative jump across the linear reconstruction inside cells
+    lo..hi (two layers)."""
+    for i in range(lo, hi + 1):
+        h1l, h1r = qm[0, i], qp[0, i]
+        h2l, h2r = qm[2, i], qp[2, i]
+        u1l = velocity(h1l, qm[1, i], dry)
+        u1r = velocity(h1r, qp[1, i], dry)
+        u2l = velocity(h2l, qm[3, i], dry)
+        u2r = velocity(h2r, qp[3, i], dry)
+        dh1 = h1r - h1l
+        dh2 = h2r - h2l
+        rate[0, i] -= (u1r * h1r - u1l * h1l) * inv_dx
+        rate[1, i] -= ((u1r * u1r * h1r - u1l * u1l * h1l)
+                       + g * 0.5 * (h1l + h1r) * (dh1 + dh2)) * inv_dx
+        rate[2, i] -= (u2r * h2r - u2l * h2l) * inv_dx
+        rate[3, i] -= ((u2r * u2r * h2r - u2l * u2l * h2l)
+                       + g * 0.5 * (h2l + h2r) * (dh2 + r * dh1)) * inv_dx
 
-    ``work`` is scratch space of shape (2, 2, n). Returns the largest wave speed [m/s]
-    over the faces that were visited.
+
+ADVECT_SIGNATURE = (STATE, FIELDS, WORK, f8, i8, i8, f8, f8, f8, i8, i8)
+
+
+@functools.cache
+def advection_kernel(two_layer: bool, flux: int, order: int, limiter: int) -> Any:
+    """The advection stage of one scheme: ``advect(q, rate, work, dx, bc_left, bc_right,
+    g, r, dry, start, stop) -> (smax, r_lo, r_hi)``.
+
+    Writes the rate of the state ``q`` (fields x cells) into ``rate`` in the cells it can
+    change, ``r_lo..r_hi``: the wet cells within ``start..stop`` (:func:`wet_cells`; all
+    others must be dry) widened by one, clipped to the grid; the rest of ``rate`` is left
+    as it was. Returns the largest wave speed over the faces visited [m/s] and
+    ``r_lo, r_hi`` (``0.0, 1, 0`` if nothing is wet). ``work`` is scratch space of shape
+    (2, fields, cells); ``g`` = g_z [m/s^2], ``r`` = rho1/rho2 (two layers), ``dry`` [m].
+    ``flux`` (layout.FLUX_*), ``order`` (1: first order, 2: MUSCL) and ``limiter``
+    (layout.LIMITER_*) choose the scheme.
     """
-    rate[:, :] = 0.0
-    lo, hi = wet_cells(q, dry, 0, q.shape[1] - 1)
-    return advect_single(q, rate, work, dx, bc_left, bc_right, g, dry, flux, order,
-                         limiter, lo, hi)[0]
+    fluct = fluctuation_kernel(two_layer, flux)
+    face = face_two_layer if two_layer else face_single
+    fields = 4 if two_layer else 2
+    muscl = order == 2
+    # the MUSCL kernels, only where they are called (see compiled.ready)
+    reconstruct = reconstruct_muscl if muscl else None
+    cell_jump = (cell_jump_two_layer if two_layer else cell_jump_single) if muscl else None
+
+    def advect(q, rate, work, dx, bc_left, bc_right, g, r, dry, start, stop):
+        lo, hi = wet_cells(q, dry, start, stop)
+        n = q.shape[1]
+        if lo > hi:
+            return 0.0, 1, 0
+        r_lo = max(lo - 1, 0)
+        r_hi = min(hi + 1, n - 1)
+        rate[:, r_lo:r_hi + 1] = 0.0
+        if muscl:
+            reconstruct(q, work, r_lo, r_hi, bc_left, bc_right, dry, limiter)
+            qm = work[0]
+            qp = work[1]
+        else:
+            qm = q  # first order: both face values are the cell average
+            qp = q
+        inv_dx = 1.0 / dx
+        # at the ends of the grid a ghost cell: a wall mirrors the face value next to
+        # it, an open end copies it
+        s_left = -1.0 if bc_left == L.BC_WALL else 1.0
+        s_right = -1.0 if bc_right == L.BC_WALL else 1.0
+        smax = 0.0
+        for i in range(max(lo, 1), min(hi + 1, n - 1) + 1):
+            # face i - 1/2, between cells i - 1 and i
+            dm, dp, s = fluct(face(qp, i - 1, 1.0), face(qm, i, 1.0), g, r, dry)
+            smax = max(smax, s)
+            for k in range(fields):
+                rate[k, i - 1] -= dm[k] * inv_dx
+                rate[k, i] -= dp[k] * inv_dx
+        if lo == 0:
+            dm, dp, s = fluct(face(qm, 0, s_left), face(qm, 0, 1.0), g, r, dry)
+            smax = max(smax, s)
+            for k in range(fields):
+                rate[k, 0] -= dp[k] * inv_dx
+        if hi == n - 1:
+            dm, dp, s = fluct(face(qp, n - 1, 1.0), face(qp, n - 1, s_right), g, r, dry)
+            smax = max(smax, s)
+            for k in range(fields):
+                rate[k, n - 1] -= dm[k] * inv_dx
+        if muscl:
+            cell_jump(qm, qp, rate, r_lo, r_hi, inv_dx, g, r, dry)
+        return smax, r_lo, r_hi
+
+    return specialise(advect, *ADVECT_SIGNATURE)
 
 
-@njit(cache=True)
-def advect_single(q: np.ndarray, rate: np.ndarray, work: np.ndarray, dx: float,
-                  bc_left: int, bc_right: int, g: float, dry: float, flux: int,
-                  order: int, limiter: int, lo: int, hi: int) -> tuple[float, int, int]:
-    """:func:`rate_single` for the wet cells ``lo..hi`` (from :func:`wet_cells`).
+@functools.cache
+def rate_kernel(two_layer: bool, flux: int, order: int, limiter: int) -> Any:
+    """The advection rate of one scheme on the whole grid (method of lines):
+    ``rate(q, out, work, dx, bc_left, bc_right, g, r, dry) -> smax`` writes every cell
+    of ``out``; arguments as :func:`advection_kernel`."""
+    advect = advection_kernel(two_layer, flux, order, limiter)
 
-    Writes ``rate`` only in the cells it can change, ``lo - 1 .. hi + 1`` (clipped to
-    the grid), and returns (largest wave speed [m/s], first, last of those cells);
-    the rest of ``rate`` is left as it was (the stepper never reads it).
-    """
-    n = q.shape[1]
-    if lo > hi:
-        return 0.0, 1, 0
-    r_lo = max(lo - 1, 0)
-    r_hi = min(hi + 1, n - 1)
-    rate[:, r_lo:r_hi + 1] = 0.0
-    reconstruct(q, work, r_lo, r_hi, bc_left, bc_right, dry, order, limiter)
-    qm = work[0]
-    qp = work[1]
-    inv_dx = 1.0 / dx
-    smax = 0.0
-    for i in range(max(lo, 1), min(hi + 1, n - 1) + 1):
-        dm0, dm1, dp0, dp1, s = fluct_single(flux, qp[0, i - 1], qp[1, i - 1],
-                                             qm[0, i], qm[1, i], g, dry)
-        smax = max(smax, s)
-        rate[0, i - 1] -= dm0 * inv_dx
-        rate[1, i - 1] -= dm1 * inv_dx
-        rate[0, i] -= dp0 * inv_dx
-        rate[1, i] -= dp1 * inv_dx
-    if lo == 0:
-        dm0, dm1, dp0, dp1, s = fluct_single(
-            flux, qm[0, 0], _ghost(qm[1, 0], True, bc_left), qm[0, 0], qm[1, 0], g, dry)
-        smax = max(smax, s)
-        rate[0, 0] -= dp0 * inv_dx
-        rate[1, 0] -= dp1 * inv_dx
-    if hi == n - 1:
-        k = n - 1
-        dm0, dm1, dp0, dp1, s = fluct_single(
-            flux, qp[0, k], qp[1, k], qp[0, k], _ghost(qp[1, k], True, bc_right), g, dry)
-        smax = max(smax, s)
-        rate[0, k] -= dm0 * inv_dx
-        rate[1, k] -= dm1 * inv_dx
-    if order > 1:
-        for i in range(r_lo, r_hi + 1):
-            hl, hr = qm[0, i], qp[0, i]
-            ul = velocity(hl, qm[1, i], dry)
-            ur = velocity(hr, qp[1, i], dry)
-            rate[0, i] -= (ur * hr - ul * hl) * inv_dx
-            rate[1, i] -= (ur * ur * hr + 0.5 * g * hr * hr
-                           - ul * ul * hl - 0.5 * g * hl * hl) * inv_dx
-    return smax, r_lo, r_hi
+    def advection_rate(q, out, work, dx, bc_left, bc_right, g, r, dry):
+        out[:, :] = 0.0
+        return advect(q, out, work, dx, bc_left, bc_right, g, r, dry, 0,
+                      q.shape[1] - 1)[0]
+
+    return specialise(advection_rate, *ADVECT_SIGNATURE[:-2])
 
 
-@njit(cache=True)
-def rate_two_layer(q: np.ndarray, rate: np.ndarray, work: np.ndarray, dx: float,
-                   bc_left: int, bc_right: int, g: float, r: float, dry: float,
-                   flux: int, order: int, limiter: int) -> float:
-    """Advection rate of the two-layer state ``q[(h1, h1u1, h2, h2u2), cell]``.
+@functools.cache
+def _any_scheme_rate(two_layer: bool) -> Any:
+    """:func:`rate_kernel` with the scheme given at run time (every scheme compiled)."""
+    schemes = tuple((3 * flux + recon, rate_kernel(two_layer, flux, order, limiter))
+                    for flux in (L.FLUX_HLL, L.FLUX_RUSANOV, L.FLUX_IFCP)
+                    for recon, (order, limiter) in enumerate(
+                        ((1, L.LIMITER_MINMOD), (2, L.LIMITER_MINMOD), (2, L.LIMITER_MC))))
 
-    ``work`` is scratch space of shape (2, 4, n). Returns the largest wave speed [m/s]
-    over the faces that were visited.
-    """
-    rate[:, :] = 0.0
-    lo, hi = wet_cells(q, dry, 0, q.shape[1] - 1)
-    return advect_two_layer(q, rate, work, dx, bc_left, bc_right, g, r, dry, flux,
-                            order, limiter, lo, hi)[0]
+    def rate(q, out, work, dx, bc_left, bc_right, g, r, dry, flux, order, limiter):
+        j = 3 * flux + (0 if order == 1 else (2 if limiter == L.LIMITER_MC else 1))
+        smax = 0.0
+        for scheme in literal_unroll(schemes):
+            if scheme[0] == j:
+                smax = scheme[1](q, out, work, dx, bc_left, bc_right, g, r, dry)
+        return smax
+
+    any_rate = specialise(rate, *ADVECT_SIGNATURE[:-2], i8, i8, i8)
+    if two_layer:
+        return any_rate
+
+    def rate_single(q, out, work, dx, bc_left, bc_right, g, dry, flux, order, limiter):
+        return any_rate(q, out, work, dx, bc_left, bc_right, g, 0.0, dry, flux, order,
+                        limiter)
+
+    return specialise(rate_single, STATE, FIELDS, WORK, f8, i8, i8, f8, f8, i8, i8, i8)
 
 
-@njit(cache=True)
-def advect_two_layer(q: np.ndarray, rate: np.ndarray, work: np.ndarray, dx: float,
-                     bc_left: int, bc_right: int, g: float, r: float, dry: float,
-                     flux: int, order: int, limiter: int, lo: int,
-                     hi: int) -> tuple[float, int, int]:
-    """:func:`rate_two_layer` for the wet cells ``lo..hi``; as :func:`advect_single`."""
-    n = q.shape[1]
-    if lo > hi:
-        return 0.0, 1, 0
-    r_lo = max(lo - 1, 0)
-    r_hi = min(hi + 1, n - 1)
-    rate[:, r_lo:r_hi + 1] = 0.0
-    reconstruct(q, work, r_lo, r_hi, bc_left, bc_right, dry, order, limiter)
-    qm = work[0]
-    qp = work[1]
-    inv_dx = 1.0 / dx
-    smax = 0.0
-    for i in range(max(lo, 1), min(hi + 1, n - 1) + 1):
-        j = i - 1
-        dm0, dm1, dm2, dm3, dp0, dp1, dp2, dp3, s = fluct_two_layer(
-            flux, qp[0, j], qp[1, j], qp[2, j], qp[3, j], qm[0, i], qm[1, i], qm[2, i],
-            qm[3, i], g, r, dry)
-        smax = max(smax, s)
-        rate[0, j] -= dm0 * inv_dx
-        rate[1, j] -= dm1 * inv_dx
-        rate[2, j] -= dm2 * inv_dx
-        rate[3, j] -= dm3 * inv_dx
-        rate[0, i] -= dp0 * inv_dx
-        rate[1, i] -= dp1 * inv_dx
-        rate[2, i] -= dp2 * inv_dx
-        rate[3, i] -= dp3 * inv_dx
-    if lo == 0:
-        dm0, dm1, dm2, dm3, dp0, dp1, dp2, dp3, s = fluct_two_layer(
-            flux, qm[0, 0], _ghost(qm[1, 0], True, bc_left), qm[2, 0],
-            _ghost(qm[3, 0], True, bc_left), qm[0, 0], qm[1, 0], qm[2, 0], qm[3, 0],
-            g, r, dry)
-        smax = max(smax, s)
-        rate[0, 0] -= dp0 * inv_dx
-        rate[1, 0] -= dp1 * inv_dx
-        rate[2, 0] -= dp2 * inv_dx
-        rate[3, 0] -= dp3 * inv_dx
-    if hi == n - 1:
-        k = n - 1
-        dm0, dm1, dm2, dm3, dp0, dp1, dp2, dp3, s = fluct_two_layer(
-            flux, qp[0, k], qp[1, k], qp[2, k], qp[3, k], qp[0, k],
-            _ghost(qp[1, k], True, bc_right), qp[2, k], _ghost(qp[3, k], True, bc_right),
-            g, r, dry)
-        smax = max(smax, s)
-        rate[0, k] -= dm0 * inv_dx
-        rate[1, k] -= dm1 * inv_dx
-        rate[2, k] -= dm2 * inv_dx
-        rate[3, k] -= dm3 * inv_dx
-    if order > 1:
-        # path-conservative jump across the linear reconstruction inside each cell
-        for i in range(r_lo, r_hi + 1):
-            h1l, h1r = qm[0, i], qp[0, i]
-            h2l, h2r = qm[2, i], qp[2, i]
-            u1l = velocity(h1l, qm[1, i], dry)
-            u1r = velocity(h1r, qp[1, i], dry)
-            u2l = velocity(h2l, qm[3, i], dry)
-            u2r = velocity(h2r, qp[3, i], dry)
-            dh1 = h1r - h1l
-            dh2 = h2r - h2l
-            rate[0, i] -= (u1r * h1r - u1l * h1l) * inv_dx
-            rate[1, i] -= ((u1r * u1r * h1r - u1l * u1l * h1l)
-                           + g * 0.5 * (h1l + h1r) * (dh1 + dh2)) * inv_dx
-            rate[2, i] -= (u2r * h2r - u2l * h2l) * inv_dx
-            rate[3, i] -= ((u2r * u2r * h2r - u2l * u2l * h2l)
-                           + g * 0.5 * (h2l + h2r) * (dh2 + r * dh1)) * inv_dx
-    return smax, r_lo, r_hi
+def __getattr__(name: str) -> Any:
+    """``rate_two_layer(q, out, work, dx, bc_left, bc_right, g, r, dry, flux, order,
+    limiter)`` and ``rate_single(..., g, dry, flux, order, limiter)``: the advection
+    rate with the scheme chosen at run time, for callers that cannot choose it in
+    Python (analysis.stability's ``mol_run``); built on first use, they compile every
+    scheme."""
+    if name in ("rate_single", "rate_two_layer"):
+        return _any_scheme_rate(name == "rate_two_layer")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

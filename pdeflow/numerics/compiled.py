@@ -1,29 +1,208 @@
-"""Whether the ``fv-split`` stepping kernel is compiled, or cached on disk.
+"""Compiled kernels: one signature each, specialised to the scheme a run uses, cached.
 
-A query on :func:`pdeflow.numerics.splitting.advance_split` that the solver (which loads
-the kernels before a run) and the progress bar (which says that they compile) both ask,
-kept here, below both.
+A run compiles only what its scheme calls. The kernels that depend on the scheme (the
+stepping loop, the advection stage, the face fluctuations) are built by factories such
+as :func:`pdeflow.numerics.advection.advection_kernel` as closures over the scheme's
+choices, held as Python booleans and integers: numba drops the branches of every other
+flux, reconstruction, limiter, splitting and model before it types anything, so their
+kernels are never compiled. The stepping loop takes the model's kernels as arguments
+(:func:`pdeflow.numerics.splitting.stepping_kernel`), so that one loop serves both
+models. Parameters and grids stay arguments: a sweep over them never recompiles.
+
+What the factories and the kernels share is kept here:
+
+* :func:`kernel` (module-level kernels) and :func:`specialise` (closures) record the one
+  signature of a kernel: the state is any 2D float64 array (py-pde's data is a view),
+  scratch arrays are C-contiguous, the parameter vector is read-only, scalars are
+  float64, codes int64 and flags bool. :func:`ready` compiles that signature (or loads it
+  from numba's disk cache) and then stops the kernel from compiling others: a call with
+  compatible types (a C-contiguous state, a writable parameter vector, a literal int) is
+  converted instead of compiling a second signature.
+* :func:`specialise` caches a closure on disk under a key made of the constants it
+  closes over and the code of the kernels it calls (numba's own key pickles a closed-over
+  kernel, which gives a new key in every process, so such a closure would never be
+  loaded from the cache).
+* :func:`kernels`, :func:`kernels_ready`, :func:`kernels_cached`: what is compiled.
 """
 
 from __future__ import annotations
 
-from .splitting import advance_split
+import hashlib
+import sys
+from collections.abc import Callable, Iterator
+from types import CodeType
+from typing import Any
+
+from numba import njit, types
+from numba.core import config
+from numba.core.caching import FunctionCache
+from numba.core.dispatcher import Dispatcher
+
+f8 = types.float64
+i8 = types.int64
+flag = types.boolean
+STATE = types.Array(f8, 2, "A")
+"""the state q[field, cell]: any layout (py-pde's state data is a view)"""
+FIELDS = types.Array(f8, 2, "C")
+"""scratch arrays of the state's shape (rates, backups)"""
+WORK = types.Array(f8, 3, "C")
+"""scratch array of shape (stages, fields, cells)"""
+VECTOR = types.Array(f8, 1, "C")
+"""the diagnostics vector (see :mod:`pdeflow.numerics.layout`)"""
+PARAMS = types.Array(f8, 1, "C", readonly=True)
+"""the parameter vector (see :mod:`pdeflow.numerics.layout`)"""
+
+_SIGNATURES: dict[Any, tuple] = {}
+_SPECIALISED: list[Any] = []
+_ENTRIES: list[Any] = []
+
+
+def kernel(*arg_types: Any) -> Callable:
+    """Decorator: a module-level numba kernel (disk-cached) with the one signature
+    ``arg_types``, compiled lazily (by :func:`ready`, or by the first caller)."""
+
+    def wrap(func: Callable) -> Any:
+        compiled = njit(cache=True)(func)
+        if isinstance(compiled, Dispatcher):  # not with NUMBA_DISABLE_JIT=1
+            _SIGNATURES[compiled] = tuple(arg_types)
+        return compiled
+
+    return wrap
+
+
+def specialise(func: Callable, *arg_types: Any) -> Any:
+    """A numba kernel of the closure ``func`` with the one signature ``arg_types``,
+    disk-cached under its constants (see the module docstring); compiled by
+    :func:`ready`."""
+    if config.DISABLE_JIT:
+        return func
+    compiled = njit(func)
+    compiled._cache = _ConstantsKeyedCache(func)
+    _SIGNATURES[compiled] = tuple(arg_types)
+    _SPECIALISED.append(compiled)
+    return compiled
+
+
+def entry(*kernels: Any) -> None:
+    """Register kernels that a solver is about to call (e.g. the stepping loop of a
+    scheme and the model's kernels it is given): :func:`kernels_ready` waits for them."""
+    for compiled in kernels:
+        if isinstance(compiled, Dispatcher) and compiled not in _ENTRIES:
+            _ENTRIES.append(compiled)
+
+
+def ready(compiled: Any) -> Any:
+    """Compile (or load) the signature of ``compiled`` and of the kernels it calls,
+    callees first, then allow no other signature; returns ``compiled``."""
+    if not isinstance(compiled, Dispatcher) or not compiled._can_compile:
+        return compiled
+    for dep in _callees(compiled):
+        ready(dep)
+    sig = _SIGNATURES.get(compiled)
+    if sig is not None:
+        if sig not in compiled.signatures:
+            compiled.compile(sig)
+        compiled.disable_compile()
+    return compiled
+
+
+def _callees(compiled: Any) -> Iterator[Any]:
+    """The kernels that ``compiled`` closes over, and the module-level kernels with a
+    declared signature that it names. (A factory closes over what its scheme calls
+    only, None for the rest, so that nothing here is compiled for nothing.)"""
+    func = compiled.py_func
+    for cell in func.__closure__ or ():
+        if isinstance(cell.cell_contents, Dispatcher):
+            yield cell.cell_contents
+    for name in func.__code__.co_names:
+        value = func.__globals__.get(name)
+        if isinstance(value, Dispatcher) and value in _SIGNATURES:
+            yield value
+
+
+def kernels() -> list[Any]:
+    """Every numba kernel of :mod:`pdeflow.numerics` in this process: the module-level
+    ones of the imported modules and the specialised ones built so far."""
+    found: dict[int, Any] = {}
+    for name, module in list(sys.modules.items()):
+        if name.startswith(__package__ + ".") and module is not None:
+            for value in vars(module).values():
+                if isinstance(value, Dispatcher) and value.py_func.__module__ == name:
+                    found[id(value)] = value
+    for compiled in _SPECIALISED:
+        found[id(compiled)] = compiled
+    return list(found.values())
+
+
+def _pending() -> list[Any]:
+    """Entry kernels built but not compiled yet, and what they call."""
+    todo = [k for k in _ENTRIES if _SIGNATURES.get(k) not in k.signatures]
+    seen: dict[int, Any] = {}
+    while todo:
+        k = todo.pop()
+        if id(k) not in seen and k in _SIGNATURES and _SIGNATURES[k] not in k.signatures:
+            seen[id(k)] = k
+            todo.extend(_callees(k))
+    return list(seen.values())
 
 
 def kernels_ready() -> bool:
-    """True if the ``fv-split`` stepping kernel is compiled (or loaded) in this process
-    (always with NUMBA_DISABLE_JIT=1: nothing to compile)."""
-    signatures = getattr(advance_split, "signatures", None)
-    return True if signatures is None else bool(signatures)
+    """True if every entry kernel built in this process (e.g. the stepping loop of a
+    solver's ``make_stepper``) is compiled or loaded (always with NUMBA_DISABLE_JIT=1)."""
+    return config.DISABLE_JIT or not _pending()
 
 
 def kernels_cached() -> bool:
-    """True if numba's disk cache holds the stepping kernel for this machine's CPU, so
-    that loading it takes a fraction of a second instead of compiling it (about 26 s
-    here: see docs/user_guide.md). Reads numba's cache index; False if it cannot."""
+    """True if numba's disk cache holds every kernel that :func:`kernels_ready` waits
+    for, for this machine's CPU, so that loading them takes a fraction of a second
+    instead of compiling them. Reads numba's cache index; False if it cannot."""
     try:
-        index = advance_split._cache._cache_file._load_index()  # {} if source changed
-        magic = advance_split.targetctx.codegen().magic_tuple()
+        for k in _pending():
+            key = k._cache._index_key(_SIGNATURES[k], k.targetctx.codegen())
+            if key not in k._cache._cache_file._load_index():  # {} if source changed
+                return False
     except Exception:  # pragma: no cover - numba internals moved: assume the worst
         return False
-    return any(key[1] == magic for key in index)
+    return True
+
+
+def _code_digest(code: CodeType) -> str:
+    """Digest of a function's bytecode and constants (nested code objects included)."""
+    h = hashlib.sha256(code.co_code)
+    for const in code.co_consts:
+        h.update(_code_digest(const).encode() if isinstance(const, CodeType)
+                 else repr(const).encode())
+    return h.hexdigest()
+
+
+def _describe_function(func: Callable, depth: int = 0) -> tuple:
+    """Code digest, closed-over values and called kernels of a kernel's function."""
+    callees = tuple((name, _describe(value, depth + 1)) for name in func.__code__.co_names
+                    if isinstance(value := func.__globals__.get(name), Dispatcher))
+    cells = tuple(_describe(c.cell_contents, depth + 1) for c in func.__closure__ or ())
+    return (func.__module__, func.__qualname__, _code_digest(func.__code__), cells,
+            callees)
+
+
+def _describe(value: Any, depth: int = 0) -> Any:
+    """A description of a closed-over value that is the same in every process."""
+    if isinstance(value, Dispatcher):
+        func = value.py_func
+        return (_describe_function(func, depth) if depth < 8
+                else (func.__module__, func.__qualname__))
+    if isinstance(value, (bool, int, float, str, type(None))):
+        return (type(value).__name__, repr(value))
+    if isinstance(value, tuple):
+        return tuple(_describe(v, depth + 1) for v in value)
+    raise TypeError(f"a specialised kernel cannot close over {value!r}")
+
+
+class _ConstantsKeyedCache(FunctionCache):
+    """numba's disk cache for a closure, keyed by what it closes over (see the module
+    docstring) and by the code of every kernel it calls: a changed callee is recompiled,
+    which numba's own cache does not notice."""
+
+    def _index_key(self, sig: Any, codegen: Any) -> tuple:
+        own = repr(_describe_function(self._py_func)).encode()
+        return (sig, codegen.magic_tuple(), (_code_digest(self._py_func.__code__),
+                                             hashlib.sha256(own).hexdigest()))

@@ -23,14 +23,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from . import layout as L
+from .compiled import FIELDS, PARAMS, STATE, kernel
 from .sources import closure_rate, relaxed_rate
 from .state import velocity
 
 
-@njit(cache=True)
+@kernel(STATE, FIELDS, PARAMS)
 def source_rate_two_layer(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> None:
     """Add the regularised source rate of (26)-(27) to ``rate`` (two layers)."""
     r = P[L.R]
@@ -68,15 +68,12 @@ def source_rate_two_layer(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> Non
             rate[3, i] -= u1 * m
 
 
-@njit(cache=True)
+@kernel(STATE, FIELDS, PARAMS)
 def source_rate_single(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> None:
     """Add gravity along the bed and regularised Coulomb friction (single layer)."""
-    g = P[L.S_G_Z]
-    gx = P[L.S_G_X]
-    dry = P[L.S_DRY]
-    eps = P[L.S_MOL_EPS]
     for i in range(q.shape[1]):
         h = max(q[0, i], 0.0)
-        if h > dry:
+        if h > P[L.S_DRY]:
             u = q[1, i] / h
-            rate[1, i] += gx * h - g * h * P[L.S_TAN_B] * u / max(abs(u), eps)
+            rate[1, i] += P[L.S_G_X] * h - P[L.S_G_Z] * h * P[L.S_TAN_B] * u / max(
+                abs(u), P[L.S_MOL_EPS])

@@ -14,15 +14,22 @@ Roe-averaged state (needed by IFCP only). D^- + D^+ = A Delta q for every flux.
 Layers at rest on both sides of a face (zero momentum) get no mass fluctuation and their
 hydrostatic jump split by each side's own depth, whatever the flux (this is what keeps a
 Coulomb heap below its friction angle exactly at rest).
+
+:func:`fluctuation_kernel` builds the fluctuations of one model and one flux (the others
+are not compiled); a face's states come as tuples ``(h, hu)`` or ``(h1, h1u1, h2, h2u2)``,
+see :func:`face_single` and :func:`face_two_layer`.
 """
 
 from __future__ import annotations
 
+import functools
 import math
+from typing import Any
 
 from numba import njit
 
 from . import layout as L
+from .compiled import f8, specialise, types
 from .hll import hll_coefficients
 from .ifcp import ifcp_coefficients, internal_speed, roe_coefficients
 from .rusanov import rusanov_coefficients
@@ -33,7 +40,7 @@ IFCP_MIN_FRACTION = 0.05
 depth; elsewhere (near a layer's front or where a layer thins out) the HLL line."""
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _roe_velocity(hL: float, uL: float, hR: float, uR: float) -> float:
     sl = math.sqrt(max(hL, 0.0))
     sr = math.sqrt(max(hR, 0.0))
@@ -42,113 +49,145 @@ def _roe_velocity(hL: float, uL: float, hR: float, uR: float) -> float:
     return (sl * uL + sr * uR) / (sl + sr)
 
 
-@njit(cache=True)
-def fluct_single(flux: int, hL: float, mL: float, hR: float, mR: float, g: float,
-                 dry: float):
-    """Fluctuations ``(dm_h, dm_m, dp_h, dp_m, smax)`` of the single-layer system."""
-    uL = velocity(hL, mL, dry)
-    uR = velocity(hR, mR, dry)
-    cL = math.sqrt(g * max(hL, 0.0))
-    cR = math.sqrt(g * max(hR, 0.0))
-    sL = min(uL - cL, uR - cR)
-    sR = max(uL + cL, uR + cR)
-    smax = max(abs(sL), abs(sR))
-    if mL == 0.0 and mR == 0.0:
-        dH = hR - hL
-        return 0.0, 0.5 * g * hL * dH, 0.0, 0.5 * g * hR * dH, smax
-    a0 = uR * hR - uL * hL
-    a1 = uR * uR * hR + 0.5 * g * hR * hR - (uL * uL * hL + 0.5 * g * hL * hL)
-    if flux == L.FLUX_RUSANOV:
-        c0, c1, c2 = rusanov_coefficients(sL, sR)
-    elif flux == L.FLUX_IFCP and hL > dry and hR > dry:
-        u = _roe_velocity(hL, uL, hR, uR)
-        c = math.sqrt(0.5 * g * (hL + hR))
-        c0, c1, c2 = roe_coefficients(u - c, u + c, 0.1 * c)
-    else:
-        c0, c1, c2 = hll_coefficients(sL, sR)
-    q0 = c0 * (hR - hL) + c1 * a0
-    q1 = c0 * (mR - mL) + c1 * a1
-    dm0 = 0.5 * (a0 - q0)
-    dm1 = 0.5 * (a1 - q1)
-    return dm0, dm1, a0 - dm0, a1 - dm1, smax
+@njit(cache=True, inline="always")
+def face_single(q, i, sign):
+    """State ``(h, hu)`` of cell (or face value) ``i`` of ``q``, the momentum times
+    ``sign`` (-1: the mirror image of a wall's ghost cell)."""
+    return q[0, i], sign * q[1, i]
 
 
-@njit(cache=True)
-def fluct_two_layer(flux: int, h1L, m1L, h2L, m2L, h1R, m1R, h2R, m2R, g, r, dry):
-    """Path-conservative fluctuations of the two-layer system (24), stage (29).
+@njit(cache=True, inline="always")
+def face_two_layer(q, i, sign):
+    """State ``(h1, h1u1, h2, h2u2)`` of cell ``i`` of ``q``, momenta times ``sign``."""
+    return q[0, i], sign * q[1, i], q[2, i], sign * q[3, i]
 
-    Returns ``(dm0, dm1, dm2, dm3, dp0, dp1, dp2, dp3, smax)`` for
-    q = (h1, h1u1, h2, h2u2); ``g`` = g_z [m/s^2], ``r`` = rho1/rho2.
-    """
-    u1L = velocity(h1L, m1L, dry)
-    u2L = velocity(h2L, m2L, dry)
-    u1R = velocity(h1R, m1R, dry)
-    u2R = velocity(h2R, m2R, dry)
-    HL = max(h1L, 0.0) + max(h2L, 0.0)
-    HR = max(h1R, 0.0) + max(h2R, 0.0)
-    cL = math.sqrt(g * HL)
-    cR = math.sqrt(g * HR)
-    loL = min(u1L if h1L > dry else u2L, u2L if h2L > dry else u1L)
-    hiL = max(u1L if h1L > dry else u2L, u2L if h2L > dry else u1L)
-    loR = min(u1R if h1R > dry else u2R, u2R if h2R > dry else u1R)
-    hiR = max(u1R if h1R > dry else u2R, u2R if h2R > dry else u1R)
-    sL = min(loL - cL, loR - cR)
-    sR = max(hiL + cL, hiR + cR)
-    smax = max(abs(sL), abs(sR))
 
-    dh1 = h1R - h1L
-    dh2 = h2R - h2L
-    a0 = u1R * h1R - u1L * h1L
-    a1 = (u1R * u1R * h1R - u1L * u1L * h1L) + g * 0.5 * (h1L + h1R) * (dh1 + dh2)
-    a2 = u2R * h2R - u2L * h2L
-    a3 = (u2R * u2R * h2R - u2L * u2L * h2L) + g * 0.5 * (h2L + h2R) * (dh2 + r * dh1)
+@functools.cache
+def fluctuation_kernel(two_layer: bool, flux: int) -> Any:
+    """``fluct(left, right, g, r, dry) -> (D^-, D^+, smax)`` of one model and one flux
+    (layout.FLUX_*): the fluctuations as tuples of the face states' length and the
+    largest wave speed [m/s]; ``g`` = g_z [m/s^2], ``r`` = rho1/rho2 (two layers)."""
+    rusanov = flux == L.FLUX_RUSANOV
+    ifcp = flux == L.FLUX_IFCP
+    if two_layer:
+        return specialise(_two_layer(rusanov, ifcp), types.UniTuple(f8, 4),
+                          types.UniTuple(f8, 4), f8, f8, f8)
+    return specialise(_single(rusanov, ifcp), types.UniTuple(f8, 2),
+                      types.UniTuple(f8, 2), f8, f8, f8)
 
-    if flux == L.FLUX_RUSANOV:
-        c0, c1, c2 = rusanov_coefficients(sL, sR)
-    elif flux == L.FLUX_IFCP:
-        h1 = 0.5 * (h1L + h1R)
-        h2 = 0.5 * (h2L + h2R)
-        u1 = _roe_velocity(h1L, u1L, h1R, u1R)
-        u2 = _roe_velocity(h2L, u2L, h2R, u2R)
-        # the parabola is not positivity preserving near a layer's front: there, HLL
-        if min(h1L, h1R, h2L, h2R) > IFCP_MIN_FRACTION * max(HL, HR):
-            c0, c1, c2 = ifcp_coefficients(sL, sR, internal_speed(h1, u1, h2, u2, g, r))
+
+def _single(rusanov: bool, ifcp: bool):
+    def fluct_single(left, right, g, r, dry):
+        """Fluctuations of the single-layer system."""
+        hL, mL = left
+        hR, mR = right
+        uL = velocity(hL, mL, dry)
+        uR = velocity(hR, mR, dry)
+        cL = math.sqrt(g * max(hL, 0.0))
+        cR = math.sqrt(g * max(hR, 0.0))
+        sL = min(uL - cL, uR - cR)
+        sR = max(uL + cL, uR + cR)
+        smax = max(abs(sL), abs(sR))
+        if mL == 0.0 and mR == 0.0:
+            dH = hR - hL
+            return (0.0, 0.5 * g * hL * dH), (0.0, 0.5 * g * hR * dH), smax
+        a0 = uR * hR - uL * hL
+        a1 = uR * uR * hR + 0.5 * g * hR * hR - (uL * uL * hL + 0.5 * g * hL * hL)
+        if rusanov:
+            c0, c1, c2 = rusanov_coefficients(sL, sR)
+        elif ifcp and hL > dry and hR > dry:
+            u = _roe_velocity(hL, uL, hR, uR)
+            c = math.sqrt(0.5 * g * (hL + hR))
+            c0, c1, c2 = roe_coefficients(u - c, u + c, 0.1 * c)
         else:
             c0, c1, c2 = hll_coefficients(sL, sR)
-    else:
-        c0, c1, c2 = hll_coefficients(sL, sR)
-    q0 = c0 * dh1 + c1 * a0
-    q1 = c0 * (m1R - m1L) + c1 * a1
-    q2 = c0 * dh2 + c1 * a2
-    q3 = c0 * (m2R - m2L) + c1 * a3
-    if c2 != 0.0:
-        # alpha2 A (A dq), A = pseudo-Jacobian of (28) at the averaged state
-        b0 = a1
-        b1 = (g * h1 - u1 * u1) * a0 + 2.0 * u1 * a1 + g * h1 * a2
-        b2 = a3
-        b3 = r * g * h2 * a0 + (g * h2 - u2 * u2) * a2 + 2.0 * u2 * a3
-        q0 += c2 * b0
-        q1 += c2 * b1
-        q2 += c2 * b2
-        q3 += c2 * b3
-    dm0 = 0.5 * (a0 - q0)
-    dm1 = 0.5 * (a1 - q1)
-    dm2 = 0.5 * (a2 - q2)
-    dm3 = 0.5 * (a3 - q3)
-    dp0 = a0 - dm0
-    dp1 = a1 - dm1
-    dp2 = a2 - dm2
-    dp3 = a3 - dm3
-    if m1L == 0.0 and m1R == 0.0:
-        dH = dh1 + dh2
-        dm0 = 0.0
-        dp0 = 0.0
-        dm1 = 0.5 * g * h1L * dH
-        dp1 = 0.5 * g * h1R * dH
-    if m2L == 0.0 and m2R == 0.0:
-        dE = dh2 + r * dh1
-        dm2 = 0.0
-        dp2 = 0.0
-        dm3 = 0.5 * g * h2L * dE
-        dp3 = 0.5 * g * h2R * dE
-    return dm0, dm1, dm2, dm3, dp0, dp1, dp2, dp3, smax
+        q0 = c0 * (hR - hL) + c1 * a0
+        q1 = c0 * (mR - mL) + c1 * a1
+        dm0 = 0.5 * (a0 - q0)
+        dm1 = 0.5 * (a1 - q1)
+        return (dm0, dm1), (a0 - dm0, a1 - dm1), smax
+
+    return fluct_single
+
+
+def _two_layer(rusanov: bool, ifcp: bool):
+    def fluct_two_layer(left, right, g, r, dry):
+        """Path-conservative fluctuations of the two-layer system (24), stage (29)."""
+        h1L, m1L, h2L, m2L = left
+        h1R, m1R, h2R, m2R = right
+        u1L = velocity(h1L, m1L, dry)
+        u2L = velocity(h2L, m2L, dry)
+        u1R = velocity(h1R, m1R, dry)
+        u2R = velocity(h2R, m2R, dry)
+        HL = max(h1L, 0.0) + max(h2L, 0.0)
+        HR = max(h1R, 0.0) + max(h2R, 0.0)
+        cL = math.sqrt(g * HL)
+        cR = math.sqrt(g * HR)
+        loL = min(u1L if h1L > dry else u2L, u2L if h2L > dry else u1L)
+        hiL = max(u1L if h1L > dry else u2L, u2L if h2L > dry else u1L)
+        loR = min(u1R if h1R > dry else u2R, u2R if h2R > dry else u1R)
+        hiR = max(u1R if h1R > dry else u2R, u2R if h2R > dry else u1R)
+        sL = min(loL - cL, loR - cR)
+        sR = max(hiL + cL, hiR + cR)
+        smax = max(abs(sL), abs(sR))
+
+        dh1 = h1R - h1L
+        dh2 = h2R - h2L
+        a0 = u1R * h1R - u1L * h1L
+        a1 = (u1R * u1R * h1R - u1L * u1L * h1L) + g * 0.5 * (h1L + h1R) * (dh1 + dh2)
+        a2 = u2R * h2R - u2L * h2L
+        a3 = (u2R * u2R * h2R - u2L * u2L * h2L) + g * 0.5 * (h2L + h2R) * (dh2 + r * dh1)
+
+        h1 = h2 = u1 = u2 = 0.0
+        if rusanov:
+            c0, c1, c2 = rusanov_coefficients(sL, sR)
+        elif ifcp:
+            h1 = 0.5 * (h1L + h1R)
+            h2 = 0.5 * (h2L + h2R)
+            u1 = _roe_velocity(h1L, u1L, h1R, u1R)
+            u2 = _roe_velocity(h2L, u2L, h2R, u2R)
+            # the parabola is not positivity preserving near a layer's front: there, HLL
+            if min(h1L, h1R, h2L, h2R) > IFCP_MIN_FRACTION * max(HL, HR):
+                c0, c1, c2 = ifcp_coefficients(sL, sR, internal_speed(h1, u1, h2, u2, g,
+                                                                      r))
+            else:
+                c0, c1, c2 = hll_coefficients(sL, sR)
+        else:
+            c0, c1, c2 = hll_coefficients(sL, sR)
+        q0 = c0 * dh1 + c1 * a0
+        q1 = c0 * (m1R - m1L) + c1 * a1
+        q2 = c0 * dh2 + c1 * a2
+        q3 = c0 * (m2R - m2L) + c1 * a3
+        if ifcp and c2 != 0.0:
+            # alpha2 A (A dq), A = pseudo-Jacobian of (28) at the averaged state
+            b0 = a1
+            b1 = (g * h1 - u1 * u1) * a0 + 2.0 * u1 * a1 + g * h1 * a2
+            b2 = a3
+            b3 = r * g * h2 * a0 + (g * h2 - u2 * u2) * a2 + 2.0 * u2 * a3
+            q0 += c2 * b0
+            q1 += c2 * b1
+            q2 += c2 * b2
+            q3 += c2 * b3
+        dm0 = 0.5 * (a0 - q0)
+        dm1 = 0.5 * (a1 - q1)
+        dm2 = 0.5 * (a2 - q2)
+        dm3 = 0.5 * (a3 - q3)
+        dp0 = a0 - dm0
+        dp1 = a1 - dm1
+        dp2 = a2 - dm2
+        dp3 = a3 - dm3
+        if m1L == 0.0 and m1R == 0.0:
+            dH = dh1 + dh2
+            dm0 = 0.0
+            dp0 = 0.0
+            dm1 = 0.5 * g * h1L * dH
+            dp1 = 0.5 * g * h1R * dH
+        if m2L == 0.0 and m2R == 0.0:
+            dE = dh2 + r * dh1
+            dm2 = 0.0
+            dp2 = 0.0
+            dm3 = 0.5 * g * h2L * dE
+            dp3 = 0.5 * g * h2R * dE
+        return (dm0, dm1, dm2, dm3), (dp0, dp1, dp2, dp3), smax
+
+    return fluct_two_layer

@@ -80,7 +80,7 @@ import math
 from numba import njit
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _sign(x: float) -> float:
     if x > 0.0:
         return 1.0

@@ -18,7 +18,7 @@ DRY_TOLERANCE = 1e-6
 velocity (the parameter ``dry_tolerance`` of both models)."""
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def velocity(h: float, m: float, dry: float) -> float:
     """Depth-averaged velocity m/h [m/s]; zero where the layer is thinner than ``dry``."""
     if h > dry:

@@ -10,15 +10,16 @@ message names the time, the step, the cell and the state there, and the variant,
 the last good state is kept (see :func:`diagnose_blowup`).
 
 With the numba backend the whole stepping loop between two tracker interrupts runs in
-one compiled, disk-cached kernel (:func:`pdeflow.numerics.splitting.advance_split`),
-which calls the same source-stage kernel that the hook wraps.
+one compiled, disk-cached kernel (:func:`pdeflow.numerics.splitting.scheme_stepper`: the loop
+and the kernels of the model's scheme only), which calls the same source-stage kernel
+that the hook wraps.
 """
 
 from __future__ import annotations
 
 import logging
 import time
-import types
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -27,9 +28,8 @@ from pde.trackers.base import FinishedSimulation
 
 from ..models.base import GranularPDE, check_range
 from ..numerics import layout as L
-from ..numerics import splitting as _splitting
 from ..numerics.compiled import kernels_cached, kernels_ready
-from ..numerics.splitting import STATUS_FAIL, STATUS_REST, advance_split
+from ..numerics.splitting import STATUS_FAIL, STATUS_REST, python_stepping, scheme_stepper
 
 
 class _RestProfilerFilter(logging.Filter):
@@ -50,30 +50,36 @@ class _RestProfilerFilter(logging.Filter):
 logging.getLogger("pde.solvers.controller").addFilter(_RestProfilerFilter())
 
 
-def load_kernels(log: Any = None) -> float:
-    """Compile the ``fv-split`` kernels (or load them from numba's disk cache) now, with
-    a run on four cells, so that this time is not booked on a real run's wall time or
-    progress bar. Returns the seconds it took (0 if they were already loaded).
+def scheme_codes(pde: GranularPDE, splitting: str = "lie") -> tuple[bool, int, int, int,
+                                                                     bool]:
+    """(two_layer, flux, order, limiter, strang): the scheme of ``pde`` with
+    ``splitting``, as :func:`pdeflow.numerics.splitting.scheme_stepper` takes it."""
+    return (bool(pde.two_layer), *pde.scheme_codes, splitting == "strang")
+
+
+def load_kernels(log: Any = None, pdes: Sequence[GranularPDE] = (),
+                 splitting: str = "lie") -> float:
+    """Compile the ``fv-split`` kernels of the models ``pdes`` (their schemes, with
+    ``splitting``) or load them from numba's disk cache, now, so that this time is not
+    booked on a real run's wall time or progress bar. Only what these schemes call is
+    compiled. Returns the seconds it took (0 if they were already loaded).
 
     Args:
         log: a stream (e.g. ``sys.stderr``) that is told when the kernels have to be
-            compiled (once per machine) and how long it took; None: silent.
+            compiled (once per machine and scheme) and how long it took; None: silent.
+        pdes: the models of the runs to come.
+        splitting: 'lie' or 'strang'.
     """
+    steppers = [scheme_stepper(*scheme_codes(pde, splitting)) for pde in pdes]
     if kernels_ready():
         return 0.0
-    from pde import CartesianGrid
-
-    from ..models import SingleLayerGranular
-
     compiling = not kernels_cached()
     if compiling and log is not None:
         print("pdeflow: compiling numba kernels (once per machine) ...", end="",
               file=log, flush=True)
     t0 = time.perf_counter()
-    eq = SingleLayerGranular()
-    state = eq.make_state(CartesianGrid([[0, 1]], 4), h=np.array([1.0, 1.0, 0.0, 0.0]),
-                          u=np.zeros(4))
-    eq.solve(state, t_range=1e-3, solver="fv-split", tracker=None)
+    for scheme in steppers:
+        scheme.ready()
     seconds = time.perf_counter() - t0
     if compiling and log is not None:
         print(f" done in {seconds:.1f} s", file=log, flush=True)
@@ -238,7 +244,12 @@ class FVSplitSolver(SolverBase):
         pde: GranularPDE = self.pde
         dx = pde.check_state(state)
         self._select_backend(state)
-        hook, diag = pde.make_post_step_hook(state, backend=self.backend)
+        if self.backend_name == "numba":
+            # the compiled loop calls the source stage itself: no hook to compile (the
+            # state was checked above, as the hook would)
+            hook, diag = None, pde.new_diagnostics(state.grid.shape[0])
+        else:
+            hook, diag = pde.make_post_step_hook(state, backend=self.backend)
         self.diagnostics = diag
         self.info.update(dt=None, steps=0, dt_adaptive=True, stochastic=False,
                          cfl=self.cfl, post_step_data=diag, variant=pde.variant,
@@ -248,9 +259,7 @@ class FVSplitSolver(SolverBase):
         rate = np.empty_like(state.data)
         backup = np.empty_like(state.data)
         work = np.empty((3, *state.data.shape))
-        flux, order, limiter = pde.scheme_codes
-        strang = self.splitting == "strang"
-        two = pde.two_layer
+        scheme = scheme_codes(pde, self.splitting)
         cfl = self.cfl
         stop = self.stop_at_rest
 
@@ -258,30 +267,25 @@ class FVSplitSolver(SolverBase):
                        rate_: np.ndarray, backup_: np.ndarray, work_: np.ndarray,
                        max_steps: int):
             return kernel(q, t0, t1, dx, bcl, bcr, P, cfl, diag_, rate_, backup_, work_,
-                          max_steps, two, stop, flux, order, limiter, strang)
+                          max_steps, stop)
 
         if self.backend_name == "numba":
+            kernel = scheme_stepper(*scheme)  # compiled (or loaded) at its first call
 
             def advance(q: np.ndarray, t0: float, t1: float):
-                return run_kernel(advance_split, q, t0, t1, diag, rate, backup, work,
+                return run_kernel(kernel, q, t0, t1, diag, rate, backup, work,
                                   self.max_steps)
         else:
             advance = self._numpy_loop(state, dx, P, hook, diag)
 
         def replay(q: np.ndarray, t0: float, t1: float, update: Any) -> None:
             # one step of the kernel's own Python code with an instrumented state update
-            scope = {**vars(_splitting), "_update": update}
-            for name in ("_advect_step", "advance_split"):
-                py = getattr(_splitting, name).py_func
-                scope[name] = types.FunctionType(py.__code__, scope, py.__name__,
-                                                 py.__defaults__, py.__closure__)
-            kernel = scope["advance_split"]
-            run_kernel(kernel, q, t0, t1, diag.copy(), np.empty_like(q), np.empty_like(q),
-                       np.empty_like(work), 1)
+            run_kernel(python_stepping(*scheme, update), q, t0, t1, diag.copy(),
+                       np.empty_like(q), np.empty_like(q), np.empty_like(work), 1)
 
         def stepper(state: Any, t_start: float, t_end: float) -> float:
             entry = state.data.copy()
-            t, steps, status = advance(state.data, float(t_start), float(t_end))  # one signature
+            t, steps, status = advance(state.data, float(t_start), float(t_end))
             self.info["steps"] += int(steps)
             self.info["dt"] = float(diag[L.D_DT]) or None
             if status == STATUS_FAIL:

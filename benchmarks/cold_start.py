@@ -1,0 +1,248 @@
+"""Cold first run: ``pdeflow run cases/paper_5_1_dam_break.toml`` with an empty numba cache.
+
+Measured by ``python benchmarks/run_benchmarks.py --only cold`` (stored under a label,
+``--label``, in ``benchmarks/measurements/cold_start.json``, rendered into
+docs/performance.md). Every run gets a fresh, empty ``NUMBA_CACHE_DIR`` and a fresh
+working directory (the command writes ``results/<case>/`` there), so each one compiles
+every kernel it needs, as the first run on a new machine does.
+
+* **plain**: ``python -m pdeflow run CASE`` and the installed ``pdeflow`` script, as a
+  user types them: wall time and CPU time (user + system) of the whole process.
+* **split**: the same command through a small wrapper that books the time spent in
+  top-level imports, in numba compilations (outermost ``numba:compile`` events; a
+  compilation triggered by an import counts as compilation), in the figures (the
+  functions of ``pdeflow.plotting``) and the rest (interpreter start, reading the case,
+  the two runs, the summary), and lists the kernels compiled with their signatures.
+* **warm**: the plain command once more with the cache the cold run left (what every
+  later run costs).
+
+Medians over ``repeats`` fresh runs. ``--tree`` measures another checkout (e.g. the
+commit before a change) with this same harness.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+CASE = "cases/paper_5_1_dam_break.toml"
+
+_SPLIT = r"""
+import builtins, json, sys, time
+t_start = time.perf_counter()
+spent = {"imports": 0.0, "compile": 0.0}
+depth = {"import": 0, "compile": 0}
+compile_in_import = [0.0]
+_real_import = builtins.__import__
+
+def _timed_import(*args, **kwargs):
+    if depth["import"]:
+        return _real_import(*args, **kwargs)
+    depth["import"] += 1
+    c0 = spent["compile"]
+    t0 = time.perf_counter()
+    try:
+        return _real_import(*args, **kwargs)
+    finally:
+        spent["imports"] += time.perf_counter() - t0
+        compile_in_import[0] += spent["compile"] - c0
+        depth["import"] -= 1
+
+builtins.__import__ = _timed_import
+from numba.core import event
+
+kernels = []
+class _Compiles(event.Listener):
+    def on_start(self, ev):
+        if depth["compile"] == 0:
+            self.t0 = time.perf_counter()
+        depth["compile"] += 1
+    def on_end(self, ev):
+        depth["compile"] -= 1
+        d = ev.data["dispatcher"]
+        name = f"{d.py_func.__module__}.{d.py_func.__qualname__}"
+        if name.startswith("pdeflow"):
+            kernels.append([name, str(ev.data["args"])])
+        if depth["compile"] == 0:
+            spent["compile"] += time.perf_counter() - self.t0
+
+event.register("numba:compile", _Compiles())
+
+# the figures: every function of pdeflow.plotting, outermost calls
+import functools, inspect
+import pdeflow.plotting as _plotting
+spent["figures"] = 0.0
+depth["figures"] = 0
+
+def _timed(f):
+    @functools.wraps(f)
+    def wrapper(*args, **kwargs):
+        depth["figures"] += 1
+        t0 = time.perf_counter()
+        try:
+            return f(*args, **kwargs)
+        finally:
+            depth["figures"] -= 1
+            if depth["figures"] == 0:
+                spent["figures"] += time.perf_counter() - t0
+    return wrapper
+
+for _name, _f in list(vars(_plotting).items()):
+    if inspect.isfunction(_f) and _f.__module__ == _plotting.__name__:
+        setattr(_plotting, _name, _timed(_f))
+import runpy
+sys.argv = ["pdeflow", *sys.argv[1:]]
+try:
+    runpy.run_module("pdeflow", run_name="__main__", alter_sys=True)
+except SystemExit as err:
+    code = err.code
+else:
+    code = 0
+total = time.perf_counter() - t_start
+imports = spent["imports"] - compile_in_import[0]
+print("RESULT" + json.dumps({
+    "imports_s": imports, "compile_s": spent["compile"], "figures_s": spent["figures"],
+    "other_s": total - imports - spent["compile"] - spent["figures"],
+    "in_process_s": total, "kernels": kernels, "code": code}), file=sys.stderr)
+"""
+
+
+def _child(cmd: list[str], tree: Path, cache: str | None) -> dict[str, Any]:
+    """Run ``cmd`` in a fresh working directory with ``tree`` on PYTHONPATH and the
+    numba cache in ``cache`` (a fresh empty one if None); wall and CPU time [s]."""
+    own = cache is None
+    cache = cache or tempfile.mkdtemp(prefix="pdeflow-cold-numba-")
+    work = tempfile.mkdtemp(prefix="pdeflow-cold-cwd-")
+    env = {**os.environ, "NUMBA_CACHE_DIR": cache, "PYTHONPATH": str(tree)}
+    env.pop("NUMBA_DISABLE_JIT", None)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, cwd=work, env=env, capture_output=True, text=True,
+                          timeout=1800)
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    shutil.rmtree(work, ignore_errors=True)
+    if own:
+        shutil.rmtree(cache, ignore_errors=True)
+    if proc.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed:\n{proc.stderr[-3000:]}")
+    out: dict[str, Any] = {"wall_s": wall, "cpu_s": (after.ru_utime - before.ru_utime)
+                           + (after.ru_stime - before.ru_stime)}
+    for line in proc.stderr.splitlines():
+        if line.startswith("RESULT"):
+            out.update(json.loads(line[6:]))
+    return out
+
+
+def _median(rows: list[dict[str, Any]], key: str) -> float | None:
+    vals = [r[key] for r in rows if r.get(key) is not None]
+    return statistics.median(vals) if vals else None
+
+
+def measure(repeats: int = 3, tree: Path = ROOT, log: Any = None,
+            commit_id: str | None = None) -> dict[str, Any]:
+    """``repeats`` fresh cold runs of each command (interleaved), then warm ones;
+    ``commit_id`` names the code measured (default: ``tree``'s git commit)."""
+    load = os.getloadavg()
+    case = str(Path(tree) / CASE)
+    script = shutil.which("pdeflow")
+    commands = {"python -m pdeflow run": [sys.executable, "-m", "pdeflow", "run", case],
+                "split": [sys.executable, "-c", _SPLIT, "run", case]}
+    if script:
+        commands["pdeflow run (script)"] = [script, "run", case]
+    runs: dict[str, list[dict[str, Any]]] = {k: [] for k in commands}
+    warm: list[dict[str, Any]] = []
+    for i in range(repeats):
+        for label, cmd in commands.items():
+            runs[label].append(_child(cmd, Path(tree), None))
+            if log is not None:
+                r = runs[label][-1]
+                print(f"cold {i + 1}/{repeats} {label}: {r['wall_s']:.1f} s wall, "
+                      f"{r['cpu_s']:.1f} s CPU", file=log, flush=True)
+        cache = tempfile.mkdtemp(prefix="pdeflow-cold-numba-")
+        try:
+            _child(commands["python -m pdeflow run"], Path(tree), cache)
+            warm.append(_child(commands["python -m pdeflow run"], Path(tree), cache))
+        finally:
+            shutil.rmtree(cache, ignore_errors=True)
+    split = runs["split"]
+    kernels = split[-1].get("kernels", [])
+    out: dict[str, Any] = {
+        "case": CASE, "repeats": repeats, "commit": commit_id or commit(Path(tree)),
+        "load_avg_at_start": load,
+        "commands": {k: {"wall_s": _median(v, "wall_s"), "cpu_s": _median(v, "cpu_s"),
+                         "walls": [r["wall_s"] for r in v]}
+                     for k, v in runs.items() if k != "split"},
+        "split": {k: _median(split, k) for k in ("wall_s", "cpu_s", "imports_s",
+                                                 "compile_s", "figures_s", "other_s")},
+        "warm": {"wall_s": _median(warm, "wall_s"), "cpu_s": _median(warm, "cpu_s")},
+        "kernels": sorted({k for k, _ in kernels}),
+        "signatures": len(kernels),
+    }
+    return out
+
+
+INTRO = """
+`pdeflow run cases/paper_5_1_dam_break.toml` with an empty `NUMBA_CACHE_DIR` (a fresh one
+per run, and a fresh working directory): the first run on a new machine, which compiles
+every kernel it calls. Measured by `python benchmarks/run_benchmarks.py --only cold
+--label LABEL` (`benchmarks/cold_start.py`); medians of fresh runs; *CPU* is user +
+system time of the process, less sensitive than wall time to the other jobs on this
+shared machine. *imports*, *compile*, *figures* and *rest* split the same command run
+through a wrapper that times top-level imports, numba's compilations and
+`pdeflow.plotting` (the rest: interpreter start, reading the case, both runs, the
+summary). *warm*: the command again with the cache the cold run left. *load*: 1-minute
+load average of the machine at the start (2 cores).
+"""
+COLUMNS = ("code", "runs", "load", "`python -m pdeflow run` wall [s]", "CPU [s]",
+           "`pdeflow` script wall [s]", "imports [s]", "compile [s]", "figures [s]",
+           "rest [s]", "warm wall [s]", "kernels compiled (signatures)")
+
+
+def render(data: dict[str, Any]) -> str:
+    """The cold-start section of docs/performance.md from ``{label: measure(...)}``."""
+    L = ["## Cold first run\n", " ".join(INTRO.split()) + "\n",
+         "| " + " | ".join(COLUMNS) + " |", "|---|" + "---:|" * (len(COLUMNS) - 2) + "---|"]
+
+    def f(v: float | None) -> str:
+        return "-" if v is None else f"{v:.1f}"
+
+    for label, d in data.items():
+        c = d["commands"]
+        plain = c.get("python -m pdeflow run", {})
+        script = c.get("pdeflow run (script)", {})
+        s = d["split"]
+        load = d.get("load_avg_at_start")
+        L.append(f"| {label} ({d.get('commit', '?')}) | {d['repeats']} | "
+                 f"{f(load[0]) if load else '?'} | {f(plain.get('wall_s'))} | "
+                 f"{f(plain.get('cpu_s'))} | {f(script.get('wall_s'))} | "
+                 f"{f(s['imports_s'])} | {f(s['compile_s'])} | {f(s.get('figures_s'))} | "
+                 f"{f(s['other_s'])} | "
+                 f"{f(d['warm']['wall_s'])} | {len(d['kernels'])} ({d['signatures']}) |")
+    for label, d in data.items():
+        L.append(f"\nKernels compiled by the cold run, *{label}*: "
+                 + ", ".join(f"`{k.replace('pdeflow.numerics.', '').replace('.<locals>', '')}`"
+                             for k in d["kernels"]) + ".")
+    return "\n".join(L) + "\n"
+
+
+def commit(tree: Path) -> str:
+    """Short commit id of ``tree`` (with ``+`` if it has uncommitted changes)."""
+    try:
+        rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=tree,
+                             capture_output=True, text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "pdeflow"], cwd=tree,
+                               capture_output=True, text=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "?"
+    return rev + ("+" if dirty else "")

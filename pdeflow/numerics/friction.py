@@ -1,0 +1,187 @@
+r"""Implicit friction (32) of one cell, with the extra exchange F_extra of (33)-(34).
+
+:func:`implicit_friction` solves stage (32) of a cell for both layers together, in closed
+form (:func:`pdeflow.numerics.sources.friction_two_layer`), with an extra momentum
+exchange F_extra between the layers; :func:`restore_hyperbolicity` finds the smallest
+F_extra after which the cell's state is hyperbolic (33)-(34), by inverting that closed
+form, with :func:`bisect_fextra` as the fallback. The predictors zero the momentum that
+friction would hold at rest in the intermediate stage of SSP-RK2 (MUSCL).
+
+Kinematic units (divided by rho2) as in :mod:`pdeflow.numerics.sources`:
+f = F_extra/rho2 [m^2/s^2], velocities [m/s], depths [m].
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from . import layout as L
+from .compiled import PARAMS, STATE, f8, i8, kernel
+from .hyperbolicity import band_lower_edge, is_hyperbolic, lower_bound_fl
+from .sources import _drag_root, coulomb_single, friction_two_layer
+from .state import velocity
+
+
+@njit(cache=True)
+def implicit_friction(b1, b2, h1, h2, dt, P, f, k, c):
+    """Implicit stage (32) for one cell with extra exchange ``f`` = F_extra/rho2 and the
+    interface law (22) with friction reduction ``k`` and collisional coefficient ``c``
+    (the parameters', or those of t1 - M du in a cell that eroded this step)."""
+    r = P[L.R]
+    g = P[L.G_Z]
+    dry = P[L.DRY]
+    wet1 = h1 > dry
+    wet2 = h2 > dry
+    if wet1 and wet2:
+        m1 = r * h1
+        if f != 0.0:
+            b1 = b1 - dt * f / m1
+            b2 = b2 + dt * f / h2
+        kdt = dt * k * r * g * h1 * P[L.TAN_INT]
+        bdt = dt * g * (r * h1 + h2) * P[L.TAN_B]
+        return friction_two_layer(b1, b2, m1, h2, kdt, dt * c, bdt)
+    if wet1:
+        # no lower layer: the upper layer rubs on the bed with the interface law (22)
+        m1 = r * h1
+        kdt = dt * k * r * g * h1 * P[L.TAN_INT]
+        u1 = _drag_root(m1 * abs(b1) - kdt, m1, dt * c)
+        return (u1 if b1 > 0.0 else -u1), 0.0
+    if wet2:
+        mu_dt = dt * g * P[L.TAN_B] * (h2 + r * max(h1, 0.0)) / h2
+        return 0.0, coulomb_single(b2, mu_dt)
+    return 0.0, 0.0
+
+
+@njit(cache=True)
+def bisect_fextra(b1, b2, h1, h2, du0, dt, P, k, c):
+    """F_extra/rho2 [m^2/s^2] by bracketing and bisection on the hyperbolicity test:
+    the fallback of :func:`restore_hyperbolicity`, stopping when the bracket in du is
+    below w."""
+    g = P[L.G_Z]
+    r = P[L.R]
+    mode = int(P[L.HYPERBOLICITY])
+    w = P[L.W]
+    # Bracket: f_lo leaves du of the original sign and non-hyperbolic; f_hi makes the
+    # state hyperbolic or flips the sign of du (du(f) decreases monotonically in f, so
+    # the smallest hyperbolic f lies before the sign change).
+    f_hi = du0 / (dt * (1.0 / (r * h1) + 1.0 / h2))
+    f_lo = 0.0
+    du_lo = abs(du0)
+    sgn = 1.0 if du0 > 0.0 else -1.0
+    for _ in range(60):
+        v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, f_hi, k, c)
+        du_hi = sgn * (v1 - v2)
+        if du_hi <= 0.0 or is_hyperbolic(h1, h2, v1, v2, g, r, mode):
+            break
+        f_lo = f_hi
+        du_lo = du_hi
+        f_hi *= 2.0
+    for _ in range(200):
+        if du_lo - du_hi <= w or abs(f_hi - f_lo) <= 1e-12 * abs(f_hi):
+            break
+        f_mid = 0.5 * (f_lo + f_hi)
+        v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, f_mid, k, c)
+        du_mid = sgn * (v1 - v2)
+        if du_mid <= 0.0 or is_hyperbolic(h1, h2, v1, v2, g, r, mode):
+            f_hi = f_mid
+            du_hi = du_mid
+        else:
+            f_lo = f_mid
+            du_lo = du_mid
+    return f_hi
+
+
+@njit(cache=True)
+def restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P, k, c):
+    r"""Smallest F_extra/rho2 [m^2/s^2] making the post-friction state hyperbolic, the
+    velocities (u1, u2) [m/s] it leads to, and whether the bisection fallback was used.
+
+    The depths are frozen, so the target is a relative velocity: the lower band edge
+    F_c1 (F_L in ``bound`` mode). Stage (32) with the extra exchange f = F_extra/rho2
+    shifts b1 by -dt f/m1 and b2 by +dt f/m2 and keeps m1 b1 + m2 b2, so on each branch
+    of its closed-form solution (:func:`pdeflow.numerics.sources.friction_two_layer`)
+    du is an explicit function of f, inverted here for du = sgn(du0) d with
+
+    * lower layer sliding in direction s2 (mu = m1 m2/(m1 + m2), p = m1 b1 + m2 b2
+      - dt B s2): :math:`m_1 b_1 - m_1 p/(m_1+m_2) - \Delta t f
+      = \mathrm{sgn}(du_0)\,(\Delta t K + \mu d + \Delta t C d^2)`;
+    * lower layer stuck: :math:`m_1 (b_1 - \Delta t f/m_1)
+      = \mathrm{sgn}(du_0)\,(\Delta t K + m_1 d + \Delta t C d^2)`.
+
+    The branch is not known beforehand: each candidate is checked by solving (32)
+    with it (|du| must land within w below the edge, where the state is hyperbolic);
+    if none passes (round-off at a branch boundary), bisection decides
+    (:func:`bisect_fextra`).
+    """
+    g = P[L.G_Z]
+    r = P[L.R]
+    mode = int(P[L.HYPERBOLICITY])
+    du0 = u1 - u2
+    if mode == 2:
+        edge = lower_bound_fl(h1, h2, g, r)
+    else:
+        edge = band_lower_edge(h1, h2, g, r, abs(du0))
+    if edge > 0.0:
+        d = edge * (1.0 - 1e-8)  # a hair inside: round-off must not leave the band edge
+        sgn = 1.0 if du0 > 0.0 else -1.0
+        m1 = r * h1
+        m2 = h2
+        mt = m1 + m2
+        kdt = dt * k * r * g * h1 * P[L.TAN_INT]
+        cdt = dt * c
+        bdt = dt * g * (r * h1 + h2) * P[L.TAN_B]
+        s_first = 1.0 if u2 >= 0.0 else -1.0
+        for branch in range(3):
+            if branch == 2:
+                f = (m1 * b1 - sgn * (kdt + m1 * d + cdt * d * d)) / dt
+            else:
+                s2 = s_first if branch == 0 else -s_first
+                p = m1 * b1 + m2 * b2 - bdt * s2
+                f = (m1 * b1 - m1 * p / mt
+                     - sgn * (kdt + m1 * m2 / mt * d + cdt * d * d)) / dt
+            if f * sgn <= 0.0:
+                continue
+            v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, f, k, c)
+            # below the edge is hyperbolic down to F_L (the band is one interval)
+            if edge - P[L.W] <= sgn * (v1 - v2) <= edge:
+                return f, v1, v2, False
+    f = bisect_fextra(b1, b2, h1, h2, du0, dt, P, k, c)
+    v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, f, k, c)
+    return f, v1, v2, True
+
+
+@kernel(STATE, f8, PARAMS, i8, i8)
+def predictor_two_layer(q: np.ndarray, dt: float, P: np.ndarray, lo: int,
+                        hi: int) -> None:
+    """Zero the momentum of layers that the implicit friction (32) would hold at rest,
+    in place, in the cells ``lo..hi``. Applied to the intermediate stage of SSP-RK2:
+    otherwise the predictor's pressure momentum, which friction balances, moves mass and
+    heaps creep. Moving layers are left untouched (friction proper is applied once, in
+    the source stage)."""
+    dry = P[L.DRY]
+    for i in range(lo, hi + 1):
+        h1 = max(q[0, i], 0.0)
+        h2 = max(q[2, i], 0.0)
+        if h1 <= dry and h2 <= dry:
+            continue
+        b1 = velocity(h1, q[1, i], dry) + dt * P[L.G_X] if h1 > dry else 0.0
+        b2 = velocity(h2, q[3, i], dry) + dt * P[L.G_X] if h2 > dry else 0.0
+        u1, u2 = implicit_friction(b1, b2, h1, h2, dt, P, 0.0, P[L.K], P[L.C])
+        if u1 == 0.0:
+            q[1, i] = 0.0
+        if u2 == 0.0:
+            q[3, i] = 0.0
+
+
+@kernel(STATE, f8, PARAMS, i8, i8)
+def predictor_single(q: np.ndarray, dt: float, P: np.ndarray, lo: int, hi: int) -> None:
+    """:func:`predictor_two_layer` for the single layer (Coulomb friction)."""
+    dry = P[L.S_DRY]
+    for i in range(lo, hi + 1):
+        h = max(q[0, i], 0.0)
+        if h > dry:
+            u = coulomb_single(q[1, i] / h + dt * P[L.S_G_X],
+                               dt * P[L.S_G_Z] * P[L.S_TAN_B])
+            if u == 0.0:
+                q[1, i] = 0.0

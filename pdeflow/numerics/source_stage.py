@@ -1,0 +1,205 @@
+r"""The source stages (31)-(34) of the split scheme, cell by cell.
+
+One step of length dt (Lie splitting, as in the paper) advects (29) and then applies,
+in every wet cell:
+
+2. exchange (31): limited closure (25), see :func:`pdeflow.numerics.sources.exchange_depth`;
+   the exchanged mass carries the velocity of the layer it leaves;
+3. implicit momentum sources (32): gravity along the bed, Voellmy interface stress
+   (t1 - M du where the step eroded, see :mod:`pdeflow.numerics.sources`), Coulomb basal
+   friction, solved for both layers together (:mod:`pdeflow.numerics.friction`);
+4. hyperbolicity (33)-(34): where the inner eigenvalues are complex, stage 3 is
+   repeated with the smallest extra exchange F_extra that restores hyperbolicity.
+
+Stages 2-4 form :func:`source_stage_two_layer`, which is also what the PDE's post-step
+hook runs; with dt = 0 it only cleans up (non-negative depths, zero velocity in dry
+cells), which is what a method-of-lines solver needs. The stepping loop of the
+``fv-split`` solver (:mod:`pdeflow.numerics.splitting`) calls the same stage on the wet
+cells only (:func:`sources_two_layer`, :func:`sources_single`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from . import layout as L
+from .compiled import PARAMS, STATE, VECTOR, f8, i8, kernel
+from .friction import implicit_friction, restore_hyperbolicity
+from .hyperbolicity import is_hyperbolic
+from .sources import coulomb_single, exchange_step
+from .state import velocity
+
+
+@kernel(STATE, f8, f8, PARAMS, VECTOR)
+def source_stage_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
+                           diag: np.ndarray) -> None:
+    """Stages (31)-(34) on the two-layer state ``q`` in place, for a step ``dt`` [s].
+
+    ``t`` is the time at the end of the step [s]; ``diag`` receives the bookkeeping
+    listed in :mod:`pdeflow.numerics.layout` and, from index N_DIAG on, F_extra/rho1
+    per cell [m^2/s^2].
+    """
+    sources_two_layer(q, dt, t, P, diag, 0, q.shape[1] - 1)
+
+
+@kernel(STATE, f8, f8, PARAMS, VECTOR, i8, i8)
+def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
+                      diag: np.ndarray, lo: int, hi: int) -> None:
+    """:func:`source_stage_two_layer` on the cells ``lo..hi`` only (the others must be
+    dry and at rest, where the stage changes nothing)."""
+    r = P[L.R]
+    g = P[L.G_Z]
+    gx = P[L.G_X]
+    dry = P[L.DRY]
+    slow_u = P[L.SLOW_U]
+    slow_h = P[L.SLOW_H]
+    mode = int(P[L.HYPERBOLICITY])
+    moving1 = False
+    moving2 = False
+    fast1 = False
+    fast2 = False
+    changed = False
+    fex = diag[L.N_DIAG:]
+    for i in range(lo, hi + 1):
+        h1 = q[0, i]
+        m1 = q[1, i]
+        h2 = q[2, i]
+        m2 = q[3, i]
+        if fex[i] != 0.0:
+            fex[i] = 0.0
+        if h1 == 0.0 and h2 == 0.0 and m1 == 0.0 and m2 == 0.0:
+            continue
+        h1 = max(h1, 0.0)
+        h2 = max(h2, 0.0)
+        u1 = velocity(h1, m1, dry)
+        u2 = velocity(h2, m2, dry)
+        if dt > 0.0:
+            # interface stress of (32): the paper's t1 (22) unless erosion rewrites it
+            k_eff = P[L.K]
+            c_eff = P[L.C]
+            # --- (31) mass exchange; the exchanged mass carries the velocity of the layer
+            # it leaves (upwind): u1 when depositing, u2 when eroding ------------------
+            if h1 > 0.0 and P[L.TAU_STAR] >= 0.0:
+                tau = P[L.TAU_STAR] * math.sqrt((h1 + h2) / g) if P[L.TAU_STAR] > 0.0 \
+                    else 0.0
+                du = u1 - u2
+                dh1, full = exchange_step(h1, h2, du, dt, r, g, P[L.TAN_INT], P[L.K],
+                                          P[L.C], P[L.DU_REG], P[L.FILM], tau)
+                if dh1 != 0.0:
+                    mom = h2 * u2 + r * h1 * u1  # rho-weighted momentum / rho2
+                    phi = 0.0
+                    if dh1 > 0.0:
+                        u1 = (h1 * u1 + dh1 * u2) / (h1 + dh1)
+                        phi = min(dh1 / full, 1.0) if full > 0.0 else 1.0
+                    h1 = h1 + dh1
+                    h2 = max(h2 - r * dh1, 0.0)
+                    if h1 <= dry:
+                        h1 = h1 if h1 > 0.0 else 0.0
+                        u1 = 0.0
+                    # lower layer takes the rest of the (rho-weighted) momentum
+                    if h2 > dry:
+                        u2 = (mom - r * h1 * u1) / h2
+                        if phi > 0.0:
+                            # t1 - M du = phi t2 + (1 - phi) t1 (see the module docstring)
+                            k_eff = P[L.K] + phi * (1.0 - P[L.K])
+                            c_eff = (1.0 - phi) * P[L.C]
+                    else:
+                        u2 = 0.0
+                        if h1 > dry:
+                            u1 = mom / (r * h1)
+                    changed = True
+                    if dh1 < 0.0:
+                        diag[L.D_DEPOSITED] -= dh1
+                    else:
+                        diag[L.D_ERODED] += dh1
+            # --- (32) implicit momentum sources ------------------------------------------
+            b1 = u1 + dt * gx if h1 > dry else 0.0
+            b2 = u2 + dt * gx if h2 > dry else 0.0
+            v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, 0.0, k_eff, c_eff)
+            # --- (33)-(34) hyperbolicity --------------------------------------------------
+            if mode > 0 and h1 > dry and h2 > dry:
+                if not is_hyperbolic(h1, h2, v1, v2, g, r, mode):
+                    f, v1, v2, bisected = restore_hyperbolicity(b1, b2, h1, h2, v1, v2,
+                                                                 dt, P, k_eff, c_eff)
+                    if bisected:
+                        diag[L.D_HYP_BISECTIONS] += 1.0
+                    fex[i] = abs(f) / r
+                    diag[L.D_HYP_EVENTS] += 1.0
+                    if fex[i] > diag[L.D_FEXTRA_MAX]:
+                        diag[L.D_FEXTRA_MAX] = fex[i]
+                        diag[L.D_FEXTRA_CELL] = i
+                        diag[L.D_FEXTRA_TIME] = t
+            u1 = v1
+            u2 = v2
+        m1 = h1 * u1 if h1 > dry else 0.0
+        m2 = h2 * u2 if h2 > dry else 0.0
+        if m1 != 0.0:
+            moving1 = True
+            if h1 > slow_h and abs(u1) >= slow_u:
+                fast1 = True
+        if m2 != 0.0:
+            moving2 = True
+            if h2 > slow_h and abs(u2) >= slow_u:
+                fast2 = True
+        q[0, i] = h1
+        q[1, i] = m1
+        q[2, i] = h2
+        q[3, i] = m2
+    _close_stage(diag, t, moving1, fast1, moving2, fast2, changed)
+
+
+@kernel(STATE, f8, f8, PARAMS, VECTOR)
+def source_stage_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
+                        diag: np.ndarray) -> None:
+    """Implicit Coulomb friction (and gravity along the bed) for the single layer."""
+    sources_single(q, dt, t, P, diag, 0, q.shape[1] - 1)
+
+
+@kernel(STATE, f8, f8, PARAMS, VECTOR, i8, i8)
+def sources_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
+                   diag: np.ndarray, lo: int, hi: int) -> None:
+    """:func:`source_stage_single` on the cells ``lo..hi`` only."""
+    g = P[L.S_G_Z]
+    gx = P[L.S_G_X]
+    dry = P[L.S_DRY]
+    mu_dt = dt * g * P[L.S_TAN_B]
+    moving = False
+    fast = False
+    for i in range(lo, hi + 1):
+        h = q[0, i]
+        m = q[1, i]
+        if h == 0.0 and m == 0.0:
+            continue
+        h = max(h, 0.0)
+        u = velocity(h, m, dry)
+        if dt > 0.0 and h > dry:
+            u = coulomb_single(u + dt * gx, mu_dt)
+        m = h * u if h > dry else 0.0
+        if m != 0.0:
+            moving = True
+            if h > P[L.S_SLOW_H] and abs(u) >= P[L.S_SLOW_U]:
+                fast = True
+        q[0, i] = h
+        q[1, i] = m
+    _close_stage(diag, t, moving, fast, False, False, False)
+
+
+@njit(cache=True, inline="always")
+def _close_stage(diag, t, moving1, fast1, moving2, fast2, changed):
+    """Book a source stage ending at ``t`` [s] in ``diag``: the times of the last motion
+    (``moving``: a layer has momentum; ``fast``: faster than SLOW_U where deeper than
+    SLOW_H) of layer 1 (or the single layer) and 2, whether it changed anything."""
+    if moving1:
+        diag[L.D_MOVE_UPPER] = t
+    if moving2:
+        diag[L.D_MOVE_LOWER] = t
+    if fast1:
+        diag[L.D_FAST_UPPER] = t
+    if fast2:
+        diag[L.D_FAST_LOWER] = t
+    diag[L.D_CHANGED] = 1.0 if (changed or moving1 or moving2) else 0.0
+    diag[L.D_T] = t
+    diag[L.D_STEPS] += 1.0

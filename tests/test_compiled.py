@@ -1,0 +1,106 @@
+"""Compiled kernels: one signature each, only what a scheme calls, cached on disk."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from numba.core import config
+
+from pdeflow.numerics import layout as L
+from pdeflow.numerics.splitting import scheme_stepper
+
+ROOT = Path(__file__).parents[1]
+
+pytestmark = pytest.mark.skipif(config.DISABLE_JIT, reason="nothing is compiled")
+
+# the shipped paper cases through the command line, in a fresh process (so that no other
+# test's calls count), then every kernel of pdeflow.numerics and its signatures
+PAPER_RUNS = r"""
+import json, sys, tempfile
+from pdeflow.cli import main
+from pdeflow.numerics import compiled
+out = tempfile.mkdtemp()
+for argv in (["run", "cases/paper_5_1_dam_break.toml", "--outdir", out + "/51"],
+             ["run", "cases/paper_5_2_single_collapse.toml", "--outdir", out + "/52"],
+             ["sweep", "cases/paper_5_2_two_layer_law.toml", "--summary", out + "/s.json"]):
+    assert main([*argv, "-q"]) == 0, argv
+kernels = {f"{k.py_func.__module__}.{k.py_func.__qualname__}#{i}": [str(s) for s in k.signatures]
+           for i, k in enumerate(compiled.kernels())}
+print("KERNELS" + json.dumps(kernels))
+"""
+
+
+def test_the_paper_cases_compile_every_kernel_once():
+    """After `pdeflow run` of 5.1 and 5.2 and `pdeflow sweep` of the 5.2 law, every
+    kernel has at most one signature (int, float and array-layout variants of the same
+    call would each compile one), and the kernels of other fluxes, reconstructions and
+    splittings were not compiled."""
+    proc = subprocess.run([sys.executable, "-c", PAPER_RUNS], cwd=ROOT, capture_output=True,
+                          text=True, timeout=1800,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    line = [x for x in proc.stdout.splitlines() if x.startswith("KERNELS")][0]
+    kernels = json.loads(line[len("KERNELS"):])
+    several = {k: v for k, v in kernels.items() if len(v) > 1}
+    assert not several, several
+    used = {k.split("#")[0] for k, v in kernels.items() if v}
+    assert "pdeflow.numerics.splitting.stepping_function.<locals>.advance" in used
+    assert "pdeflow.numerics.source_stage.sources_two_layer" in used
+    for name in ("reconstruct_muscl", "predictor", "rusanov", "ifcp", "roe",
+                 "internal_speed", "source_rate", "source_stage_"):
+        assert not any(name in k for k in used), (name, sorted(used))
+    loops = [k for k in kernels if k.startswith("pdeflow.numerics.splitting.stepping")]
+    assert sum(bool(kernels[k]) for k in loops) == 1  # first order, Lie, no IFCP fallback
+
+
+def test_kernels_are_compiled_for_their_declared_signature_only():
+    """Called with other but compatible types (a C-contiguous copy instead of py-pde's
+    strided state, plain Python ints), a ready kernel converts them instead of
+    compiling a second signature."""
+    import numpy as np
+
+    import pdeflow
+    from pdeflow.numerics.source_stage import sources_single
+
+    stepper = scheme_stepper(False, L.FLUX_HLL, 1, L.LIMITER_MINMOD, False).ready()
+    eq = pdeflow.SingleLayerGranular()
+    P = eq.parameter_array()
+    q = np.array([[1.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0]])
+    diag = eq.new_diagnostics(4)
+    stepper(q, 0, 1e-3, 0.25, 0, 1, P, 0.3, diag, np.empty_like(q), np.empty_like(q),
+            np.empty((3, 2, 4)), 10, False)
+    sources_single(q, 0.0, 0.0, P, diag, 0, 3)
+    for kernel in (*stepper.kernels, sources_single):
+        assert len(kernel.signatures) == 1, kernel
+
+
+def test_a_closure_is_cached_under_its_constants(tmp_path):
+    """Two specialised kernels of the same code but other constants are two cache
+    entries; a fresh process loads both from the disk cache instead of compiling."""
+    script = r"""
+import json
+from pdeflow.numerics import layout as L
+from pdeflow.numerics.advection import advection_kernel
+from pdeflow.numerics.compiled import ready
+out = []
+for flux in (L.FLUX_HLL, L.FLUX_RUSANOV):
+    k = ready(advection_kernel(False, flux, 1, L.LIMITER_MINMOD))
+    out.append([sum(k.stats.cache_hits.values()), sum(k.stats.cache_misses.values())])
+print("STATS" + json.dumps(out))
+"""
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path), "PYTHONPATH": str(ROOT)}
+    stats = []
+    for _ in range(2):
+        proc = subprocess.run([sys.executable, "-c", script], env=env, cwd=ROOT,
+                              capture_output=True, text=True, timeout=900)
+        assert proc.returncode == 0, proc.stderr[-3000:]
+        line = [x for x in proc.stdout.splitlines() if x.startswith("STATS")][0]
+        stats.append(json.loads(line[len("STATS"):]))
+    assert stats[0] == [[0, 1], [0, 1]]  # compiled
+    assert stats[1] == [[1, 0], [1, 0]]  # loaded, each under its own key
+
