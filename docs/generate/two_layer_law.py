@@ -435,17 +435,25 @@ def figure_map(rows: list[dict], path: Path) -> None:
     save(fig, path)
 
 
-STUDY_MAPS = {  # study name -> (varied closure key, what the map above holds, closure)
-    "two_layer_law_relaxed": ("tau_star", "tau_star = 0.1", "relaxed closure"),
-    "two_layer_law_du_reg": ("du_reg", "du_reg = 0.2 m/s", "paper's closure bounded by du_reg"),
+STUDY_MAPS = {  # study name -> (varied keys, what the map above holds, closure, fixed)
+    "two_layer_law_relaxed": (("two_layer.tau_star", "two_layer.phi_b_deg", "two_layer.c"),
+                              "tau_star = 0.1", "relaxed closure", "k = 0.8, wedge 60 deg"),
+    "two_layer_law_du_reg": (("two_layer.du_reg", "two_layer.phi_b_deg", "two_layer.c"),
+                             "du_reg = 0.2 m/s", "paper's closure bounded by du_reg",
+                             "k = 0.8, wedge 60 deg"),
+    "two_layer_law_wedge_k": (("two_layer.k", "two_layer.c", "initial.wedge_angle_deg"),
+                              None, "paper's closure bounded by du_reg = 0.05 m/s",
+                              "phi_B = 41 deg"),
 }
-"""maps over a closure's regularisation, studies: pdeflow study cases/study_NAME.toml
---out docs/studies/NAME (this script only reads their results tables)"""
+"""maps over a closure's regularisation and the other parameters, studies: pdeflow study
+cases/study_NAME.toml --out docs/studies/NAME (this script only reads their tables)"""
+LABELS = {"phi_b_deg": "phi_B", "wedge_angle_deg": "wedge"}
 
 
 def study_map_section(docs: Path, name: str) -> list[str]:
     """Part C over one closure's regularisation, from a study's results table."""
-    key, held, closure = STUDY_MAPS[name]
+    keys, held, closure, fixed = STUDY_MAPS[name]
+    labels = [LABELS.get(k.split(".")[1], k.split(".")[1]) for k in keys]
     study = f"studies/{name}"
     path = docs / study / "results.csv"
     if not path.exists():
@@ -458,24 +466,30 @@ def study_map_section(docs: Path, name: str) -> list[str]:
                 rows += [r for r in csv.DictReader(fh) if r["status"] == "ok"]
     groups: dict = {}
     for r in rows:
-        point = tuple(float(r[f"two_layer.{k}"]) for k in (key, "phi_b_deg", "c"))
+        point = tuple(float(r[k]) for k in keys)
         e = r["sweep.two_layer.exponent"]
         groups.setdefault(point, {})[float(r["grid.dx"])] = {
             "exponent": float(e) if e else None,
             "prefactor": float(r["sweep.two_layer.prefactor"]) if e else None,
             "sweep_at_rest": r["sweep.two_layer.all_at_rest"] == "1"}
     dxs = sorted({dx for lv in groups.values() for dx in lv}, reverse=True)
-    lines = ["", f"**{closure.capitalize()} over {key}** (the map above holds {held}): "
+
+    def named(point: tuple) -> str:
+        return ", ".join(f"{lab} {v:g}" for lab, v in zip(labels, point, strict=True))
+
+    over = labels[0] if held else ", ".join(labels)
+    lines = ["", f"**{closure[0].upper() + closure[1:]} over {over}**"
+             + (f" (the map above holds {held})" if held else "") + ": "
              f"the study `cases/study_{name}.toml`, run by `pdeflow study "
              f"cases/study_{name}.toml --out docs/{study}` "
              f"([report]({study}/report.md)"
              + (f"; one level finer for some sets: [report]({study}_refine/report.md)"
                 if (docs / f"{study}_refine").exists() else "")
-             + "), MUSCL/mc, k = 0.8, wedge 60 deg; the change is between each set's "
+             + f"), MUSCL/mc, {fixed}; the change is between each set's "
              "two finest grids:", "",
-             f"| {key} | phi_B | c | " + " | ".join(f"fit, dx {d}" for d in dxs)
+             "| " + " | ".join(labels) + " | " + " | ".join(f"fit, dx {d}" for d in dxs)
              + " | change of the exponent | converged (< 0.01)? | sub-linear (< 0.95)? |",
-             "|---|---|---|" + "---|" * (len(dxs) + 3)]
+             "|" + "---|" * len(labels) + "---|" * (len(dxs) + 3)]
     conv_sub, conv_all, sub_all = [], [], []
     for point in sorted(groups):
         lv = groups[point]
@@ -497,18 +511,17 @@ def study_map_section(docs: Path, name: str) -> list[str]:
                 sub_all.append((point, e[1], d))
                 if d < 0.01:
                     conv_sub.append((point, e[1]))
-        lines.append(f"| {point[0]:g} | {point[1]:g} | {point[2]:g} | " + " | ".join(cells)
-                     + f" | {ch} | {ok} | {sub} |")
+        lines.append("| " + " | ".join(f"{v:g}" for v in point) + " | "
+                     + " | ".join(cells) + f" | {ch} | {ok} | {sub} |")
     lines += ["", f"* {len(conv_all)} of {len(groups)} sets converged"
               + (f" (exponents {min(conv_all):.3f} - {max(conv_all):.3f})" if conv_all
                  else "") + f"; {len(conv_sub)} of them sub-linear"
-              + (": " + ", ".join(f"{key} {k[0]:g}, phi_B {k[1]:g}, c {k[2]:g} "
-                                  f"({e:.3f})" for k, e in conv_sub) if conv_sub else "")
+              + (": " + ", ".join(f"{named(k)} ({e:.3f})" for k, e in conv_sub)
+                 if conv_sub else "")
               + "."]
     if sub_all:
         lines.append("* Sub-linear on the finer grid: " + ", ".join(
-            f"{key} {k[0]:g}, phi_B {k[1]:g}, c {k[2]:g} ({e:.3f}, change {d:.3f})"
-            for k, e, d in sub_all) + ".")
+            f"{named(k)} ({e:.3f}, change {d:.3f})" for k, e, d in sub_all) + ".")
     return lines
 
 

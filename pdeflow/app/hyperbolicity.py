@@ -26,10 +26,9 @@ from bokeh.models import (
 )
 from bokeh.palettes import Reds256
 from bokeh.plotting import figure
-from scipy.optimize import brentq
 
+from ..numerics import hyperbolicity as hyp
 from ..numerics.hyperbolicity import (
-    band_lower_edge,
     discriminant,
     eigenvalues,
     lower_bound_fl,
@@ -42,8 +41,6 @@ from .dam_break import COLOURS, FRAMES_PER_T_END, DamBreakRun, SharedRun
 
 G = 9.81
 """g_z of the sliders' state [m/s^2] (a flat bed); a cell of a run brings its own."""
-BAND_SAMPLES = 2000
-"""du samples on [0, 1.05 F_R] that find the band before its edges are refined"""
 
 
 @dataclass
@@ -70,23 +67,8 @@ class LocalSpectrum:
 
 
 def band_edges(h1: float, h2: float, r: float, g: float = G) -> tuple[float, float] | None:
-    """(F_c1, F_c2) [m/s]: the band of |du| where two eigenvalues are complex, or None.
-
-    The band is located on a grid of :data:`BAND_SAMPLES` values of du up to 1.05 F_R
-    (F_R bounds it from above); F_c1 is then pdeflow's own edge
-    (:func:`~pdeflow.numerics.hyperbolicity.band_lower_edge`, the target of the
-    restoration), F_c2 the discriminant's root above the last complex sample.
-    """
-    du = np.linspace(0.0, 1.05 * upper_bound_fr(h1, h2, g, r), BAND_SAMPLES + 1)
-    disc = np.array([discriminant(h1, h2, d, 0.0, g, r) for d in du])
-    bad = np.nonzero(disc < 0.0)[0]
-    if bad.size == 0:
-        return None
-    f_c1 = band_lower_edge(h1, h2, g, r, du[bad[0]])
-    j = bad[-1]
-    f_c2 = brentq(lambda d: discriminant(h1, h2, d, 0.0, g, r), du[j], du[j + 1],
-                  xtol=1e-12)
-    return float(f_c1), float(f_c2)
+    """(F_c1, F_c2) [m/s] of :func:`pdeflow.numerics.hyperbolicity.band_edges`, or None."""
+    return hyp.band_edges(h1, h2, g, r)
 
 
 def local_spectrum(h1: float, h2: float, r: float, du: float, g: float = G

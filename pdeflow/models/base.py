@@ -338,7 +338,10 @@ class GranularPDE(PDEBase):
         """Post-step hook applying the split source stage with dt = data[0].
 
         Every py-pde solver builds this hook before its first step, so the initial
-        state is validated here (:meth:`check_state`) whatever the solver.
+        state is validated here (:meth:`check_state`) whatever the solver. A step that
+        left a non-finite value or a depth below -1e-12 m is counted in
+        ``data[D_BAD_STEPS]`` before the kernel clips it (generic solvers have no other
+        check; fv-split rejects such steps itself).
         """
         from ..numerics.compiled import ready
 
@@ -350,6 +353,8 @@ class GranularPDE(PDEBase):
 
         def post_step_hook(state_data, t, post_step_data):
             dt = post_step_data[0]
+            if not (np.all(np.isfinite(state_data)) and np.all(state_data[::2] >= -1e-12)):
+                post_step_data[L.D_BAD_STEPS] += 1.0  # the kernel clips what it counts
             kernel(state_data, dt, t + dt, P, post_step_data)
             return state_data, post_step_data
 

@@ -185,3 +185,28 @@ def band_lower_edge(h1: float, h2: float, g: float, r: float, du_bad: float) -> 
         if hi - lo <= 1e-10 * hi:
             break
     return 2.0 * math.sqrt(lo * c2)
+
+
+BAND_SAMPLES = 2000
+"""du samples on [0, 1.05 F_R] that find the band before its edges are refined"""
+
+
+def band_edges(h1: float, h2: float, g: float, r: float) -> tuple[float, float] | None:
+    """(F_c1, F_c2) [m/s]: the band of |du| where two eigenvalues are complex, or None.
+
+    The band is located on a grid of :data:`BAND_SAMPLES` values of du up to 1.05 F_R
+    (F_R bounds it from above); F_c1 is then :func:`band_lower_edge` (the target of the
+    restoration), F_c2 the discriminant's root above the last complex sample.
+    """
+    from scipy.optimize import brentq
+
+    du = np.linspace(0.0, 1.05 * upper_bound_fr(h1, h2, g, r), BAND_SAMPLES + 1)
+    disc = np.array([discriminant(h1, h2, d, 0.0, g, r) for d in du])
+    bad = np.nonzero(disc < 0.0)[0]
+    if bad.size == 0:
+        return None
+    f_c1 = band_lower_edge(h1, h2, g, r, du[bad[0]])
+    j = bad[-1]
+    f_c2 = brentq(lambda d: discriminant(h1, h2, d, 0.0, g, r), du[j], du[j + 1],
+                  xtol=1e-12)
+    return float(f_c1), float(f_c2)

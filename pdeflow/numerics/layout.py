@@ -56,7 +56,9 @@ D_CHANGED = 12  #: 1 if the last source stage changed any depth or momentum
 D_STEPS = 13  #: number of source stages applied
 D_FLUX_FALLBACKS = 14  #: steps redone with HLL because the IFCP step was not positive
 D_HYP_BISECTIONS = 15  #: restorations that needed the bisection fallback (see splitting)
-N_DIAG = 16  #: the per-cell F_extra/rho1 of the last step follows at N_DIAG
+D_BAD_STEPS = 16  #: steps of a generic py-pde solver that left a non-finite value or a depth
+#: below -1e-12 m, before the post-step hook clipped it (models.base.make_post_step_hook)
+N_DIAG = 17  #: the per-cell F_extra/rho1 of the last step follows at N_DIAG
 
 # --- boundary conditions ---------------------------------------------------------------
 BC_WALL = 0
