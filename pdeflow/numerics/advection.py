@@ -30,7 +30,7 @@ import functools
 from typing import Any
 
 import numpy as np
-from numba import literal_unroll, njit
+from numba import njit
 
 from . import layout as L
 from .compiled import FIELDS, STATE, WORK, f8, i8, kernel, specialise
@@ -243,40 +243,3 @@ def rate_kernel(two_layer: bool, flux: int, order: int, limiter: int) -> Any:
 
     return specialise(advection_rate, *ADVECT_SIGNATURE[:-2])
 
-
-@functools.cache
-def _any_scheme_rate(two_layer: bool) -> Any:
-    """:func:`rate_kernel` with the scheme given at run time (every scheme compiled)."""
-    schemes = tuple((3 * flux + recon, rate_kernel(two_layer, flux, order, limiter))
-                    for flux in (L.FLUX_HLL, L.FLUX_RUSANOV, L.FLUX_IFCP)
-                    for recon, (order, limiter) in enumerate(
-                        ((1, L.LIMITER_MINMOD), (2, L.LIMITER_MINMOD), (2, L.LIMITER_MC))))
-
-    def rate(q, out, work, dx, bc_left, bc_right, g, r, dry, flux, order, limiter):
-        j = 3 * flux + (0 if order == 1 else (2 if limiter == L.LIMITER_MC else 1))
-        smax = 0.0
-        for scheme in literal_unroll(schemes):
-            if scheme[0] == j:
-                smax = scheme[1](q, out, work, dx, bc_left, bc_right, g, r, dry)
-        return smax
-
-    any_rate = specialise(rate, *ADVECT_SIGNATURE[:-2], i8, i8, i8)
-    if two_layer:
-        return any_rate
-
-    def rate_single(q, out, work, dx, bc_left, bc_right, g, dry, flux, order, limiter):
-        return any_rate(q, out, work, dx, bc_left, bc_right, g, 0.0, dry, flux, order,
-                        limiter)
-
-    return specialise(rate_single, STATE, FIELDS, WORK, f8, i8, i8, f8, f8, i8, i8, i8)
-
-
-def __getattr__(name: str) -> Any:
-    """``rate_two_layer(q, out, work, dx, bc_left, bc_right, g, r, dry, flux, order,
-    limiter)`` and ``rate_single(..., g, dry, flux, order, limiter)``: the advection
-    rate with the scheme chosen at run time, for callers that cannot choose it in
-    Python (analysis.stability's ``mol_run``); built on first use, they compile every
-    scheme."""
-    if name in ("rate_single", "rate_two_layer"):
-        return _any_scheme_rate(name == "rate_two_layer")
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

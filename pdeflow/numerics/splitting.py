@@ -44,16 +44,7 @@ from .compiled import (
     specialise,
 )
 from .friction import predictor_single, predictor_two_layer
-from .source_stage import (
-    source_stage_single,
-    source_stage_two_layer,
-    sources_single,
-    sources_two_layer,
-)
-
-# the full-grid source stages are imported from here by analysis.stability's mol_run
-__all__ = ["source_stage_single", "source_stage_two_layer", "stepping_kernel", "Stepper",
-           "scheme_stepper", "advance_split", "STATUS_END", "STATUS_REST", "STATUS_FAIL"]
+from .source_stage import sources_single, sources_two_layer
 
 STATUS_END = 0  #: reached t_end
 STATUS_REST = 1  #: everything at rest: nothing will change any more
