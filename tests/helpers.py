@@ -10,7 +10,7 @@ import pytest
 from pde import CartesianGrid
 
 import pdeflow
-from pdeflow.numerics.splitting import advance_split
+from pdeflow.numerics.splitting import scheme_stepper
 
 
 def grid(n: int = 100, lo: float = 0.0, hi: float = 1.0) -> CartesianGrid:
@@ -23,10 +23,10 @@ def step(eq, state, t_end: float, cfl: float = 0.3, stop_at_rest: bool = False,
     q = state.data.copy()
     diag = eq.new_diagnostics(q.shape[1])
     dx = float(state.grid.discretization[0])
-    t, steps, status = advance_split(q, 0.0, t_end, dx, *eq.bc_codes,
-                                     eq.parameter_array(), cfl, diag, np.empty_like(q),
-                                     np.empty_like(q), np.empty((3, *q.shape)), max_steps,
-                                     eq.two_layer, stop_at_rest, *eq.scheme_codes, strang)
+    stepper = scheme_stepper(eq.two_layer, *eq.scheme_codes, strang)
+    t, steps, status = stepper(q, 0.0, t_end, dx, *eq.bc_codes, eq.parameter_array(), cfl,
+                               diag, np.empty_like(q), np.empty_like(q),
+                               np.empty((3, *q.shape)), max_steps, stop_at_rest)
     return q, t, steps, status, diag
 
 

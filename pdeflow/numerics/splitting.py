@@ -367,15 +367,3 @@ def python_stepping(two_layer: bool, flux: int, order: int, limiter: int, strang
                              advect_step_function(order, strang, update))
     return functools.partial(compiled.run, loop)
 
-
-def advance_split(q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int,
-                  bc_right: int, P: np.ndarray, cfl: float, diag: np.ndarray,
-                  rate: np.ndarray, backup: np.ndarray, work: np.ndarray, max_steps: int,
-                  two_layer: bool, stop_at_rest: bool, flux: int, order: int,
-                  limiter: int, strang: bool) -> tuple[float, int, int]:
-    """:func:`scheme_stepper` of the scheme given by ``two_layer``, ``flux``, ``order``,
-    ``limiter`` and ``strang``, called on the other arguments: ``(t, steps, status)``."""
-    return scheme_stepper(bool(two_layer), int(flux), int(order), int(limiter),
-                          bool(strang))(
-        q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, work, max_steps,
-        stop_at_rest)
