@@ -213,6 +213,12 @@ def render(data: dict[str, Any]) -> str:
                  f"{f(s['imports_s'])} | {f(s['compile_s'])} | {f(s.get('figures_s'))} | "
                  f"{f(s['other_s'])} | "
                  f"{f(d['warm']['wall_s'])} | {len(d['kernels'])} ({d['signatures']}) |")
+    label, d = list(data.items())[-1]
+    s = d["split"]
+    rest = s["imports_s"] + s.get("figures_s", 0.0) + s["other_s"]
+    L.append(f"\nWithout any compilation the command would still take {rest:.1f} s "
+             f"(*{label}*: imports, figures and the rest), the floor of a cold run; "
+             f"compiling took {s['compile_s']:.1f} s of {s['wall_s']:.1f} s.")
     for label, d in data.items():
         L.append(f"\nKernels compiled by the cold run, *{label}*: "
                  + ", ".join(f"`{k.replace('pdeflow.numerics.', '').replace('.<locals>', '')}`"

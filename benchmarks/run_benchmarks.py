@@ -559,7 +559,7 @@ def _findings(wp: dict[str, Any] | None, b: dict[str, Any] | None) -> str:
             "flux, reconstruction and limiter), source stage and predictor are its "
             "arguments. Parameters are an array and the grid an argument, so a sweep "
             "over them never recompiles, and a run compiles only what its scheme calls "
-            "(cold first run below). What "
+            "(see *Cold first run*). What "
             "a scene does not need is skipped by branches: dry cells and absent layers "
             "(the loops' range and per-cell tests), the hyperbolicity stage where a layer "
             "is absent, F_extra writes except where it is applied, the time after rest "
