@@ -156,6 +156,8 @@ class Variant:
             how = f"py-pde {self.solver}, fixed dt, method of lines"
         hyp = {"exact": "exact hyperbolicity test", "bound": "hyperbolicity restored "
                "below F_L only", "none": "no hyperbolicity correction"}[self.hyperbolicity]
+        if self.is_mol:  # the hook runs the source stage with dt = 0: nothing to restore
+            hyp = "no hyperbolicity correction (sources in the rate)"
         return f"{self.flux.upper()} flux, {rec}; {how}; {hyp}"
 
     @property

@@ -1,6 +1,6 @@
 """Regenerate docs/stability.md's generated sections and its figures: the stability study.
 
-    python docs/generate/stability.py               # CFL search and map (~15 min on 2 cores)
+    python docs/generate/stability.py               # CFL search and map (~40 min on 2 cores)
     python docs/generate/stability.py --extremes    # also the heavy extreme runs (~2 min)
 
 Runs the largest-stable-CFL search and the stability map of every variant

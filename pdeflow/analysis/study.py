@@ -115,7 +115,7 @@ def case_on_grid(case: Case, grid: float | int, variant: Variant,
         sets.append(f"numerics.cfl={float(cfl)!r}")
     c = with_sets(case, sets, validate=False)
     c.data["grid"].pop("dx", None)
-    c.data["numerics"].pop("dt", None)
+    c.data.get("numerics", {}).pop("dt", None)
     return c.with_variant(variant)  # validates once, with every change made
 
 
