@@ -13,13 +13,12 @@ import sys
 import time
 import warnings
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 from pde import FieldCollection
 
-from .cases import Case, load_case
+from .cases import Case
 from .checks import RunWarning, cost_warning, domain_ends, result_warnings, solver_warning
 from .metrics import front_position, mass
 from .models.base import GranularPDE
@@ -101,12 +100,6 @@ class Run:
         self.model = model
         self.backend = backend
         self.pde, self.state = self.case.make_state(model)
-
-    @classmethod
-    def from_file(cls, path: str | Path, model: str, overrides: list[str] | None = None,
-                  variant: Variant | str | None = None) -> Run:
-        """The run of ``model`` of a case file (with ``section.key=value`` overrides)."""
-        return cls(load_case(path, overrides), model, variant)
 
     def solver_arguments(self) -> dict[str, Any]:
         """Keyword arguments of py-pde's ``solve`` that select the integrator."""

@@ -20,7 +20,7 @@ parsed.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 from .numerics import layout as L
@@ -164,10 +164,6 @@ class Variant:
     def is_mol(self) -> bool:
         """True for a py-pde solver on the method-of-lines rate."""
         return self.solver != "fv-split"
-
-    def with_(self, **changes: Any) -> Variant:
-        """A copy with some fields changed (validated)."""
-        return replace(self, **changes)
 
     def numerics(self) -> dict[str, Any]:
         """The case file's ``[numerics]`` entries that select this variant."""

@@ -78,9 +78,9 @@ def on_grid(case: Case, *, cells: int | None = None, dx: float | None = None) ->
     return c
 
 
-def refined(case: Case, level: int, dx0: float | None = None) -> Case:
-    """Copy of ``case`` with dx = dx0 / 2**level (dx0: the case's dx)."""
-    return on_grid(case, dx=(case.dx if dx0 is None else dx0) / 2**level)
+def refined(case: Case, level: int) -> Case:
+    """Copy of ``case`` with dx = (the case's dx) / 2**level."""
+    return on_grid(case, dx=case.dx / 2**level)
 
 
 def with_sets(case: Case, items: Iterable[str], validate: bool = True) -> Case:
