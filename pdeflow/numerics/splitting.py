@@ -38,6 +38,7 @@ from .compiled import (
     WORK,
     entry,
     f8,
+    first_class,
     flag,
     i8,
     ready,
@@ -319,11 +320,15 @@ class Stepper:
         self.kernels = [k for k in (self.loop, self.advect, self.sources, self.predictor,
                                     self.fallback) if k is not None]
         entry(*self.kernels)
+        self.arguments: tuple[Any, ...] | None = None
 
     def ready(self) -> Stepper:
         """Compile (or load) every kernel of this scheme now."""
-        for kernel in self.kernels:
-            ready(kernel)
+        if self.arguments is None:
+            for kernel in self.kernels:
+                ready(kernel)
+            self.arguments = tuple(first_class(k) for k in (
+                self.advect, self.sources, self.predictor, self.fallback))
         return self
 
     def model_constants(self, P: np.ndarray) -> tuple[float, float, float]:
@@ -347,7 +352,7 @@ class Stepper:
         on the stepper's arguments."""
         return loop(q, t, t_end, dx, bc_left, bc_right, P, *self.model_constants(P), cfl,
                     diag, rate, backup, np.empty_like(diag), work, max_steps,
-                    stop_at_rest, self.advect, self.sources, self.predictor, self.fallback)
+                    stop_at_rest, *self.ready().arguments)
 
 
 @functools.cache
