@@ -22,9 +22,10 @@ from .cases import Case
 from .checks import RunWarning, cost_warning, domain_ends, result_warnings, solver_warning
 from .metrics import front_position, mass
 from .models.base import GranularPDE
+from .numerics import layout as L
 from .numerics.state import velocity_profile
 from .solvers.diagnostics import SplitDiagnostics
-from .solvers.fv_split import load_kernels
+from .solvers.fv_split import SimulationBlowUp, load_kernels
 from .trackers import FextraStorageTracker
 from .variant import Variant
 
@@ -154,6 +155,16 @@ class Run:
                                     f"t={info['controller'].get('t_final')}")
         sinfo = info.get("solver", {})
         data = sinfo.get("post_step_data")
+        if self.variant.is_mol and not np.all(np.isfinite(final.data)):
+            # py-pde's solvers have no step control: a blow-up runs on to t_end as NaN
+            bad = int(data[L.D_BAD_STEPS]) if isinstance(data, np.ndarray) else 0
+            raise SimulationBlowUp(
+                f"{model} run of {case.name} with {self.variant.name} "
+                f"(dt={self.solver_arguments()['dt']:g} s) blew up: the state is not "
+                f"finite at t={case.t_end:g} s ({bad} step(s) left a non-finite value or "
+                f"a negative depth); nothing is kept. Use a smaller numerics.dt, or the "
+                f"fv-split solver (CFL-limited).",
+                report={"variant": self.variant.name}, state=final.data.copy())
         diag = (SplitDiagnostics.from_array(data)
                 if isinstance(data, np.ndarray) and not self.variant.is_mol else None)
         t_final = float(sinfo.get("rest_time", info["controller"].get("t_final",

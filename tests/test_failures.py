@@ -371,6 +371,27 @@ def test_failed_run_from_the_command_line_writes_no_file(tmp_path):
     assert left == []
 
 
+@pytest.mark.filterwarnings("ignore::pdeflow.checks.RunWarning")
+def test_method_of_lines_run_that_blows_up_is_an_error_not_a_result(tmp_path):
+    """py-pde's solvers have no step control: a run whose state turns non-finite used
+    to go on to t_end and hand back NaN as its result. It now fails like fv-split
+    does, and the command line writes nothing."""
+    from pdeflow.cli import main
+    from pdeflow.simulate import run_model
+
+    sets = ["numerics.solver='runge-kutta'", "numerics.dt=0.001", "case.t_end=0.5",
+            "case.models=['two_layer']", "output.snapshot_times=[]"]
+    with pytest.raises(SimulationBlowUp, match="mol-rk .*dt=0.001 s.* blew up.*"
+                       "numerics.dt"):
+        run_model(load_case(CASE, sets), "two_layer")
+    # the same run with a small enough step is a result
+    ok = run_model(load_case(CASE, [*sets, "numerics.dt=1e-4"]), "two_layer")
+    assert np.all(np.isfinite(ok.state.data)) and ok.summary["t_final"] == 0.5
+    rc = main(["run", str(CASE), "-q", *sum((["--set", s] for s in sets), []),
+               "--summary", str(tmp_path / "s.json")])
+    assert rc == 3 and list(tmp_path.iterdir()) == []
+
+
 # --- output files: complete or absent ------------------------------------------------------
 
 def test_atomic_write_interrupted_leaves_no_file_and_keeps_the_old_one(tmp_path):
