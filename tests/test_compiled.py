@@ -104,3 +104,23 @@ print("STATS" + json.dumps(out))
     assert stats[0] == [[0, 1], [0, 1]]  # compiled
     assert stats[1] == [[1, 0], [1, 0]]  # loaded, each under its own key
 
+
+
+@pytest.mark.skipif(config.DISABLE_JIT, reason="no cache without the JIT")
+def test_cache_key_follows_the_code_of_every_called_kernel(monkeypatch):
+    """A kernel's disk-cache key changes when a kernel it calls, in another file and
+    two calls down, changes (numba's own key, the file's time stamp, does not: a stale
+    cache once gave a wrong test 5.1 result)."""
+    from pdeflow.numerics import compiled, sources
+    from pdeflow.numerics.source_stage import sources_two_layer
+
+    def key() -> tuple:
+        return sources_two_layer._cache._index_key(
+            compiled._SIGNATURES[sources_two_layer], sources_two_layer.targetctx.codegen())
+
+    before = key()
+    assert key() == before  # the same in every call (and process: test above)
+    # sources_two_layer -> friction.implicit_friction -> sources.friction_two_layer
+    monkeypatch.setattr(sources.friction_two_layer.py_func, "__code__",
+                        sources.coulomb_single.py_func.__code__)
+    assert key() != before

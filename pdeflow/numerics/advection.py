@@ -30,15 +30,14 @@ import functools
 from typing import Any
 
 import numpy as np
-from numba import njit
 
 from . import layout as L
-from .compiled import FIELDS, STATE, WORK, f8, i8, kernel, specialise
+from .compiled import FIELDS, STATE, WORK, cached, f8, i8, kernel, specialise
 from .pvm import face_single, face_two_layer, fluctuation_kernel
 from .state import velocity
 
 
-@njit(cache=True)
+@cached
 def _is_wet(q: np.ndarray, i: int, dry: float) -> bool:
     for k in range(0, q.shape[0], 2):
         if q[k, i] > dry:
@@ -61,7 +60,7 @@ def wet_cells(q: np.ndarray, dry: float, start: int, stop: int) -> tuple[int, in
     return lo, hi
 
 
-@njit(cache=True)
+@cached
 def _limited(a: float, b: float, limiter: int) -> float:
     if a * b <= 0.0:
         return 0.0
@@ -123,7 +122,7 @@ def reconstruct_muscl(q: np.ndarray, work: np.ndarray, lo: int, hi: int, bc_left
             work[1, k + 1, i] = hp * (u + 0.5 * su) if hp > dry else 0.0
 
 
-@njit(cache=True)
+@cached
 def cell_jump_single(qm: np.ndarray, qp: np.ndarray, rate: np.ndarray, lo: int, hi: int,
                      inv_dx: float, g: float, r: float, dry: float) -> None:
     """Subtract the flux difference across the reconstruction inside cells lo..hi
@@ -137,7 +136,7 @@ def cell_jump_single(qm: np.ndarray, qp: np.ndarray, rate: np.ndarray, lo: int, 
                        - ul * ul * hl - 0.5 * g * hl * hl) * inv_dx
 
 
-@njit(cache=True)
+@cached
 def cell_jump_two_layer(qm: np.ndarray, qp: np.ndarray, rate: np.ndarray, lo: int,
                         hi: int, inv_dx: float, g: float, r: float, dry: float) -> None:
     """Subtract the path-conservative jump across the linear reconstruction inside cells

@@ -19,9 +19,10 @@ What the factories and the kernels share is kept here:
   compatible types (a C-contiguous state, a writable parameter vector, a literal int) is
   converted instead of compiling a second signature.
 * :func:`specialise` caches a closure on disk under a key made of the constants it
-  closes over and the code of the kernels it calls (numba's own key pickles a closed-over
-  kernel, which gives a new key in every process, so such a closure would never be
-  loaded from the cache).
+  closes over and the code of the kernels it calls (numba's own key pickles a
+  closed-over kernel, which gives a new key in every process, so such a closure would
+  never be loaded from the cache); :func:`cached`, which every other kernel uses, keys
+  module-level kernels by their code and their callees' the same way.
 * :func:`kernels`, :func:`kernels_ready`, :func:`kernels_cached`: what is compiled.
 """
 
@@ -64,12 +65,26 @@ def kernel(*arg_types: Any) -> Callable:
     ``arg_types``, compiled lazily (by :func:`ready`, or by the first caller)."""
 
     def wrap(func: Callable) -> Any:
-        compiled = njit(cache=True)(func)
+        compiled = cached(func)
         if isinstance(compiled, Dispatcher):  # not with NUMBA_DISABLE_JIT=1
             _SIGNATURES[compiled] = tuple(arg_types)
         return compiled
 
     return wrap
+
+
+def cached(func: Callable | None = None, *, inline: str = "never") -> Any:
+    """Decorator: ``numba.njit`` with the disk cache keyed by the code of the function
+    and of every kernel it calls (see :class:`_CodeKeyedCache`); ``@cached`` or
+    ``@cached(inline="always")``."""
+
+    def wrap(f: Callable) -> Any:
+        compiled = njit(inline=inline)(f)
+        if isinstance(compiled, Dispatcher):  # not with NUMBA_DISABLE_JIT=1
+            compiled._cache = _CodeKeyedCache(f)
+        return compiled
+
+    return wrap(func) if func is not None else wrap
 
 
 def specialise(func: Callable, *arg_types: Any) -> Any:
@@ -79,7 +94,7 @@ def specialise(func: Callable, *arg_types: Any) -> Any:
     if config.DISABLE_JIT:
         return func
     compiled = njit(func)
-    compiled._cache = _ConstantsKeyedCache(func)
+    compiled._cache = _CodeKeyedCache(func)
     _SIGNATURES[compiled] = tuple(arg_types)
     _SPECIALISED.append(compiled)
     return compiled
@@ -223,10 +238,12 @@ def _describe(value: Any, depth: int = 0) -> Any:
     raise TypeError(f"a specialised kernel cannot close over {value!r}")
 
 
-class _ConstantsKeyedCache(FunctionCache):
-    """numba's disk cache for a closure, keyed by what it closes over (see the module
-    docstring) and by the code of every kernel it calls: a changed callee is recompiled,
-    which numba's own cache does not notice."""
+class _CodeKeyedCache(FunctionCache):
+    """numba's disk cache for a kernel, keyed by its code, what it closes over (see the
+    module docstring) and the code of every kernel it calls. numba's own key is the
+    kernel's source file's time stamp: a kernel whose callee in another file changed
+    was loaded with the old callee compiled in (a stale cache once gave a wrong test
+    5.1 result); here it is recompiled."""
 
     def _index_key(self, sig: Any, codegen: Any) -> tuple:
         own = repr(_describe_function(self._py_func)).encode()

@@ -14,16 +14,15 @@ f = F_extra/rho2 [m^2/s^2], velocities [m/s], depths [m].
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from . import layout as L
-from .compiled import PARAMS, STATE, f8, i8, kernel
+from .compiled import PARAMS, STATE, cached, f8, i8, kernel
 from .hyperbolicity import band_lower_edge, is_hyperbolic, lower_bound_fl
 from .sources import _drag_root, coulomb_single, friction_two_layer
 from .state import velocity
 
 
-@njit(cache=True)
+@cached
 def implicit_friction(b1, b2, h1, h2, dt, P, f, k, c):
     """Implicit stage (32) for one cell with extra exchange ``f`` = F_extra/rho2 and the
     interface law (22) with friction reduction ``k`` and collisional coefficient ``c``
@@ -53,7 +52,7 @@ def implicit_friction(b1, b2, h1, h2, dt, P, f, k, c):
     return 0.0, 0.0
 
 
-@njit(cache=True)
+@cached
 def bisect_fextra(b1, b2, h1, h2, du0, dt, P, k, c):
     """F_extra/rho2 [m^2/s^2] by bracketing and bisection on the hyperbolicity test:
     the fallback of :func:`restore_hyperbolicity`, stopping when the bracket in du is
@@ -92,7 +91,7 @@ def bisect_fextra(b1, b2, h1, h2, du0, dt, P, k, c):
     return f_hi
 
 
-@njit(cache=True)
+@cached
 def restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P, k, c):
     r"""Smallest F_extra/rho2 [m^2/s^2] making the post-friction state hyperbolic, the
     velocities (u1, u2) [m/s] it leads to, and whether the bisection fallback was used.

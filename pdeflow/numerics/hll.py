@@ -44,10 +44,10 @@ H = h1 + h2, which is used on both sides (only wet layers contribute a velocity)
 
 from __future__ import annotations
 
-from numba import njit
+from .compiled import cached
 
 
-@njit(cache=True)
+@cached
 def hll_coefficients(sL: float, sR: float) -> tuple[float, float, float]:
     """Viscosity polynomial Q(x) = a0 + a1 x of HLL: the line through (S_L, |S_L|) and
     (S_R, |S_R|). With D^-+ = (A dq -+ Q(A) dq)/2 this gives the HLL fluctuations above

@@ -42,10 +42,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from .compiled import cached
 
 
-@njit(cache=True)
+@cached
 def lower_bound_fl(h1: float, h2: float, g: float, r: float) -> float:
     """Closed-form lower edge F_L [m/s] of the non-hyperbolic band (Castro-Diaz 2023)."""
     H = h1 + h2
@@ -53,13 +54,13 @@ def lower_bound_fl(h1: float, h2: float, g: float, r: float) -> float:
     return math.sqrt(g * H * H * H / (2.0 * h1 * h2) * (1.0 - math.sqrt(max(disc, 0.0))))
 
 
-@njit(cache=True)
+@cached
 def upper_bound_fr(h1: float, h2: float, g: float, r: float) -> float:
     """Upper bound F_R [m/s] of the non-hyperbolic band."""
     return math.sqrt(2.0 * g * (h1 + h2) * (1.0 + math.sqrt(r)))
 
 
-@njit(cache=True)
+@cached
 def eigenvalues(h1: float, h2: float, u1: float, u2: float, g: float,
                 r: float) -> np.ndarray:
     """The four roots of P(lambda), sorted by real part (complex array) [m/s]."""
@@ -81,7 +82,7 @@ def eigenvalues(h1: float, h2: float, u1: float, u2: float, g: float,
     return roots[order] + um
 
 
-@njit(cache=True)
+@cached
 def _quartic_in_a(h1: float, h2: float, r: float) -> tuple[float, float, float, float,
                                                               float]:
     r"""Coefficients (a4, a3, a2, a1, a0) of Delta/16 as a quartic in A = (du/2)^2/(g H).
@@ -104,7 +105,7 @@ def _quartic_in_a(h1: float, h2: float, r: float) -> tuple[float, float, float, 
             c * (4.0 * c - 1.0) ** 2)
 
 
-@njit(cache=True)
+@cached
 def discriminant(h1: float, h2: float, u1: float, u2: float, g: float,
                  r: float) -> float:
     """Discriminant of P in units of (g H)^6 (>= 0: all four roots real)."""
@@ -114,7 +115,7 @@ def discriminant(h1: float, h2: float, u1: float, u2: float, g: float,
     return 16.0 * ((((a4 * A + a3) * A + a2) * A + a1) * A + a0)
 
 
-@njit(cache=True)
+@cached
 def is_hyperbolic(h1: float, h2: float, u1: float, u2: float, g: float, r: float,
                   mode: int) -> bool:
     """Hyperbolicity test: mode 1 exact inner roots (paper), mode 2 the bound F_L only.
@@ -130,7 +131,7 @@ def is_hyperbolic(h1: float, h2: float, u1: float, u2: float, g: float, r: float
     return discriminant(h1, h2, u1, u2, g, r) >= 0.0
 
 
-@njit(cache=True)
+@cached
 def band_lower_edge(h1: float, h2: float, g: float, r: float, du_bad: float) -> float:
     """Lower edge F_c1 [m/s] of the non-hyperbolic band, given a non-hyperbolic |du|.
 

@@ -25,12 +25,11 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
+from .compiled import cached
 from .hll import hll_coefficients
 
 
-@njit(cache=True)
+@cached
 def ifcp_coefficients(sL: float, sR: float, sint: float) -> tuple[float, float, float]:
     """Coefficients (a0, a1, a2) of the parabola through |x| at S_L, S_int, S_R."""
     width = sR - sL
@@ -41,7 +40,7 @@ def ifcp_coefficients(sL: float, sR: float, sint: float) -> tuple[float, float, 
     return abs(sL) - d1 * sL + d2 * sL * sR, d1 - d2 * (sL + sR), d2
 
 
-@njit(cache=True)
+@cached
 def internal_speed(h1: float, u1: float, h2: float, u2: float, g: float,
                    r: float) -> float:
     """Approximate internal eigenvalue of larger magnitude [m/s] (see module doc)."""
@@ -55,7 +54,7 @@ def internal_speed(h1: float, u1: float, h2: float, u2: float, g: float,
     return uc + c if abs(uc + c) >= abs(uc - c) else uc - c
 
 
-@njit(cache=True)
+@cached
 def roe_coefficients(lam1: float, lam2: float, delta: float) -> tuple[float, float, float]:
     """Line through the entropy-fixed |lambda| at the two Roe eigenvalues (one layer)."""
     a1 = abs(lam1) if abs(lam1) >= delta else (lam1 * lam1 + delta * delta) / (2 * delta)

@@ -26,10 +26,8 @@ import functools
 import math
 from typing import Any
 
-from numba import njit
-
 from . import layout as L
-from .compiled import f8, specialise, types
+from .compiled import cached, f8, specialise, types
 from .hll import hll_coefficients
 from .ifcp import ifcp_coefficients, internal_speed, roe_coefficients
 from .rusanov import rusanov_coefficients
@@ -40,7 +38,7 @@ IFCP_MIN_FRACTION = 0.05
 depth; elsewhere (near a layer's front or where a layer thins out) the HLL line."""
 
 
-@njit(cache=True)
+@cached
 def _roe_velocity(hL: float, uL: float, hR: float, uR: float) -> float:
     sl = math.sqrt(max(hL, 0.0))
     sr = math.sqrt(max(hR, 0.0))
@@ -49,14 +47,14 @@ def _roe_velocity(hL: float, uL: float, hR: float, uR: float) -> float:
     return (sl * uL + sr * uR) / (sl + sr)
 
 
-@njit(cache=True, inline="always")
+@cached(inline="always")
 def face_single(q, i, sign):
     """State ``(h, hu)`` of cell (or face value) ``i`` of ``q``, the momentum times
     ``sign`` (-1: the mirror image of a wall's ghost cell)."""
     return q[0, i], sign * q[1, i]
 
 
-@njit(cache=True, inline="always")
+@cached(inline="always")
 def face_two_layer(q, i, sign):
     """State ``(h1, h1u1, h2, h2u2)`` of cell ``i`` of ``q``, momenta times ``sign``."""
     return q[0, i], sign * q[1, i], q[2, i], sign * q[3, i]

@@ -9,10 +9,10 @@ much as the fast external ones.
 
 from __future__ import annotations
 
-from numba import njit
+from .compiled import cached
 
 
-@njit(cache=True)
+@cached
 def rusanov_coefficients(sL: float, sR: float) -> tuple[float, float, float]:
     """Q(x) = S_max: coefficients (a0, a1, a2) of the viscosity polynomial."""
     return max(abs(sL), abs(sR)), 0.0, 0.0

@@ -23,10 +23,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from . import layout as L
-from .compiled import PARAMS, STATE, VECTOR, f8, i8, kernel
+from .compiled import PARAMS, STATE, VECTOR, cached, f8, i8, kernel
 from .friction import implicit_friction, restore_hyperbolicity
 from .hyperbolicity import is_hyperbolic
 from .sources import coulomb_single, exchange_step
@@ -187,7 +186,7 @@ def sources_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
     _close_stage(diag, t, moving, fast, False, False, False)
 
 
-@njit(cache=True, inline="always")
+@cached(inline="always")
 def _close_stage(diag, t, moving1, fast1, moving2, fast2, changed):
     """Book a source stage ending at ``t`` [s] in ``diag``: the times of the last motion
     (``moving``: a layer has momentum; ``fast``: faster than SLOW_U where deeper than

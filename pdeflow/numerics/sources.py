@@ -77,10 +77,10 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from .compiled import cached
 
 
-@njit(cache=True)
+@cached
 def _sign(x: float) -> float:
     if x > 0.0:
         return 1.0
@@ -89,7 +89,7 @@ def _sign(x: float) -> float:
     return 0.0
 
 
-@njit(cache=True)
+@cached
 def coulomb_single(b: float, mu_dt: float) -> float:
     """Backward-Euler Coulomb step u = b - mu_dt Sgn(u) (set-valued): shrink towards 0.
 
@@ -102,7 +102,7 @@ def coulomb_single(b: float, mu_dt: float) -> float:
     return 0.0
 
 
-@njit(cache=True)
+@cached
 def _drag_root(y: float, mass: float, cdt: float) -> float:
     """Positive x with mass x + cdt x^2 = y (y >= 0), in a cancellation-free form."""
     if y <= 0.0:
@@ -112,7 +112,7 @@ def _drag_root(y: float, mass: float, cdt: float) -> float:
     return 2.0 * y / (mass + math.sqrt(mass * mass + 4.0 * cdt * y))
 
 
-@njit(cache=True)
+@cached
 def friction_two_layer(b1, b2, m1, m2, Kdt, Cdt, Bdt):
     """Solve the coupled implicit friction step for (u1, u2); see module docstring.
 
@@ -137,7 +137,7 @@ def friction_two_layer(b1, b2, m1, m2, Kdt, Cdt, Bdt):
     return u2 + d, u2
 
 
-@njit(cache=True)
+@cached
 def closure_rate(h1: float, du: float, r: float, g: float, tan_int: float, k: float,
                  c: float, du_reg: float) -> float:
     """Kinematic mass flux M/rho2 [m/s] of closure (25); -inf at du = 0 if du_reg = 0."""
@@ -150,7 +150,7 @@ def closure_rate(h1: float, du: float, r: float, g: float, tan_int: float, k: fl
     return 0.0
 
 
-@njit(cache=True)
+@cached
 def relaxed_rate(m: float, h1: float, h2: float, du: float, r: float, g: float,
                  tan_int: float, k: float, c: float, tau: float) -> float:
     """Rate form of the relaxed closure: the kinematic mass flux ``m`` = M/rho2 [m/s]
@@ -167,7 +167,7 @@ def relaxed_rate(m: float, h1: float, h2: float, du: float, r: float, g: float,
     return m
 
 
-@njit(cache=True)
+@cached
 def exchange_depth(h1: float, h2: float, du: float, dt: float, r: float, g: float,
                    tan_int: float, k: float, c: float, du_reg: float,
                    film: float, tau: float) -> float:
@@ -182,7 +182,7 @@ def exchange_depth(h1: float, h2: float, du: float, dt: float, r: float, g: floa
     return exchange_step(h1, h2, du, dt, r, g, tan_int, k, c, du_reg, film, tau)[0]
 
 
-@njit(cache=True)
+@cached
 def exchange_step(h1: float, h2: float, du: float, dt: float, r: float, g: float,
                   tan_int: float, k: float, c: float, du_reg: float, film: float,
                   tau: float) -> tuple[float, float]:

@@ -36,6 +36,7 @@ from .compiled import (
     STATE,
     VECTOR,
     WORK,
+    cached,
     entry,
     f8,
     first_class,
@@ -52,7 +53,7 @@ STATUS_REST = 1  #: everything at rest: nothing will change any more
 STATUS_FAIL = 2  #: non-finite or negative state: the step was undone
 
 
-@njit(cache=True, inline="always")
+@cached(inline="always")
 def update(q, base, rate, dt, weight, lo, hi):
     """q <- weight * base + (1 - weight) * (q + dt * rate) in cells ``lo..hi``; returns
     (max |mass rate|, ok).
@@ -75,7 +76,7 @@ def update(q, base, rate, dt, weight, lo, hi):
     return mass_rate, ok
 
 
-@njit(cache=True, inline="always")
+@cached(inline="always")
 def _copy_cells(dst, src, lo, hi):
     """dst[..., lo:hi + 1] = src[..., lo:hi + 1] for 2D arrays (a loop: numba compiles
     an array-to-array slice assignment with its shape-mismatch error message, seconds)."""
@@ -84,7 +85,7 @@ def _copy_cells(dst, src, lo, hi):
             dst[k, i] = src[k, i]
 
 
-@njit(cache=True, inline="always")
+@cached(inline="always")
 def _copy_range(dst, src, lo, hi):
     """dst[lo:hi + 1] = src[lo:hi + 1] for 1D arrays (see :func:`_copy_cells`)."""
     for i in range(lo, hi + 1):

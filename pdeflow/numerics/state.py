@@ -11,14 +11,15 @@ wrote, a threshold at or below the model's dry tolerance gives the same velociti
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .compiled import cached
 
 DRY_TOLERANCE = 1e-6
 """Default dry tolerance of the models [m]: a layer not thicker than this has zero
 velocity (the parameter ``dry_tolerance`` of both models)."""
 
 
-@njit(cache=True)
+@cached
 def velocity(h: float, m: float, dry: float) -> float:
     """Depth-averaged velocity m/h [m/s]; zero where the layer is thinner than ``dry``."""
     if h > dry:
