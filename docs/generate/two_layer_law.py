@@ -118,6 +118,44 @@ def run_51(params: dict, *extra: str) -> dict:
     return row
 
 
+def paper_51_figures(best: dict, meet52: list[dict]) -> list[str]:
+    """The paper's figures of test 5.1 (from its text and figures: the layers' stop
+    times, the upper layer's depth, F_extra, the run-outs) against the best set meeting
+    every target (the shipped case), and the best any set meeting the 5.2 fit achieves."""
+    single = run_model(load_case(CASE_51, ["case.models=['single_layer']", "case.t_end=10",
+                                           "output.snapshot_times=[]"]), "single_layer")
+    front_1 = single.summary["front_position"]
+    lower = [r["lower_rest"] for r in meet52 if r["lower_rest"] is not None]
+    upper = [r["upper_rest"] for r in meet52 if r["upper_rest"] is not None]
+    h1 = [best[f"h1max_{t}"] for t in TIMES]
+
+    def yes(ok: bool) -> str:
+        return "yes" if ok else "**no**"
+
+    return ["", f"The shipped set ({_set_name(best)}, `cases/paper_5_2_two_layer_law.toml`)"
+            " against the paper's figures of 5.1 (dx = 0.05 m), and the closest any of the "
+            f"{len(meet52)} sets meeting the 5.2 fit comes:", "",
+            "| 5.1 figure | paper | shipped set | reproduced? | best of the sets meeting "
+            "the 5.2 fit |", "|---|---|---|---|---|",
+            f"| lower layer at rest | about 0.7 s | {_fmt(best['lower_rest'])} s | "
+            f"{yes(abs(best['lower_rest'] - 0.7) <= 0.15)} | earliest "
+            f"{min(lower):.2f} s |",
+            f"| upper layer at rest | just before 1.5 s | {_fmt(best['upper_rest'])} s | "
+            f"{yes(1.3 <= best['upper_rest'] <= 1.5)} | "
+            f"{sum(1.3 <= u <= 1.5 for u in upper)} sets in 1.3-1.5 s |",
+            f"| lower layer stops first | yes | "
+            f"{'yes' if best['lower_rest'] <= best['upper_rest'] else 'no'} | "
+            f"{yes(best['lower_rest'] <= best['upper_rest'])} | |",
+            f"| upper layer 0.2-1 m deep (deepest cell, 0.1-0.7 s) | yes | "
+            f"{min(h1):.2f}-{max(h1):.2f} m | {yes(best['upper_ok'])} | "
+            f"{sum(r['upper_ok'] for r in meet52)} sets |",
+            f"| max F_extra/rho1 | below 2 m^2/s^2 | {_fmt(best['fextra'])} | "
+            f"{yes(best['fextra'] < 2)} | |",
+            f"| two-layer run-out shorter than the single layer's | yes | "
+            f"{_fmt(best['front_51'])} m against {front_1:.2f} m | "
+            f"{yes(best['front_51'] < front_1)} | |"]
+
+
 def run_52(params: dict, *extra: str, models: str = "two_layer") -> dict:
     case = load_case(CASE_52, [f"case.models=['{models}']", *overrides(params), *extra])
     m = run_sweep(case)["models"][models]
@@ -444,14 +482,22 @@ STUDY_MAPS = {  # study name -> (varied keys, what the map above holds, closure,
     "two_layer_law_wedge_k": (("two_layer.k", "two_layer.c", "initial.wedge_angle_deg"),
                               None, "paper's closure bounded by du_reg = 0.05 m/s",
                               "phi_B = 41 deg"),
+    "two_layer_law_phi_b_k": (("two_layer.phi_b_deg", "two_layer.k", "two_layer.c"),
+                              None, "paper's closure bounded by du_reg = 0.05 m/s",
+                              "wedge 60 deg"),
+    "two_layer_law_relaxed_phi_b_k": (("two_layer.phi_b_deg", "two_layer.k", "two_layer.c"),
+                                      None, "relaxed closure, tau_star = 0.1",
+                                      "wedge 60 deg"),
 }
 """maps over a closure's regularisation and the other parameters, studies: pdeflow study
 cases/study_NAME.toml --out docs/studies/NAME (this script only reads their tables)"""
 LABELS = {"phi_b_deg": "phi_B", "wedge_angle_deg": "wedge"}
 
 
-def study_map_section(docs: Path, name: str) -> list[str]:
-    """Part C over one closure's regularisation, from a study's results table."""
+def study_map_section(docs: Path, name: str, found: list[dict]) -> list[str]:
+    """Part C over one closure's regularisation, from a study's results table; appends
+    every set whose finest two grids have a fit to ``found`` (closure, set name, its
+    exponent on each grid, on the finest one and the change between the finest two)."""
     keys, held, closure, fixed = STUDY_MAPS[name]
     labels = [LABELS.get(k.split(".")[1], k.split(".")[1]) for k in keys]
     study = f"studies/{name}"
@@ -459,8 +505,9 @@ def study_map_section(docs: Path, name: str) -> list[str]:
     if not path.exists():
         return []
     rows = []
-    # a study NAME_refine holds sets of NAME one level finer
-    for p in (path, docs / f"{study}_refine" / "results.csv"):
+    # studies NAME_refine, NAME_refine2 hold sets of NAME one and two levels finer
+    refines = sorted(docs.glob(f"{study}_refine*/results.csv"))
+    for p in (path, *refines):
         if p.exists():
             with open(p) as fh:
                 rows += [r for r in csv.DictReader(fh) if r["status"] == "ok"]
@@ -483,8 +530,9 @@ def study_map_section(docs: Path, name: str) -> list[str]:
              f"the study `cases/study_{name}.toml`, run by `pdeflow study "
              f"cases/study_{name}.toml --out docs/{study}` "
              f"([report]({study}/report.md)"
-             + (f"; one level finer for some sets: [report]({study}_refine/report.md)"
-                if (docs / f"{study}_refine").exists() else "")
+             + "".join(f"; {p.parent.name[len(name) + 1:].replace('_', ' ')} (finer "
+                       f"levels for some sets): [report]({p.parent.relative_to(docs)}/"
+                       "report.md)" for p in refines)
              + f"), MUSCL/mc, {fixed}; the change is between each set's "
              "two finest grids:", "",
              "| " + " | ".join(labels) + " | " + " | ".join(f"fit, dx {d}" for d in dxs)
@@ -500,10 +548,13 @@ def study_map_section(docs: Path, name: str) -> list[str]:
                          f"{r['prefactor']:.2f} a^{r['exponent']:.3f}"
                          + ("" if r["sweep_at_rest"] else "*"))
         e = [lv[dx]["exponent"] for dx in sorted(lv, reverse=True)[-2:]]  # finest two
-        if None in e:
+        if len(e) < 2 or None in e:
             ch = ok = sub = "-"
         else:
             d = abs(e[1] - e[0])
+            found.append({"closure": closure, "set": named(point), "exponent": e[1],
+                          "change": d, "levels": {dx: r["exponent"] for dx, r in
+                                                  lv.items() if r["exponent"] is not None}})
             ch, ok, sub = f"{d:.3f}", "yes" if d < 0.01 else "no", \
                 "yes" if e[1] < 0.95 else "no"
             (conv_all if d < 0.01 else []).append(e[1])
@@ -523,6 +574,54 @@ def study_map_section(docs: Path, name: str) -> list[str]:
         lines.append("* Sub-linear on the finer grid: " + ", ".join(
             f"{named(k)} ({e:.3f}, change {d:.3f})" for k, e, d in sub_all) + ".")
     return lines
+
+
+def overall_answer(found: list[dict]) -> list[str]:
+    """Part C across the study maps: per closure, the sets converged on the finest two
+    grids, and which of them are sub-linear."""
+    out = ["", "**Part C across the study maps** (MUSCL/mc; converged: the exponent "
+           "changes by < 0.01 between a set's two finest grids; the fits leave out runs "
+           "not at rest by t_end):", "",
+           "| closure | sets | converged | converged exponents | converged and "
+           "sub-linear (< 0.95) |", "|---|---|---|---|---|"]
+    for closure in dict.fromkeys(f["closure"] for f in found):
+        sets = [f for f in found if f["closure"] == closure]
+        conv = [f for f in sets if f["change"] < 0.01]
+        sub = [f for f in conv if f["exponent"] < 0.95]
+        es = [f["exponent"] for f in conv]
+        out.append(f"| {closure} | {len(sets)} | {len(conv)} | "
+                   + (f"{min(es):.3f} - {max(es):.3f}" if es else "-") + " | "
+                   + ("; ".join(f"{f['set']}: {f['exponent']:.3f}" for f in sub)
+                      or "none") + " |")
+    return out + ["", "![the study maps' exponents against dx]"
+                  "(figures/two_layer_law_study_convergence.png)"]
+
+
+def figure_study_convergence(found: list[dict], path: Path) -> None:
+    """Exponent against dx for every set of the study maps, one colour per closure;
+    the sets sub-linear on their finest grid drawn bold."""
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    closures = list(dict.fromkeys(f["closure"] for f in found))
+    shades = {True: ["tab:blue", "navy", "tab:cyan"], False: ["tab:red", "darkorange",
+                                                              "tab:brown"]}
+    colors = {c: shades[c.startswith("relaxed")].pop(0) for c in closures}
+    for f in found:
+        dxs = sorted(f["levels"])
+        sub = f["exponent"] < 0.95
+        ax.plot(dxs, [f["levels"][d] for d in dxs], color=colors[f["closure"]],
+                lw=1.8 if sub else 0.7, alpha=0.9 if sub else 0.4, marker=".")
+    for closure, color in colors.items():
+        ax.plot([], [], color=color, label=closure)
+    ax.axhspan(TARGET_E - TOL_E, TARGET_E + TOL_E, color="0.85", label="0.84 +- 0.05")
+    ax.set_xscale("log")
+    finest = sorted({d for f in found for d in f["levels"]})
+    log_ticks(ax.xaxis, finest)
+    ax.set_xlabel("dx [m]")
+    ax.set_ylabel("5.2 two-layer exponent (MUSCL/mc)")
+    ax.invert_xaxis()
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    save(fig, path)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -655,6 +754,8 @@ def main(argv: list[str] | None = None) -> int:
         lines += ["", "Sets meeting every target (best first):", "", head,
                   "|---|---|---|---|---|---|---|"]
         lines += [table_row(r) for r in meet_all[:10]]
+    if meet_all:
+        lines += paper_51_figures(meet_all[0], meet52)
     lines += ["", "Exponent at dx = 0.01 m over phi_B and c for each closure (at each point "
               "the k and wedge angle closest to the targets):", "",
               "![5.2 exponent maps](figures/two_layer_law_exponent_map.png)", ""]
@@ -709,8 +810,13 @@ def main(argv: list[str] | None = None) -> int:
         lines += ["", f"({len(map_rows)} sweeps, {sum(walls) / 60:.0f} CPU-minutes, "
                   f"{args.workers} worker processes.)"]
         lines += ["", *map_answer(groups), "", *answers(groups, conv)]
+    found: list[dict] = []
     for name in STUDY_MAPS:
-        lines += study_map_section(docs, name)
+        lines += study_map_section(docs, name, found)
+    if found:
+        lines += overall_answer(found)
+        figure_study_convergence(found, docs / "figures" /
+                                 "two_layer_law_study_convergence.png")
     lines += ["", "![the 5.2 exponent against dx](figures/two_layer_law_convergence.png)"]
     lines += ["", "## D. Against experiments and DEM", "",
               "r = (R - L0)/L0 with R the front (last cell deeper than 1 mm) in every "
