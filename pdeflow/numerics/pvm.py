@@ -64,8 +64,9 @@ def upper_layer_at_uncovered_step(h1L: float, u1L: float, sL: float, h1R: float,
     its lower side, that lifts material of the lower side, which lies wholly below the
     step's top, onto the step: with h2 frozen the potential energy (per rho2 and unit
     width) int r g (h1 h2 + h1^2/2) dx has derivative r g H in h1, so the diffusion
-    d_x(nu d_x h1) changes it at the rate -nu r g int d_x H d_x h1, and across such a
-    step H rises towards the step while h1 thins: potential energy from nothing.
+    d_x(nu d_x h1) changes it at the rate -nu r g int d_x H d_x h1; across such a step
+    H rises towards the step, so wherever h1 thins that way (a layer in the hollow, a
+    film or nothing on the step) the viscosity makes potential energy from nothing.
     Surges of the upper layer dumping material against the counter-slopes of a stepped
     deposit were fed this way and never came to rest at dx = 0.05 m (docs/model.md,
     "Coming to rest when the upper layer erodes"). Between the depths above the top,
@@ -74,9 +75,11 @@ def upper_layer_at_uncovered_step(h1L: float, u1L: float, sL: float, h1R: float,
 
     What changes is only how the jumps are shared between the two cells: mass and
     momentum are transported and diffused by the flux between the reconstructed states
-    (s, s u1) (transport f = (s u1, s u1^2)), so that a cell never receives momentum
-    without the mass that carries it; the hydrostatic part of the momentum jump is
-    shared as the flux shares it, (1 -+ alpha1)/2. The sums are those of the flux:
+    (s, s u1) (transport f = (s u1, s u1^2)), so that the momentum they bring a cell
+    comes with the mass that carries it (the flux's momentum viscosity alpha0
+    Delta(h1 u1) with this mass flux gave thin cells momentum without mass: velocity
+    spikes); the hydrostatic part of the momentum jump is shared as the flux shares it,
+    (1 -+ alpha1)/2. The sums are those of the flux:
     D^- + D^+ = (Delta(h1 u1), ``jump``), the paper's path-conservative discretisation
     of the pressure and of the coupling term g_z h1 d_x h2, so a thin layer on a steep
     deposit keeps its driving force. As s <= h1 on both sides, the flux never takes
