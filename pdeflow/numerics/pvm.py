@@ -43,7 +43,7 @@ depth; elsewhere (near a layer's front or where a layer thins out) the HLL line.
 @njit(cache=True)
 def upper_layer_at_uncovered_step(h1L: float, u1L: float, sL: float, h1R: float,
                                   u1R: float, sR: float, jump: float, c0: float,
-                                  c1: float, e0: float, e1: float
+                                  c1: float, e0: float, e1: float, dry: float
                                   ) -> tuple[float, float, float, float]:
     r"""Upper-layer fluctuations ``(D^-_h1, D^-_h1u1, D^+_h1, D^+_h1u1)`` at a face where
     the lower layer is at rest on both sides and its step is not covered by the upper
@@ -56,7 +56,7 @@ def upper_layer_at_uncovered_step(h1L: float, u1L: float, sL: float, h1R: float,
     Garcia, Gonzalez & Pares 2005); ``jump`` the path-conservative momentum jump
     Delta(h1 u1^2) + g_z h1bar Delta H of (24) [m^3/s^2]; ``c0``, ``c1`` the flux's
     viscosity coefficients; ``e0``, ``e1`` IFCP's alpha2 terms (else 0), kept as they
-    are.
+    are; ``dry`` [m] the dry tolerance.
 
     Why: a lower layer at rest is a bed for the upper one, and the flux's mass viscosity
     alpha0 Delta h1 moves upper-layer material from the thicker side to the thinner
@@ -79,7 +79,11 @@ def upper_layer_at_uncovered_step(h1L: float, u1L: float, sL: float, h1R: float,
     comes with the mass that carries it (the flux's momentum viscosity alpha0
     Delta(h1 u1) with this mass flux gave thin cells momentum without mass: velocity
     spikes); the hydrostatic part of the momentum jump is shared as the flux shares it,
-    (1 -+ alpha1)/2. The sums are those of the flux:
+    (1 -+ alpha1)/2, except that a side without upper layer (h1 <= ``dry``) gets none:
+    it has no upper-layer momentum to receive (the source stage zeroes a dry cell's),
+    and a cell that gets a trace of mass through its other face turned that share into
+    a velocity spike (a blow-up of the MUSCL run of test 5.1 with phi_B = 46 deg,
+    c = 3 at dx = 0.0125 m). Otherwise the sums are those of the flux:
     D^- + D^+ = (Delta(h1 u1), ``jump``), the paper's path-conservative discretisation
     of the pressure and of the coupling term g_z h1 d_x h2, so a thin layer on a steep
     deposit keeps its driving force. As s <= h1 on both sides, the flux never takes
@@ -92,8 +96,10 @@ def upper_layer_at_uncovered_step(h1L: float, u1L: float, sL: float, h1R: float,
     mass = fL + 0.5 * ((fR - fL) - c0 * (sR - sL) - c1 * (fR - fL) - e0)
     mom = tL + 0.5 * ((tR - tL) - c0 * (fR - fL) - c1 * (tR - tL) - e1)
     pressure = jump - (h1R * u1R * u1R - h1L * u1L * u1L)
-    return (mass - h1L * u1L, mom - h1L * u1L * u1L + 0.5 * (1.0 - c1) * pressure,
-            h1R * u1R - mass, h1R * u1R * u1R - mom + 0.5 * (1.0 + c1) * pressure)
+    wL = 0.5 * (1.0 - c1) if h1L > dry else 0.0
+    wR = 0.5 * (1.0 + c1) if h1R > dry else 0.0
+    return (mass - h1L * u1L, mom - h1L * u1L * u1L + wL * pressure,
+            h1R * u1R - mass, h1R * u1R * u1R - mom + wR * pressure)
 
 
 @njit(cache=True)
@@ -242,7 +248,8 @@ def _two_layer(rusanov: bool, ifcp: bool):
             sR = h1R + h2R - top
             if sL <= 0.0 or sR <= 0.0:
                 dm0, dm1, dp0, dp1 = upper_layer_at_uncovered_step(
-                    h1L, u1L, max(sL, 0.0), h1R, u1R, max(sR, 0.0), a1, c0, c1, e0, e1)
+                    h1L, u1L, max(sL, 0.0), h1R, u1R, max(sR, 0.0), a1, c0, c1, e0, e1,
+                    dry)
         if m1L == 0.0 and m1R == 0.0:
             dH = dh1 + dh2
             dm0 = 0.0
