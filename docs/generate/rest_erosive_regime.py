@@ -5,7 +5,8 @@
 Runs test 5.1 over the (phi_B, k, c) sets of an independent code's table (issue "The
 two-layer run-out law, decided", part A), the splitting-error check (the same set at
 smaller CFL numbers) and the phi_B = 46 deg set at a smaller CFL and dx, and draws the
-cells that still move in that set with the forces on their upper layer. Uses the public
+cells that still move in that set at 5 s, while its surges run, with the forces on their
+upper layer. Uses the public
 API only (case files, ``run_model``).
 """
 
@@ -166,8 +167,8 @@ def main(argv: list[str] | None = None) -> int:
         lines.append(f"| {label}, t_end = 30 s | {_row(s)} | "
                      f"{_t(s['lower_stop_time'])} / {_t(s['upper_stop_time'])} |")
     fig = args.docs / "figures" / "rest_erosive_phi_b_46.png"
-    forces_figure(run(46, 0.65, 3.0), fig)
-    lines += ["", f"![moving cells and forces at t = 10 s](figures/{fig.name})", ""]
+    forces_figure(run(46, 0.65, 3.0, t_end=5.0), fig)
+    lines += ["", f"![moving cells and forces at t = 5 s](figures/{fig.name})", ""]
     out = args.docs / "rest_erosive_regime.md"
     write_text(out, "\n".join(lines))
     print(f"wrote {out} and {fig}")

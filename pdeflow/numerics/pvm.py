@@ -39,6 +39,68 @@ depth; elsewhere (near a layer's front or where a layer thins out) the HLL line.
 
 
 @cached
+def upper_layer_at_uncovered_step(h1L: float, u1L: float, sL: float, h1R: float,
+                                  u1R: float, sR: float, jump: float, c0: float,
+                                  c1: float, e0: float, e1: float, dry: float
+                                  ) -> tuple[float, float, float, float]:
+    r"""Upper-layer fluctuations ``(D^-_h1, D^-_h1u1, D^+_h1, D^+_h1u1)`` at a face where
+    the lower layer is at rest on both sides and its step is not covered by the upper
+    layer: on one side h1 + h2 <= max(h2L, h2R) (or that side has no upper layer).
+
+    ``sL``, ``sR`` [m] are the upper layer's depths above the top of the step,
+    s = max(h1 + h2 - max(h2L, h2R), 0) <= h1 (hydrostatic reconstruction over the
+    bed b = h2: Audusse, Bouchut, Bristeau, Klein & Perthame 2004; for the
+    path-conservative scheme, the emerged-step wet/dry front of Castro, Ferreiro,
+    Garcia, Gonzalez & Pares 2005); ``jump`` the path-conservative momentum jump
+    Delta(h1 u1^2) + g_z h1bar Delta H of (24) [m^3/s^2]; ``c0``, ``c1`` the flux's
+    viscosity coefficients; ``e0``, ``e1`` IFCP's alpha2 terms (else 0), kept as they
+    are; ``dry`` [m] the dry tolerance.
+
+    Why: a lower layer at rest is a bed for the upper one, and the flux's mass viscosity
+    alpha0 Delta h1 moves upper-layer material from the thicker side to the thinner
+    one whatever the bed does. At a step that rises above the upper layer's surface on
+    its lower side, that lifts material of the lower side, which lies wholly below the
+    step's top, onto the step: with h2 frozen the potential energy (per rho2 and unit
+    width) int r g (h1 h2 + h1^2/2) dx has derivative r g H in h1, so the diffusion
+    d_x(nu d_x h1) changes it at the rate -nu r g int d_x H d_x h1; across such a step
+    H rises towards the step, so wherever h1 thins that way (a layer in the hollow, a
+    film or nothing on the step) the viscosity makes potential energy from nothing.
+    Surges of the upper layer dumping material against the counter-slopes of a stepped
+    deposit were fed this way and never came to rest at dx = 0.05 m (docs/model.md,
+    "Coming to rest when the upper layer erodes"). Between the depths above the top,
+    nothing of the lower side reaches the face, and the viscosity moves material only
+    down the step.
+
+    What changes is only how the jumps are shared between the two cells: mass and
+    momentum are transported and diffused by the flux between the reconstructed states
+    (s, s u1) (transport f = (s u1, s u1^2)), so that the momentum they bring a cell
+    comes with the mass that carries it (the flux's momentum viscosity alpha0
+    Delta(h1 u1) with this mass flux gave thin cells momentum without mass: velocity
+    spikes); the hydrostatic part of the momentum jump is shared as the flux shares it,
+    (1 -+ alpha1)/2, except that a side without upper layer (h1 <= ``dry``) gets none:
+    it has no upper-layer momentum to receive (the source stage zeroes a dry cell's),
+    and a cell that gets a trace of mass through its other face turned that share into
+    a velocity spike (a blow-up of the MUSCL run of test 5.1 with phi_B = 46 deg,
+    c = 3 at dx = 0.0125 m). Otherwise the sums are those of the flux:
+    D^- + D^+ = (Delta(h1 u1), ``jump``), the paper's path-conservative discretisation
+    of the pressure and of the coupling term g_z h1 d_x h2, so a thin layer on a steep
+    deposit keeps its driving force. As s <= h1 on both sides, the flux never takes
+    more mass from a cell than between its own depths (positivity).
+    """
+    fL = sL * u1L
+    fR = sR * u1R
+    tL = fL * u1L
+    tR = fR * u1R
+    mass = fL + 0.5 * ((fR - fL) - c0 * (sR - sL) - c1 * (fR - fL) - e0)
+    mom = tL + 0.5 * ((tR - tL) - c0 * (fR - fL) - c1 * (tR - tL) - e1)
+    pressure = jump - (h1R * u1R * u1R - h1L * u1L * u1L)
+    wL = 0.5 * (1.0 - c1) if h1L > dry else 0.0
+    wR = 0.5 * (1.0 + c1) if h1R > dry else 0.0
+    return (mass - h1L * u1L, mom - h1L * u1L * u1L + wL * pressure,
+            h1R * u1R - mass, h1R * u1R * u1R - mom + wR * pressure)
+
+
+@cached
 def _roe_velocity(hL: float, uL: float, hR: float, uR: float) -> float:
     sl = math.sqrt(max(hL, 0.0))
     sr = math.sqrt(max(hR, 0.0))
@@ -156,14 +218,15 @@ def _two_layer(rusanov: bool, ifcp: bool):
         q1 = c0 * (m1R - m1L) + c1 * a1
         q2 = c0 * dh2 + c1 * a2
         q3 = c0 * (m2R - m2L) + c1 * a3
+        e0 = e1 = 0.0
         if ifcp and c2 != 0.0:
             # alpha2 A (A dq), A = pseudo-Jacobian of (28) at the averaged state
-            b0 = a1
-            b1 = (g * h1 - u1 * u1) * a0 + 2.0 * u1 * a1 + g * h1 * a2
+            e0 = c2 * a1
+            e1 = c2 * ((g * h1 - u1 * u1) * a0 + 2.0 * u1 * a1 + g * h1 * a2)
             b2 = a3
             b3 = r * g * h2 * a0 + (g * h2 - u2 * u2) * a2 + 2.0 * u2 * a3
-            q0 += c2 * b0
-            q1 += c2 * b1
+            q0 += e0
+            q1 += e1
             q2 += c2 * b2
             q3 += c2 * b3
         dm0 = 0.5 * (a0 - q0)
@@ -174,6 +237,17 @@ def _two_layer(rusanov: bool, ifcp: bool):
         dp1 = a1 - dm1
         dp2 = a2 - dm2
         dp3 = a3 - dm3
+        if m2L == 0.0 and m2R == 0.0 and dh2 != 0.0:
+            # a step of a lower layer at rest: where it rises above the upper layer's
+            # surface on one side, the upper layer's transport and viscosity act on the
+            # depths above its top (see upper_layer_at_uncovered_step)
+            top = max(h2L, h2R)
+            sL = h1L + h2L - top
+            sR = h1R + h2R - top
+            if sL <= 0.0 or sR <= 0.0:
+                dm0, dm1, dp0, dp1 = upper_layer_at_uncovered_step(
+                    h1L, u1L, max(sL, 0.0), h1R, u1R, max(sR, 0.0), a1, c0, c1, e0, e1,
+                    dry)
         if m1L == 0.0 and m1R == 0.0:
             dH = dh1 + dh2
             dm0 = 0.0

@@ -37,6 +37,36 @@ def _hll_split(sL, sR, dq, a):
     return dm, dp
 
 
+def _at_uncovered_steps(left, right, ul, ur, sL, sR, a0, a1, dH, g, dry, fluct):
+    """The upper layer's fluctuations (D-_h1, D+_h1, D-_h1u1, D+_h1u1) with those of
+    :func:`pdeflow.numerics.pvm.upper_layer_at_uncovered_step` where the lower layer is
+    at rest on both sides of a face and steps above the upper layer's surface on one
+    side; ``fluct`` (the flux's own) elsewhere."""
+    h1l, h1r, h2l, h2r = left[0], right[0], left[2], right[2]
+    top = np.maximum(h2l, h2r)
+    s_l = h1l + h2l - top
+    s_r = h1r + h2r - top
+    at = ((left[3] == 0.0) & (right[3] == 0.0) & (h2r - h2l != 0.0)
+          & ((s_l <= 0.0) | (s_r <= 0.0)))
+    s_l = np.maximum(s_l, 0.0)
+    s_r = np.maximum(s_r, 0.0)
+    f_l, f_r = s_l * ul, s_r * ur
+    pressure = g * 0.5 * (h1l + h1r) * dH
+    mass = f_l + _hll_split(sL, sR, s_r - s_l, f_r - f_l)[0]
+    mom = f_l * ul + _hll_split(sL, sR, f_r - f_l, f_r * ur - f_l * ul)[0]
+    share_l = _hll_split(sL, sR, 0.0 * pressure, pressure)[0]  # the flux's share of it
+    share_r = pressure - share_l
+    # a side without upper layer gets no share of the hydrostatic jump
+    share_l = np.where(h1l > dry, share_l, 0.0)
+    share_r = np.where(h1r > dry, share_r, 0.0)
+    dm0 = mass - ul * h1l
+    dm1 = mom - ul * ul * h1l + share_l
+    dp1 = ur * ur * h1r - ul * ul * h1l - (mom - ul * ul * h1l) + share_r
+    dm0_, dp0_, dm1_, dp1_ = fluct
+    return (np.where(at, dm0, dm0_), np.where(at, a0 - dm0, dp0_),
+            np.where(at, dm1, dm1_), np.where(at, dp1, dp1_))
+
+
 def advection_rate(q: np.ndarray, dx: float, bc: tuple[int, int], g: float,
                    dry: float, r: float | None) -> tuple[np.ndarray, float]:
     """HLL advection rate of a single-layer (r is None) or two-layer state, and the
@@ -84,6 +114,9 @@ def advection_rate(q: np.ndarray, dx: float, bc: tuple[int, int], g: float,
         a0 = ur * hr - ul * hl
         dm0, dp0 = _hll_split(sL, sR, hr - hl, a0)
         dm1, dp1 = _hll_split(sL, sR, mr - ml, a1)
+        if n_layers == 2 and k == 0:
+            dm0, dp0, dm1, dp1 = _at_uncovered_steps(left, right, ul, ur, sL, sR, a0, a1,
+                                                     dH, g, dry, (dm0, dp0, dm1, dp1))
         rest = (ml == 0.0) & (mr == 0.0)
         dm0 = np.where(rest, 0.0, dm0)
         dp0 = np.where(rest, 0.0, dp0)
