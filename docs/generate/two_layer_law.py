@@ -14,10 +14,10 @@ checked on finer grids, and set against published laws.
 2. Grid convergence of the 5.2 fit for representative sets (dx = 0.01 .. 0.00125 m).
 3. The computed r(a) against the published planar-collapse laws (REFERENCE section 4).
 
-Search and map are plain loops written before pdeflow had a study engine; the map over
-each closure's regularisation (tau_star, du_reg) are studies
-(cases/study_two_layer_law_relaxed.toml, cases/study_two_layer_law_du_reg.toml, run by
-``pdeflow study``), whose results tables this file reads. Every number in the report comes
+Search and map are plain loops written before pdeflow had a study engine; the maps over
+each closure's regularisation (tau_star, du_reg) and the rest of the parameter space are
+studies (cases/study_two_layer_law_*.toml, run by ``pdeflow study``), whose results
+tables two_layer_law_maps.py reads. Every number in the report comes
 from this file or that table. All results also go to docs/two_layer_law_search.csv.
 """
 
@@ -38,6 +38,17 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from two_layer_law_maps import (  # noqa: E402
+    STUDY_MAPS,
+    TARGET_E,
+    TOL_E,
+    figure_study_convergence,
+    law_answer,
+    overall_answer,
+    set_params,
+    stored_check,
+    study_map_section,
+)
 
 from pdeflow.analysis.sweep import (  # noqa: E402
     PUBLISHED_EXPONENTS,
@@ -54,7 +65,6 @@ ROOT = Path(__file__).resolve().parents[2]
 CASE_51 = ROOT / "cases" / "paper_5_1_dam_break.toml"
 CASE_52 = ROOT / "cases" / "collapse_sweep.toml"
 TIMES = (0.1, 0.25, 0.4, 0.7)
-TARGET_E, TOL_E = 0.84, 0.05
 TARGET_P, TOL_P = 1.61, 0.15
 
 CLOSURES = {  # name -> [two_layer] keys
@@ -473,157 +483,6 @@ def figure_map(rows: list[dict], path: Path) -> None:
     save(fig, path)
 
 
-STUDY_MAPS = {  # study name -> (varied keys, what the map above holds, closure, fixed)
-    "two_layer_law_relaxed": (("two_layer.tau_star", "two_layer.phi_b_deg", "two_layer.c"),
-                              "tau_star = 0.1", "relaxed closure", "k = 0.8, wedge 60 deg"),
-    "two_layer_law_du_reg": (("two_layer.du_reg", "two_layer.phi_b_deg", "two_layer.c"),
-                             "du_reg = 0.2 m/s", "paper's closure bounded by du_reg",
-                             "k = 0.8, wedge 60 deg"),
-    "two_layer_law_wedge_k": (("two_layer.k", "two_layer.c", "initial.wedge_angle_deg"),
-                              None, "paper's closure bounded by du_reg = 0.05 m/s",
-                              "phi_B = 41 deg"),
-    "two_layer_law_phi_b_k": (("two_layer.phi_b_deg", "two_layer.k", "two_layer.c"),
-                              None, "paper's closure bounded by du_reg = 0.05 m/s",
-                              "wedge 60 deg"),
-    "two_layer_law_relaxed_phi_b_k": (("two_layer.phi_b_deg", "two_layer.k", "two_layer.c"),
-                                      None, "relaxed closure, tau_star = 0.1",
-                                      "wedge 60 deg"),
-}
-"""maps over a closure's regularisation and the other parameters, studies: pdeflow study
-cases/study_NAME.toml --out docs/studies/NAME (this script only reads their tables)"""
-LABELS = {"phi_b_deg": "phi_B", "wedge_angle_deg": "wedge"}
-
-
-def study_map_section(docs: Path, name: str, found: list[dict]) -> list[str]:
-    """Part C over one closure's regularisation, from a study's results table; appends
-    every set whose finest two grids have a fit to ``found`` (closure, set name, its
-    exponent on each grid, on the finest one and the change between the finest two)."""
-    keys, held, closure, fixed = STUDY_MAPS[name]
-    labels = [LABELS.get(k.split(".")[1], k.split(".")[1]) for k in keys]
-    study = f"studies/{name}"
-    path = docs / study / "results.csv"
-    if not path.exists():
-        return []
-    rows = []
-    # studies NAME_refine, NAME_refine2 hold sets of NAME one and two levels finer
-    refines = sorted(docs.glob(f"{study}_refine*/results.csv"))
-    for p in (path, *refines):
-        if p.exists():
-            with open(p) as fh:
-                rows += [r for r in csv.DictReader(fh) if r["status"] == "ok"]
-    groups: dict = {}
-    for r in rows:
-        point = tuple(float(r[k]) for k in keys)
-        e = r["sweep.two_layer.exponent"]
-        groups.setdefault(point, {})[float(r["grid.dx"])] = {
-            "exponent": float(e) if e else None,
-            "prefactor": float(r["sweep.two_layer.prefactor"]) if e else None,
-            "sweep_at_rest": r["sweep.two_layer.all_at_rest"] == "1"}
-    dxs = sorted({dx for lv in groups.values() for dx in lv}, reverse=True)
-
-    def named(point: tuple) -> str:
-        return ", ".join(f"{lab} {v:g}" for lab, v in zip(labels, point, strict=True))
-
-    over = labels[0] if held else ", ".join(labels)
-    lines = ["", f"**{closure[0].upper() + closure[1:]} over {over}**"
-             + (f" (the map above holds {held})" if held else "") + ": "
-             f"the study `cases/study_{name}.toml`, run by `pdeflow study "
-             f"cases/study_{name}.toml --out docs/{study}` "
-             f"([report]({study}/report.md)"
-             + "".join(f"; {p.parent.name[len(name) + 1:].replace('_', ' ')} (finer "
-                       f"levels for some sets): [report]({p.parent.relative_to(docs)}/"
-                       "report.md)" for p in refines)
-             + f"), MUSCL/mc, {fixed}; the change is between each set's "
-             "two finest grids:", "",
-             "| " + " | ".join(labels) + " | " + " | ".join(f"fit, dx {d}" for d in dxs)
-             + " | change of the exponent | converged (< 0.01)? | sub-linear (< 0.95)? |",
-             "|" + "---|" * len(labels) + "---|" * (len(dxs) + 3)]
-    conv_sub, conv_all, sub_all = [], [], []
-    for point in sorted(groups):
-        lv = groups[point]
-        cells = []
-        for dx in dxs:
-            r = lv.get(dx)
-            cells.append("" if r is None else "-" if r["exponent"] is None else
-                         f"{r['prefactor']:.2f} a^{r['exponent']:.3f}"
-                         + ("" if r["sweep_at_rest"] else "*"))
-        e = [lv[dx]["exponent"] for dx in sorted(lv, reverse=True)[-2:]]  # finest two
-        if len(e) < 2 or None in e:
-            ch = ok = sub = "-"
-        else:
-            d = abs(e[1] - e[0])
-            found.append({"closure": closure, "set": named(point), "exponent": e[1],
-                          "change": d, "levels": {dx: r["exponent"] for dx, r in
-                                                  lv.items() if r["exponent"] is not None}})
-            ch, ok, sub = f"{d:.3f}", "yes" if d < 0.01 else "no", \
-                "yes" if e[1] < 0.95 else "no"
-            (conv_all if d < 0.01 else []).append(e[1])
-            if e[1] < 0.95:
-                sub_all.append((point, e[1], d))
-                if d < 0.01:
-                    conv_sub.append((point, e[1]))
-        lines.append("| " + " | ".join(f"{v:g}" for v in point) + " | "
-                     + " | ".join(cells) + f" | {ch} | {ok} | {sub} |")
-    lines += ["", f"* {len(conv_all)} of {len(groups)} sets converged"
-              + (f" (exponents {min(conv_all):.3f} - {max(conv_all):.3f})" if conv_all
-                 else "") + f"; {len(conv_sub)} of them sub-linear"
-              + (": " + ", ".join(f"{named(k)} ({e:.3f})" for k, e in conv_sub)
-                 if conv_sub else "")
-              + "."]
-    if sub_all:
-        lines.append("* Sub-linear on the finer grid: " + ", ".join(
-            f"{named(k)} ({e:.3f}, change {d:.3f})" for k, e, d in sub_all) + ".")
-    return lines
-
-
-def overall_answer(found: list[dict]) -> list[str]:
-    """Part C across the study maps: per closure, the sets converged on the finest two
-    grids, and which of them are sub-linear."""
-    out = ["", "**Part C across the study maps** (MUSCL/mc; converged: the exponent "
-           "changes by < 0.01 between a set's two finest grids; the fits leave out runs "
-           "not at rest by t_end):", "",
-           "| closure | sets | converged | converged exponents | converged and "
-           "sub-linear (< 0.95) |", "|---|---|---|---|---|"]
-    for closure in dict.fromkeys(f["closure"] for f in found):
-        sets = [f for f in found if f["closure"] == closure]
-        conv = [f for f in sets if f["change"] < 0.01]
-        sub = [f for f in conv if f["exponent"] < 0.95]
-        es = [f["exponent"] for f in conv]
-        out.append(f"| {closure} | {len(sets)} | {len(conv)} | "
-                   + (f"{min(es):.3f} - {max(es):.3f}" if es else "-") + " | "
-                   + ("; ".join(f"{f['set']}: {f['exponent']:.3f}" for f in sub)
-                      or "none") + " |")
-    return out + ["", "![the study maps' exponents against dx]"
-                  "(figures/two_layer_law_study_convergence.png)"]
-
-
-def figure_study_convergence(found: list[dict], path: Path) -> None:
-    """Exponent against dx for every set of the study maps, one colour per closure;
-    the sets sub-linear on their finest grid drawn bold."""
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    closures = list(dict.fromkeys(f["closure"] for f in found))
-    shades = {True: ["tab:blue", "navy", "tab:cyan"], False: ["tab:red", "darkorange",
-                                                              "tab:brown"]}
-    colors = {c: shades[c.startswith("relaxed")].pop(0) for c in closures}
-    for f in found:
-        dxs = sorted(f["levels"])
-        sub = f["exponent"] < 0.95
-        ax.plot(dxs, [f["levels"][d] for d in dxs], color=colors[f["closure"]],
-                lw=1.8 if sub else 0.7, alpha=0.9 if sub else 0.4, marker=".")
-    for closure, color in colors.items():
-        ax.plot([], [], color=color, label=closure)
-    ax.axhspan(TARGET_E - TOL_E, TARGET_E + TOL_E, color="0.85", label="0.84 +- 0.05")
-    ax.set_xscale("log")
-    finest = sorted({d for f in found for d in f["levels"]})
-    log_ticks(ax.xaxis, finest)
-    ax.set_xlabel("dx [m]")
-    ax.set_ylabel("5.2 two-layer exponent (MUSCL/mc)")
-    ax.invert_xaxis()
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    save(fig, path)
-
-
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--docs", type=Path, default=ROOT / "docs", help="docs directory")
@@ -702,7 +561,9 @@ def main(argv: list[str] | None = None) -> int:
         "",
         f"Generated by `python docs/generate/two_layer_law.py{' --quick' if args.quick else ''}`"
         + (" (this copy from the stored search and map, `--reuse`; the full run takes "
-           "about 45 min on 2 cores)" if args.reuse else
+           "about 45 min on 2 cores; the stored tables and the studies were computed by "
+           "earlier versions of pdeflow: how far the current code moves them is measured "
+           "at the end of part C)" if args.reuse else
            f" ({(time.perf_counter() - t_start) / 60:.0f} min on this machine)")
         + f"; all {n} "
         "searched sets with every measured number: "
@@ -807,8 +668,7 @@ def main(argv: list[str] | None = None) -> int:
                          + " | ".join(fit(lv.get(dx)) for dx in dxs_all)
                          + f" | {ch} | {conv_ok} | {sub} |")
         walls = [r["wall"] for r in map_rows]
-        lines += ["", f"({len(map_rows)} sweeps, {sum(walls) / 60:.0f} CPU-minutes, "
-                  f"{args.workers} worker processes.)"]
+        lines += ["", f"({len(map_rows)} sweeps, {sum(walls) / 60:.0f} CPU-minutes.)"]
         lines += ["", *map_answer(groups), "", *answers(groups, conv)]
     found: list[dict] = []
     for name in STUDY_MAPS:
@@ -817,6 +677,22 @@ def main(argv: list[str] | None = None) -> int:
         lines += overall_answer(found)
         figure_study_convergence(found, docs / "figures" /
                                  "two_layer_law_study_convergence.png")
+    for key, lv in _group(map_rows).items():  # the map of this script
+        d = _change(lv)
+        if d is not None:
+            fine = lv[min(lv)]
+            case = load_case(CASE_52, overrides(dict(zip(("closure", "phi_b_deg", "k", "c",
+                                                          "wedge"), key, strict=True))))
+            found.append({"closure": key[0], "exponent": fine["exponent"],
+                          "prefactor": fine["prefactor"], "change": d,
+                          "params": set_params(case), "levels": {
+                              dx: r["exponent"] for dx, r in lv.items()}})
+    lines += law_answer(found)
+    if args.reuse:
+        by_name = {_set_name(r): r for r in rows}
+        lines += stored_check(docs, conv, {label: by_name[name] for label in conv
+                                           if (name := label[label.find("(") + 1:-1])
+                                           in by_name})
     lines += ["", "![the 5.2 exponent against dx](figures/two_layer_law_convergence.png)"]
     lines += ["", "## D. Against experiments and DEM", "",
               "r = (R - L0)/L0 with R the front (last cell deeper than 1 mm) in every "
