@@ -1,7 +1,7 @@
 """Regenerate docs/two_layer_law.md: the two-layer run-out law of test 5.2, searched,
 checked on finer grids, and set against published laws.
 
-    python docs/generate/two_layer_law.py            # ~45 min on 2 cores
+    python docs/generate/two_layer_law.py            # everything, the studies included
     python docs/generate/two_layer_law.py --quick    # a coarse search, ~3 min
     python docs/generate/two_layer_law.py --reuse    # report from the stored CSVs, ~5 min
 
@@ -14,10 +14,11 @@ checked on finer grids, and set against published laws.
 2. Grid convergence of the 5.2 fit for representative sets (dx = 0.01 .. 0.00125 m).
 3. The computed r(a) against the published planar-collapse laws (REFERENCE section 4).
 
-Search and map are plain loops written before pdeflow had a study engine; the maps over
-each closure's regularisation (tau_star, du_reg) and the rest of the parameter space are
-studies (cases/study_two_layer_law_*.toml, run by ``pdeflow study``), whose results
-tables two_layer_law_maps.py reads. Every number in the report comes
+Search and map are plain loops written before pdeflow had a study engine (about 45 min on
+2 cores); the maps over each closure's regularisation (tau_star, du_reg) and the rest of
+the parameter space are studies (cases/study_two_layer_law_*.toml), which the full run
+runs (or resumes) on Dask like ``pdeflow study`` (about 3 CPU-hours from nothing) and
+two_layer_law_maps.py reads. Every number in the report comes
 from this file or that table. All results also go to docs/two_layer_law_search.csv.
 """
 
@@ -45,6 +46,7 @@ from two_layer_law_maps import (  # noqa: E402
     figure_study_convergence,
     law_answer,
     overall_answer,
+    run_studies,
     set_params,
     stored_check,
     study_map_section,
@@ -670,6 +672,8 @@ def main(argv: list[str] | None = None) -> int:
         walls = [r["wall"] for r in map_rows]
         lines += ["", f"({len(map_rows)} sweeps, {sum(walls) / 60:.0f} CPU-minutes.)"]
         lines += ["", *map_answer(groups), "", *answers(groups, conv)]
+    if not (args.reuse or args.quick):
+        run_studies(docs, args.workers)
     found: list[dict] = []
     for name in STUDY_MAPS:
         lines += study_map_section(docs, name, found)

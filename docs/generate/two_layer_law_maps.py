@@ -6,6 +6,7 @@ in words (used by docs/generate/two_layer_law.py)."""
 from __future__ import annotations
 
 import csv
+import os
 from pathlib import Path
 from typing import Any
 
@@ -309,3 +310,20 @@ def stored_check(docs: Path, conv: dict[str, Any], stored: dict[str, dict]) -> l
                        f"{abs(now['exponent'] - e0):.3f} |")
     return out
 
+
+
+def run_studies(docs: Path, workers: int) -> None:
+    """Run every study of the maps (``cases/study_two_layer_law*.toml``) into
+    ``docs/studies/NAME`` and write its report, as ``pdeflow study`` does. A study
+    directory that holds results already is resumed: only what is missing is computed
+    (to recompute with another version of pdeflow, remove the directory first)."""
+    from pdeflow.study.execute import run_study
+    from pdeflow.study.report import write_report
+    from pdeflow.study.spec import load_study
+
+    for path in sorted((ROOT / "cases").glob("study_two_layer_law*.toml")):
+        name = path.stem[len("study_"):]
+        # a relative path, so that the report's commands read as typed from the root
+        table = run_study(load_study(os.path.relpath(path)), str(docs / "studies" / name),
+                          workers=workers, log=print)
+        write_report(table, f"pdeflow study cases/{path.name} --out docs/studies/{name}")
