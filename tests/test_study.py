@@ -226,6 +226,27 @@ def test_killed_study_resumes_without_duplicates(tmp_path):
             == df.set_index("id").loc[partial["id"], "y"].to_numpy()).all()
 
 
+def test_resuming_results_of_other_numerics_warns_and_keeps_them(tmp_path, capsys):
+    """A study's fingerprint covers its study and case files; the code of the models and
+    numerics is recorded beside it: a directory computed by other code is resumed with a
+    warning (its rows are kept), as the same code resumes silently."""
+    import json
+
+    study, out = _study(tmp_path, ishigami_study("lhs", 4, 1)), tmp_path / "out"
+    cmd = ["study", str(study), "--out", str(out), "--workers", "1"]
+    assert main(cmd) == 0
+    assert main(cmd) == 0
+    assert "another version" not in capsys.readouterr().out
+    meta = json.loads((out / "meta.json").read_text())
+    meta["numerics"] = "0" * 16  # as if computed before a change of the numerics
+    (out / "meta.json").write_text(json.dumps(meta))
+    assert main(cmd) == 0
+    said = capsys.readouterr().out
+    assert "its 4 results were computed by another version of pdeflow's models or " \
+           "numerics" in said
+    assert len(_frame(out)) == 4
+
+
 def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))

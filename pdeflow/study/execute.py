@@ -72,6 +72,11 @@ def run_study(spec: StudySpec, out: str, *, workers: int | None = None,
     """Run (or resume) ``spec`` into directory ``out``; return its results table."""
     table = ResultsTable(out, spec)
     finished = table.rows()
+    if table.other_code and finished:
+        log(f"warning: {table.dir}: its {len(finished)} results were computed by another "
+            "version of pdeflow's models or numerics (or one that did not record it); "
+            "they are kept and only missing evaluations are run: remove the directory "
+            "to recompute them all")
     done = {int(r["id"]) for r in finished}
     optimiser = None
     if spec.design == "optimize":

@@ -5,13 +5,16 @@
 row intact; a line cut short by a crash mid-write (no final newline) is dropped when the
 directory is opened again, and its evaluation is redone. ``DIR/study.toml`` is a copy of
 the study file and ``DIR/meta.json`` records pdeflow's version, the study's fingerprint
-(the study file and the case files it reads) and every execution's timing; reopening a
-directory with a changed study file is an error.
+(the study file and the case files it reads), a digest of the code of pdeflow's models
+and numerics, and every execution's timing; reopening a directory with a changed study
+file is an error, with changed models or numerics a warning (``ResultsTable.other_code``:
+its rows were computed by other code).
 """
 
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import json
 import os
@@ -23,6 +26,16 @@ from ..io import atomic_path, write_json
 from .spec import StudyError, StudySpec
 
 FIXED_COLUMNS = ("id", "status", "message", "wall_s")
+
+
+def numerics_digest() -> str:
+    """Digest of the source of pdeflow's models and numerics: what a study's numbers
+    depend on besides its study and case files (16 hex digits)."""
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for path in sorted([*root.glob("models/*.py"), *root.glob("numerics/*.py")]):
+        h.update(path.name.encode() + b"\0" + path.read_bytes())
+    return h.hexdigest()[:16]
 
 
 class ResultsTable:
@@ -42,7 +55,11 @@ class ResultsTable:
                     f"(its study.toml or a case file it reads has changed since); use a "
                     f"new --out directory or remove {self.dir}")
             self._repair()
+            # rows computed by other models or numerics (or by a version that did not
+            # record them) are kept; run_study says so
+            self.other_code = self.meta.get("numerics") != numerics_digest()
         else:
+            self.other_code = False
             if self.dir.exists() and any(self.dir.iterdir()):
                 raise StudyError(f"--out {self.dir} exists and is not a study directory "
                                  "(no meta.json); give a new or empty directory")
@@ -56,8 +73,8 @@ class ResultsTable:
                 tmp.write_text(self._lines([dict(zip(self.columns, self.columns,
                                                      strict=True))]))
             self.meta = {"pdeflow_version": __version__, "study": str(spec.path),
-                         "fingerprint": spec.fingerprint, "design": spec.design,
-                         "executions": []}
+                         "fingerprint": spec.fingerprint, "numerics": numerics_digest(),
+                         "design": spec.design, "executions": []}
             write_json(self.meta_path, self.meta)
 
     def _lines(self, rows: list[dict[str, Any]]) -> str:
