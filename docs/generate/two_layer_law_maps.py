@@ -40,6 +40,23 @@ cases/study_NAME.toml --out docs/studies/NAME (this script only reads their tabl
 LABELS = {"phi_b_deg": "phi_B", "wedge_angle_deg": "wedge"}
 
 
+def study_spec(name: str) -> dict:
+    """The ``[study]`` table of ``cases/study_NAME.toml``."""
+    return tomllib.loads((ROOT / "cases" / f"study_{name}.toml").read_text())["study"]
+
+
+def study_rows(docs: Path, name: str) -> tuple[list[dict], list[Path]]:
+    """The finished rows of the study NAME and of NAME_refine, NAME_refine2, ... (its
+    sets one, two levels finer), and the refinements' results tables."""
+    refines = sorted(docs.glob(f"studies/{name}_refine*/results.csv"))
+    rows = []
+    for p in (docs / "studies" / name / "results.csv", *refines):
+        if p.exists():
+            with open(p) as fh:
+                rows += [r for r in csv.DictReader(fh) if r["status"] == "ok"]
+    return rows, refines
+
+
 def study_map_section(docs: Path, name: str, found: list[dict]) -> list[str]:
     """Part C over one closure's regularisation, from a study's results table; appends
     every set whose finest two grids have a fit to ``found`` (closure, set name, its
@@ -47,16 +64,9 @@ def study_map_section(docs: Path, name: str, found: list[dict]) -> list[str]:
     keys, held, closure, fixed = STUDY_MAPS[name]
     labels = [LABELS.get(k.split(".")[1], k.split(".")[1]) for k in keys]
     study = f"studies/{name}"
-    path = docs / study / "results.csv"
-    if not path.exists():
+    if not (docs / study / "results.csv").exists():
         return []
-    rows = []
-    # studies NAME_refine, NAME_refine2 hold sets of NAME one and two levels finer
-    refines = sorted(docs.glob(f"{study}_refine*/results.csv"))
-    for p in (path, *refines):
-        if p.exists():
-            with open(p) as fh:
-                rows += [r for r in csv.DictReader(fh) if r["status"] == "ok"]
+    rows, refines = study_rows(docs, name)
     groups: dict = {}
     for r in rows:
         point = tuple(float(r[k]) for k in keys)
@@ -70,7 +80,7 @@ def study_map_section(docs: Path, name: str, found: list[dict]) -> list[str]:
     def named(point: tuple) -> str:
         return ", ".join(f"{lab} {v:g}" for lab, v in zip(labels, point, strict=True))
 
-    spec = tomllib.loads((ROOT / "cases" / f"study_{name}.toml").read_text())["study"]
+    spec = study_spec(name)
 
     def params(point: tuple) -> dict:
         case = load_case(ROOT / "cases" / spec["sweep_case"],
@@ -290,11 +300,8 @@ def stored_check(docs: Path, conv: dict[str, Any], stored: dict[str, dict]) -> l
         out.append(f"| {label} | {lv['dx']} | {fit(s['prefactor'], s['exponent'])} | "
                    f"{fit(lv['prefactor'], lv['exponent'])} | {change} |")
     for name, point, dxs in STORED_CHECKS:
-        spec = tomllib.loads((ROOT / "cases" / f"study_{name}.toml").read_text())["study"]
-        table = []
-        for p in sorted((docs / "studies").glob(f"{name}*/results.csv")):
-            with open(p) as fh:
-                table += list(csv.DictReader(fh))
+        spec = study_spec(name)
+        table = study_rows(docs, name)[0]
         for dx in dxs:
             row = next(r for r in table if float(r["grid.dx"]) == dx and all(
                 float(r[k]) == v for k, v in point.items()))
