@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 from numba.core import config
 
+from pdeflow.numerics import compiled
 from pdeflow.numerics import layout as L
 from pdeflow.numerics.splitting import scheme_stepper
 
@@ -111,7 +112,7 @@ def test_cache_key_follows_the_code_of_every_called_kernel(monkeypatch):
     """A kernel's disk-cache key changes when a kernel it calls, in another file and
     two calls down, changes (numba's own key, the file's time stamp, does not: a stale
     cache once gave a wrong test 5.1 result)."""
-    from pdeflow.numerics import compiled, sources
+    from pdeflow.numerics import sources
     from pdeflow.numerics.source_stage import sources_two_layer
 
     def key() -> tuple:
@@ -124,3 +125,90 @@ def test_cache_key_follows_the_code_of_every_called_kernel(monkeypatch):
     monkeypatch.setattr(sources.friction_two_layer.py_func, "__code__",
                         sources.coulomb_single.py_func.__code__)
     assert key() != before
+
+
+# three independent kernels of different sizes in a module of their own (a helper
+# process that compiled one that another calls would not be seen: the caller compiles
+# its callees itself)
+TOY_KERNELS = """
+from pdeflow.numerics.compiled import f8, kernel
+
+@kernel(f8)
+def small(x):
+    return x + 1.0
+
+@kernel(f8)
+def medium(x):
+    s = 0.0
+    for i in range(10):
+        s += x * i
+    return s
+
+@kernel(f8)
+def large(x):
+    s = 0.0
+    for i in range(10):
+        if x > i:
+            s += x * i - s / (i + 1.0)
+        else:
+            s -= x / (i + 1.0)
+    return s * s + x
+"""
+
+READY_ALL = r"""
+import json, sys
+sys.path.insert(0, sys.argv[1])
+import toy_kernels as toy
+from pdeflow.numerics import compiled
+ks = [toy.small, toy.medium, toy.large]
+helper = [k.py_func.__name__ for k in compiled.split_work(ks)]
+compiled.ready_all(ks)
+print("STATS" + json.dumps({"helper": helper, "results": [k(2.0) for k in ks],
+    "hits": {k.py_func.__name__: sum(k.stats.cache_hits.values()) for k in ks},
+    "misses": {k.py_func.__name__: sum(k.stats.cache_misses.values()) for k in ks}}))
+"""
+
+
+def test_ready_all_compiles_part_of_the_kernels_in_a_helper_process(tmp_path):
+    """On two cores and a cold cache, a forked helper compiles some of the kernels
+    (this process then loads them from the disk cache: cache hits) and this process
+    compiles the others (cache misses); the kernels give the same results."""
+    if not compiled.can_fork():
+        pytest.skip("no second core or no fork here")
+    (tmp_path / "toy_kernels.py").write_text(TOY_KERNELS)
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
+           "PYTHONPATH": str(ROOT)}
+    proc = subprocess.run([sys.executable, "-c", READY_ALL, str(tmp_path)], env=env,
+                          cwd=ROOT, capture_output=True, text=True, timeout=900)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    line = [x for x in proc.stdout.splitlines() if x.startswith("STATS")][0]
+    out = json.loads(line[len("STATS"):])
+    assert 0 < len(out["helper"]) < 3, out
+    for name in ("small", "medium", "large"):
+        by_helper = name in out["helper"]
+        assert out["hits"][name] == int(by_helper), (name, out)
+        assert out["misses"][name] == int(not by_helper), (name, out)
+    x = 2.0
+    medium = sum(x * i for i in range(10))
+    assert out["results"][:2] == [x + 1.0, medium]
+
+
+def test_split_work_keeps_this_process_busy_and_no_fork_beside_threads():
+    """The helper gets at most HELPER_SHARE of the work and never all kernels; one
+    kernel is compiled here; with a second thread running nothing is forked."""
+    import threading
+
+    stepper = scheme_stepper(True, L.FLUX_HLL, 1, L.LIMITER_MINMOD, False)
+    kernels = stepper.kernels
+    helper = compiled.split_work(kernels)
+    assert len(helper) < len(kernels)
+    assert compiled._work(helper) <= compiled.HELPER_SHARE * compiled._work(kernels)
+    assert compiled.split_work(kernels[:1]) == []
+    stop = threading.Event()
+    thread = threading.Thread(target=stop.wait)
+    thread.start()
+    try:
+        assert not compiled.can_fork()
+    finally:
+        stop.set()
+        thread.join()

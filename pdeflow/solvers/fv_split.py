@@ -28,7 +28,7 @@ from pde.trackers.base import FinishedSimulation
 
 from ..models.base import GranularPDE, check_range
 from ..numerics import layout as L
-from ..numerics.compiled import kernels_cached, kernels_ready
+from ..numerics.compiled import kernels_cached, kernels_ready, ready_all
 from ..numerics.splitting import STATUS_FAIL, STATUS_REST, python_stepping, scheme_stepper
 
 
@@ -58,7 +58,7 @@ def scheme_codes(pde: GranularPDE, splitting: str = "lie") -> tuple[bool, int, i
 
 
 def load_kernels(log: Any = None, pdes: Sequence[GranularPDE] = (),
-                 splitting: str = "lie") -> float:
+                 splitting: str = "lie", parallel: bool = True) -> float:
     """Compile the ``fv-split`` kernels of the models ``pdes`` (their schemes, with
     ``splitting``) or load them from numba's disk cache, now, so that this time is not
     booked on a real run's wall time or progress bar. Only what these schemes call is
@@ -69,6 +69,8 @@ def load_kernels(log: Any = None, pdes: Sequence[GranularPDE] = (),
             compiled (once per machine and scheme) and how long it took; None: silent.
         pdes: the models of the runs to come.
         splitting: 'lie' or 'strang'.
+        parallel: compile on two cores where there are (a helper process compiles
+            part of the kernels, see :func:`pdeflow.numerics.compiled.ready_all`).
     """
     steppers = [scheme_stepper(*scheme_codes(pde, splitting)) for pde in pdes]
     if kernels_ready():
@@ -78,6 +80,7 @@ def load_kernels(log: Any = None, pdes: Sequence[GranularPDE] = (),
         print("pdeflow: compiling numba kernels (once per machine) ...", end="",
               file=log, flush=True)
     t0 = time.perf_counter()
+    ready_all([k for scheme in steppers for k in scheme.kernels], parallel=parallel)
     for scheme in steppers:
         scheme.ready()
     seconds = time.perf_counter() - t0
