@@ -95,10 +95,13 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
     return trackers
 
 
+def _import_plotting() -> None:
+    from . import plotting  # noqa: F401
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     from .cases import load_case
     from .io import check_output, write_json, write_npz
-    from .plotting import case_figures, deposit_figure, save
     from .simulate import load_case_kernels, print_summary, run_model
 
     case = load_case(args.case, args.set)
@@ -123,7 +126,13 @@ def cmd_run(args: argparse.Namespace) -> int:
             print("pdeflow: warning: --live needs a display (matplotlib backend "
                   "is non-interactive); use --movie or --frames on a headless machine",
                   file=sys.stderr)
-    load_case_kernels(case, None if args.quiet else sys.stderr)
+    default_out = not (args.summary or args.final or args.plot or args.outdir
+                       or args.store or args.movie or args.frames)
+    outdir = Path(args.outdir) if args.outdir else (
+        Path("results") / case.name if default_out else None)
+    # matplotlib's import (~0.5 s) fills the wait for the kernels a helper compiles
+    load_case_kernels(case, None if args.quiet else sys.stderr,
+                      meanwhile=_import_plotting if args.plot or outdir else None)
     results = {}
     stores: dict[str, Any] = {}
     all_trackers: list[Any] = []
@@ -152,10 +161,6 @@ def cmd_run(args: argparse.Namespace) -> int:
         "parameters": {m: case.make_pde(m).parameters.to_dict() for m in case.models},
         "models": {m: r.summary for m, r in results.items()},
     }
-    default_out = not (args.summary or args.final or args.plot or args.outdir
-                       or args.store or args.movie or args.frames)
-    outdir = Path(args.outdir) if args.outdir else (
-        Path("results") / case.name if default_out else None)
     written = []
     for model, tracker in stores.items():
         written.append(tracker.commit({"summary": summary["models"][model]}))
@@ -170,6 +175,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         for i, m in enumerate(case.models):
             written.append(write_npz(_model_path(args.final, m, i == 0),
                                      results[m].final_arrays()))
+    if args.plot or outdir:
+        from .plotting import case_figures, deposit_figure, save
     if args.plot:
         two = results.get("two_layer")
         one = results.get("single_layer")

@@ -12,6 +12,7 @@ from __future__ import annotations
 import sys
 import time
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -70,13 +71,19 @@ class RunResult:
         return out
 
 
-def load_case_kernels(case: Case, log: Any = None) -> float:
+def load_case_kernels(case: Case, log: Any = None,
+                      meanwhile: Callable[[], Any] | None = None) -> float:
     """Compile or load the compiled kernels that ``case`` needs, before its runs, so
     that neither its wall times nor its progress bars include it; ``log`` (a stream) is
-    told when they are compiled (the first run on a machine). Returns seconds spent."""
+    told when they are compiled (the first run on a machine); ``meanwhile``: work to do
+    while a helper process compiles (see :func:`~pdeflow.solvers.fv_split.load_kernels`),
+    called once in any case. Returns seconds spent."""
     if case.solver != "fv-split":
+        if meanwhile is not None:
+            meanwhile()
         return 0.0
-    return load_kernels(log, [case.make_pde(m) for m in case.models], case.splitting)
+    return load_kernels(log, [case.make_pde(m) for m in case.models], case.splitting,
+                        meanwhile=meanwhile)
 
 
 class Run:

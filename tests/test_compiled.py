@@ -162,7 +162,7 @@ import toy_kernels as toy
 from pdeflow.numerics import compiled
 ks = [toy.small, toy.medium, toy.large]
 helper = [k.py_func.__name__ for k in compiled.split_work(ks)]
-compiled.ready_all(ks)
+compiled.ready_all(ks, meanwhile=lambda: print("MEANWHILE", flush=True))
 print("STATS" + json.dumps({"helper": helper, "results": [k(2.0) for k in ks],
     "hits": {k.py_func.__name__: sum(k.stats.cache_hits.values()) for k in ks},
     "misses": {k.py_func.__name__: sum(k.stats.cache_misses.values()) for k in ks}}))
@@ -172,7 +172,8 @@ print("STATS" + json.dumps({"helper": helper, "results": [k(2.0) for k in ks],
 def test_ready_all_compiles_part_of_the_kernels_in_a_helper_process(tmp_path):
     """On two cores and a cold cache, a forked helper compiles some of the kernels
     (this process then loads them from the disk cache: cache hits) and this process
-    compiles the others (cache misses); the kernels give the same results."""
+    compiles the others (cache misses), and does what it is given to do meanwhile
+    once (the helper does not); the kernels give the right results."""
     if not compiled.can_fork():
         pytest.skip("no second core or no fork here")
     (tmp_path / "toy_kernels.py").write_text(TOY_KERNELS)
@@ -183,6 +184,7 @@ def test_ready_all_compiles_part_of_the_kernels_in_a_helper_process(tmp_path):
     assert proc.returncode == 0, proc.stderr[-3000:]
     line = [x for x in proc.stdout.splitlines() if x.startswith("STATS")][0]
     out = json.loads(line[len("STATS"):])
+    assert proc.stdout.count("MEANWHILE") == 1, proc.stdout
     assert 0 < len(out["helper"]) < 3, out
     for name in ("small", "medium", "large"):
         by_helper = name in out["helper"]
@@ -212,3 +214,18 @@ def test_split_work_keeps_this_process_busy_and_no_fork_beside_threads():
     finally:
         stop.set()
         thread.join()
+
+
+def test_meanwhile_is_called_once_whatever_there_is_to_compile():
+    """The caller's work for the wait runs once, also with nothing to compile or wait
+    for (kernels already loaded, no kernels)."""
+    import pdeflow
+    from pdeflow.solvers import fv_split
+
+    calls: list[int] = []
+    compiled.ready_all([], meanwhile=lambda: calls.append(1))
+    stepper = scheme_stepper(False, L.FLUX_HLL, 1, L.LIMITER_MINMOD, False).ready()
+    compiled.ready_all(stepper.kernels, meanwhile=lambda: calls.append(2))
+    fv_split.load_kernels(None, [pdeflow.SingleLayerGranular()],
+                          meanwhile=lambda: calls.append(3))
+    assert calls == [1, 2, 3]

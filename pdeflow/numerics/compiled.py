@@ -138,7 +138,8 @@ two-layer source stage is 41 % of the bytecode and half of the compile time (5.4
 10.7 s, one process): the helper takes it alone."""
 
 
-def ready_all(kernels: Sequence[Any], parallel: bool = True) -> None:
+def ready_all(kernels: Sequence[Any], parallel: bool = True,
+              meanwhile: Callable[[], Any] | None = None) -> None:
     """:func:`ready` every kernel of ``kernels``; with ``parallel``, two or more kernels
     to compile (not in the disk cache) and a second core, a helper process (a fork of
     this one) compiles about half of them into numba's disk cache meanwhile (see
@@ -146,7 +147,9 @@ def ready_all(kernels: Sequence[Any], parallel: bool = True) -> None:
     the helper fails, this process compiles its kernels itself: same outcome, slower.
     A process with other threads (a server, a Dask worker) compiles alone: a fork
     copies only this thread, and a lock that another one held (numba's compiler lock)
-    would stay locked in the helper."""
+    would stay locked in the helper. ``meanwhile`` (if given) is called once, after
+    this process's own compiling and before it waits for the helper: other work of
+    the caller's that can fill that wait (e.g. the imports its figures need)."""
     todo = [k for k in dict.fromkeys(kernels) if _needs_compiling(k)]
     helper_kernels: list[Any] = []
     if parallel and can_fork():
@@ -159,6 +162,8 @@ def ready_all(kernels: Sequence[Any], parallel: bool = True) -> None:
             target=_ready_each, args=(helper_kernels,), daemon=True)
         helper.start()
     _ready_each([k for k in todo if k not in helper_kernels])
+    if meanwhile is not None:
+        meanwhile()
     if helper is not None:
         helper.join()
     _ready_each(todo)

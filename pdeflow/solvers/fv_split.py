@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import logging
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -58,7 +58,8 @@ def scheme_codes(pde: GranularPDE, splitting: str = "lie") -> tuple[bool, int, i
 
 
 def load_kernels(log: Any = None, pdes: Sequence[GranularPDE] = (),
-                 splitting: str = "lie", parallel: bool = True) -> float:
+                 splitting: str = "lie", parallel: bool = True,
+                 meanwhile: Callable[[], Any] | None = None) -> float:
     """Compile the ``fv-split`` kernels of the models ``pdes`` (their schemes, with
     ``splitting``) or load them from numba's disk cache, now, so that this time is not
     booked on a real run's wall time or progress bar. Only what these schemes call is
@@ -71,16 +72,20 @@ def load_kernels(log: Any = None, pdes: Sequence[GranularPDE] = (),
         splitting: 'lie' or 'strang'.
         parallel: compile on two cores where there are (a helper process compiles
             part of the kernels, see :func:`pdeflow.numerics.compiled.ready_all`).
+        meanwhile: work of the caller's for this process while the helper compiles
+            (called once in any case; see ``ready_all``).
     """
     steppers = [scheme_stepper(*scheme_codes(pde, splitting)) for pde in pdes]
     if kernels_ready():
+        if meanwhile is not None:
+            meanwhile()
         return 0.0
     compiling = not kernels_cached()
     if compiling and log is not None:
         print("pdeflow: compiling numba kernels (once per machine) ...", end="",
               file=log, flush=True)
     t0 = time.perf_counter()
-    ready_all([k for scheme in steppers for k in scheme.kernels], parallel=parallel)
+    ready_all([k for scheme in steppers for k in scheme.kernels], parallel, meanwhile)
     for scheme in steppers:
         scheme.ready()
     seconds = time.perf_counter() - t0
