@@ -220,14 +220,12 @@ def _work(kernels: Sequence[Any]) -> int:
 
 
 def can_fork() -> bool:
-    """True if this process can fork a helper safely (it runs no other thread, whose
-    locks would stay locked in the fork) and the helper gets a core of its own."""
-    try:
-        cores = len(os.sched_getaffinity(0))
-    except AttributeError:  # pragma: no cover - not on Linux
-        cores = os.cpu_count() or 1
-    return (cores > 1 and threading.active_count() == 1
-            and "fork" in multiprocessing.get_all_start_methods())
+    """True if this process can fork a helper safely: on Linux (macOS's system libraries
+    do not survive a fork; Windows has none), with no other thread running (its locks
+    would stay locked in the fork) and a core for the helper."""
+    if not sys.platform.startswith("linux"):
+        return False
+    return len(os.sched_getaffinity(0)) > 1 and threading.active_count() == 1
 
 
 class FunctionPointer(CompileResultWAP):
