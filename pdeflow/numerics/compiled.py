@@ -130,12 +130,12 @@ def ready(compiled: Any) -> Any:
 
 
 HELPER_SHARE = 0.42
-"""Largest share of the compile work (bytecode of the call trees) that
-:func:`ready_all` gives its helper process. Below one half because the bytecode of a
-closure's tree overcounts: it includes the kernels of the branches that its
-constants drop (the fluxes a scheme does not use). On the paper's test 5.1 the
-two-layer source stage is 41 % of the bytecode and half of the compile time (5.4 of
-10.7 s, one process): the helper takes it alone."""
+"""The helper process's share of the compile work (bytecode of the call trees) that
+:func:`split_work` aims at. Below one half because the bytecode of a closure's tree
+overcounts: it includes the kernels of the branches that its constants drop (the
+fluxes a scheme does not use). On the paper's test 5.1 the two-layer source stage is
+41 % of the bytecode and half of the compile time (5.4 of 10.7 s, one process): the
+helper takes it alone."""
 
 
 def ready_all(kernels: Sequence[Any], parallel: bool = True,
@@ -176,20 +176,25 @@ def _ready_each(kernels: Sequence[Any]) -> None:
 
 def split_work(kernels: Sequence[Any]) -> list[Any]:
     """The kernels of ``kernels`` that the helper process of :func:`ready_all`
-    compiles: heaviest first, as long as its share of the work stays within
-    :data:`HELPER_SHARE` and this process keeps some. The work of a kernel is the
-    bytecode size of its call tree (compile time grows with it; a closure's tree also
-    counts the kernels of branches it drops); a callee shared by both sides counts on
-    both (both compile it)."""
+    compiles: of all ways to split them in two (neither side empty), the one whose
+    helper share of the work is nearest :data:`HELPER_SHARE` (more than 12 kernels:
+    the heaviest first while the share stays below it). The work of kernels is the
+    bytecode size of their call trees (compile time grows with it); a callee on both
+    sides counts on both (both compile it)."""
+    kernels = list(kernels)
     if len(kernels) < 2:
         return []
     total = _work(kernels)
-    chosen: list[Any] = []
-    for k in sorted(kernels, key=lambda k: -_work([k])):
-        rest = [other for other in kernels if other not in chosen and other is not k]
-        if rest and _work([*chosen, k]) <= HELPER_SHARE * total:
-            chosen.append(k)
-    return chosen
+    if len(kernels) > 12:
+        chosen: list[Any] = []
+        for k in sorted(kernels, key=lambda k: -_work([k])):
+            if len(chosen) < len(kernels) - 1 and \
+                    _work([*chosen, k]) <= HELPER_SHARE * total:
+                chosen.append(k)
+        return chosen
+    splits = ([k for i, k in enumerate(kernels) if mask >> i & 1]
+              for mask in range(1, 2 ** len(kernels) - 1))
+    return min(splits, key=lambda side: abs(_work(side) / total - HELPER_SHARE))
 
 
 def _needs_compiling(compiled: Any) -> bool:

@@ -100,9 +100,8 @@ def warm(spec: StudySpec) -> float:
     _silence_run_warnings()
     if spec.function is not None:
         importlib.import_module(spec.function.split(":", 1)[0])
-    for base, models in ((spec.case, spec.models()), (spec.sweep_case, spec.sweep_models())):
-        if base is None or not models:
-            continue
+    load_study_kernels(spec)
+    for base, models in _bases(spec):
         tiny = base.copy()
         grid = tiny.data.setdefault("grid", {})
         grid.pop("dx", None)
@@ -115,6 +114,24 @@ def warm(spec: StudySpec) -> float:
             except Exception:  # noqa: BLE001, S112 - warming only; evaluations report errors
                 continue
     return time.perf_counter() - t0
+
+
+def load_study_kernels(spec: StudySpec) -> None:
+    """Compile or load the numba kernels of every model the study's evaluations run,
+    all at once (so that a cold cache is filled on two cores, see
+    :func:`pdeflow.numerics.compiled.ready_all`). The local study engine calls it before
+    it starts its workers, which then load the kernels instead of each compiling them."""
+    from ..simulate import load_case_kernels
+
+    for base, models in _bases(spec):
+        load_case_kernels(spec.case_for(base, {}, models))
+
+
+def _bases(spec: StudySpec) -> list[tuple[Any, list[str]]]:
+    """(base case, models it runs) of the study's evaluations: its case and its sweep."""
+    return [(base, models) for base, models in ((spec.case, spec.models()),
+                                                (spec.sweep_case, spec.sweep_models()))
+            if base is not None and models]
 
 
 def evaluate_batch(spec: StudySpec, items: list[tuple[int, dict[str, Any]]]

@@ -22,7 +22,7 @@ from collections.abc import Callable
 from typing import Any
 
 from .designs import Optimiser, design_points
-from .evaluate import evaluate_batch, warm
+from .evaluate import evaluate_batch, load_study_kernels, warm
 from .results import ResultsTable
 from .spec import StudySpec
 
@@ -92,6 +92,8 @@ def run_study(spec: StudySpec, out: str, *, workers: int | None = None,
         return table
     log(f"{spec.name}: {total} evaluations to run ({len(done)} already in {table.csv})")
     t_start = time.perf_counter()
+    if scheduler is None:  # the local workers share this machine's kernel cache
+        load_study_kernels(spec)
     client, cluster, n_workers = _client(workers, scheduler)
     log(f"Dask: {n_workers} workers, dashboard {client.dashboard_link}")
     walls: deque[float] = deque(maxlen=200)
