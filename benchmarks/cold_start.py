@@ -201,7 +201,7 @@ system time of the process and of its helper processes, less sensitive than wall
 to the other jobs on this shared machine. *imports*, *compile*, *figures* and *rest*
 split the same command run through a wrapper that times top-level imports, numba's
 compilations (since *session4* with the wait for the helper process that compiles part
-of the kernels on the second core, `pdeflow.numerics.compiled.ready_all`) and
+of the kernels on the second core, `pdeflow.numerics.compile_parallel.ready_all`) and
 `pdeflow.plotting` (since *session4* drawn on two cores; the rest: interpreter start,
 reading the case, both runs, the summary). *warm*: the command again with the cache
 the cold run left. *load*: 1-minute load average of the machine at the start (2 cores).

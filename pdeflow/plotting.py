@@ -19,7 +19,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .io import atomic_path
-from .numerics.compiled import can_fork
+from .numerics.compile_parallel import can_fork
 from .numerics.state import DRY_TOLERANCE, velocity_profile
 
 DRY = 1e-9
@@ -162,7 +162,7 @@ def draw_all(jobs: Sequence[tuple[Callable, tuple, Path]],
     arguments, path) each; returns the paths. matplotlib draws on one core (a case's
     five figures take ~1 s): with ``parallel`` and the Agg backend (no window that a
     fork would share), a forked process draws every second figure meanwhile (where
-    :func:`pdeflow.numerics.compiled.can_fork`)."""
+    :func:`pdeflow.numerics.compile_parallel.can_fork`)."""
     agg = plt.get_backend().lower() == "agg"
     if not (parallel and len(jobs) > 1 and agg and can_fork()):
         return [_draw(job) for job in jobs]

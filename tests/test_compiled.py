@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 from numba.core import config
 
+from pdeflow.numerics import compile_parallel as parallel
 from pdeflow.numerics import compiled
 from pdeflow.numerics import layout as L
 from pdeflow.numerics.splitting import scheme_stepper
@@ -156,30 +157,35 @@ def large(x):
 """
 
 READY_ALL = r"""
-import json, sys
-sys.path.insert(0, sys.argv[1])
+import json, sys, threading
 import toy_kernels as toy
+from pdeflow.numerics import compile_parallel as parallel
 from pdeflow.numerics import compiled
+if sys.argv[1] == "threads":  # a server's process: the helper is a new interpreter
+    stop = threading.Event()
+    threading.Thread(target=stop.wait, daemon=True).start()
 ks = [toy.small, toy.medium, toy.large]
-helper = [k.py_func.__name__ for k in compiled.split_work(ks)]
-compiled.ready_all(ks, meanwhile=lambda: print("MEANWHILE", flush=True))
+helper = [k.py_func.__name__ for k in parallel.split_work(ks)]
+parallel.ready_all(ks, meanwhile=lambda: print("MEANWHILE", flush=True))
 print("STATS" + json.dumps({"helper": helper, "results": [k(2.0) for k in ks],
     "hits": {k.py_func.__name__: sum(k.stats.cache_hits.values()) for k in ks},
     "misses": {k.py_func.__name__: sum(k.stats.cache_misses.values()) for k in ks}}))
 """
 
 
-def test_ready_all_compiles_part_of_the_kernels_in_a_helper_process(tmp_path):
-    """On two cores and a cold cache, a forked helper compiles some of the kernels
-    (this process then loads them from the disk cache: cache hits) and this process
-    compiles the others (cache misses), and does what it is given to do meanwhile
-    once (the helper does not); the kernels give the right results."""
-    if not compiled.can_fork():
-        pytest.skip("no second core or no fork here")
+@pytest.mark.parametrize("threads", ["none", "threads"])
+def test_ready_all_compiles_part_of_the_kernels_in_a_helper_process(tmp_path, threads):
+    """On two cores and a cold cache, a helper process (a fork; with another thread
+    running, a new interpreter) compiles some of the kernels (this process then loads
+    them from the disk cache: cache hits) and this process compiles the others (cache
+    misses), and does what it is given to do meanwhile once (the helper does not); the
+    kernels give the right results."""
+    if parallel._cores() < 2:
+        pytest.skip("one core")
     (tmp_path / "toy_kernels.py").write_text(TOY_KERNELS)
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
-           "PYTHONPATH": str(ROOT)}
-    proc = subprocess.run([sys.executable, "-c", READY_ALL, str(tmp_path)], env=env,
+           "PYTHONPATH": os.pathsep.join([str(ROOT), str(tmp_path)])}
+    proc = subprocess.run([sys.executable, "-c", READY_ALL, threads], env=env,
                           cwd=ROOT, capture_output=True, text=True, timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
     line = [x for x in proc.stdout.splitlines() if x.startswith("STATS")][0]
@@ -207,19 +213,19 @@ def test_split_work_keeps_this_process_busy_and_no_fork_beside_threads():
     kernels = list(dict.fromkeys(
         scheme_stepper(True, L.FLUX_HLL, 1, L.LIMITER_MINMOD, False).kernels
         + scheme_stepper(False, L.FLUX_HLL, 1, L.LIMITER_MINMOD, False).kernels))
-    helper = compiled.split_work(kernels)
+    helper = parallel.split_work(kernels)
     assert helper == [sources_two_layer]
-    total = compiled._work(kernels)
-    best = min(abs(compiled._work(side) / total - compiled.HELPER_SHARE)
+    total = parallel._work(kernels)
+    best = min(abs(parallel._work(side) / total - parallel.HELPER_SHARE)
                for n in range(1, len(kernels))
                for side in itertools.combinations(kernels, n))
-    assert abs(compiled._work(helper) / total - compiled.HELPER_SHARE) == best
-    assert compiled.split_work(kernels[:1]) == []
+    assert abs(parallel._work(helper) / total - parallel.HELPER_SHARE) == best
+    assert parallel.split_work(kernels[:1]) == []
     stop = threading.Event()
     thread = threading.Thread(target=stop.wait)
     thread.start()
     try:
-        assert not compiled.can_fork()
+        assert not parallel.can_fork()
     finally:
         stop.set()
         thread.join()
@@ -232,9 +238,9 @@ def test_meanwhile_is_called_once_whatever_there_is_to_compile():
     from pdeflow.solvers import fv_split
 
     calls: list[int] = []
-    compiled.ready_all([], meanwhile=lambda: calls.append(1))
+    parallel.ready_all([], meanwhile=lambda: calls.append(1))
     stepper = scheme_stepper(False, L.FLUX_HLL, 1, L.LIMITER_MINMOD, False).ready()
-    compiled.ready_all(stepper.kernels, meanwhile=lambda: calls.append(2))
+    parallel.ready_all(stepper.kernels, meanwhile=lambda: calls.append(2))
     fv_split.load_kernels(None, [pdeflow.SingleLayerGranular()],
                           meanwhile=lambda: calls.append(3))
     assert calls == [1, 2, 3]

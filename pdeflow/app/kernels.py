@@ -1,8 +1,8 @@
 """The numba kernels, loaded in the background so that the app can say what it waits for.
 
-pdeflow's kernels are compiled on their first use and cached on disk (about 40 s for the
-app's kernels on the two-core development machine, docs/teaching.md; a fraction of a
-second to load afterwards). The app starts
+pdeflow's kernels are compiled on their first use and cached on disk (the app's first
+picture came 18 s after a start with an empty cache on the two-core development machine,
+docs/teaching.md; they load in a fraction of a second afterwards). The app starts
 :data:`WARMUP` when it is served or displayed; its pages show :meth:`KernelWarmup.message`
 (with the elapsed time) until the kernels are ready, instead of looking frozen.
 """
@@ -28,9 +28,10 @@ def warm_kernels() -> None:
     """Run every kernel the app uses once: compiles them, or loads them from the cache."""
     from ..cases import Case
     from ..numerics import hyperbolicity as hyp
-    from ..simulate import run_model
+    from ..simulate import load_case_kernels, run_model
 
     case = Case.from_dict(WARMUP_CASE, source="<kernel warm-up>")
+    load_case_kernels(case)  # both models' kernels at once: compiled on two cores
     for model in case.models:
         run_model(case, model)
     g, r, h1, h2 = 9.81, 0.67, 0.5, 1.0

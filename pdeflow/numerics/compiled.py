@@ -23,20 +23,16 @@ What the factories and the kernels share is kept here:
   closed-over kernel, which gives a new key in every process, so such a closure would
   never be loaded from the cache); :func:`cached`, which every other kernel uses, keys
   module-level kernels by their code and their callees' the same way.
-* :func:`ready_all` compiles several kernels on two cores: a helper process compiles
-  about half of them into numba's disk cache while this one compiles the rest, then
-  loads them (the first run on a machine spends most of its time compiling).
 * :func:`kernels`, :func:`kernels_ready`, :func:`kernels_cached`: what is compiled.
+
+Compiling several kernels on two cores: :mod:`pdeflow.numerics.compile_parallel`.
 """
 
 from __future__ import annotations
 
 import hashlib
-import multiprocessing
-import os
 import sys
-import threading
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator
 from types import CodeType
 from typing import Any
 
@@ -114,6 +110,12 @@ def entry(*kernels: Any) -> None:
             _ENTRIES.append(compiled)
 
 
+def needs_compiling(compiled: Any) -> bool:
+    """True for a kernel whose declared signature is neither compiled nor loaded."""
+    return (isinstance(compiled, Dispatcher) and compiled in _SIGNATURES
+            and _SIGNATURES[compiled] not in compiled.signatures)
+
+
 def ready(compiled: Any) -> Any:
     """Compile (or load) the signature of ``compiled`` and of the kernels it calls,
     callees first, then allow no other signature; returns ``compiled``."""
@@ -127,110 +129,6 @@ def ready(compiled: Any) -> Any:
             compiled.compile(sig)
         compiled.disable_compile()
     return compiled
-
-
-HELPER_SHARE = 0.42
-"""The helper process's share of the compile work (bytecode of the call trees) that
-:func:`split_work` aims at. Below one half because the bytecode of a closure's tree
-overcounts: it includes the kernels of the branches that its constants drop (the
-fluxes a scheme does not use). On the paper's test 5.1 the two-layer source stage is
-41 % of the bytecode and half of the compile time (5.4 of 10.7 s, one process): the
-helper takes it alone."""
-
-
-def ready_all(kernels: Sequence[Any], parallel: bool = True,
-              meanwhile: Callable[[], Any] | None = None) -> None:
-    """:func:`ready` every kernel of ``kernels``; with ``parallel``, two or more kernels
-    to compile (not in the disk cache) and a second core, a helper process (a fork of
-    this one) compiles about half of them into numba's disk cache meanwhile (see
-    :func:`split_work`) and this process loads them from there once it is done. If
-    the helper fails, this process compiles its kernels itself: same outcome, slower.
-    A process with other threads (a server, a Dask worker) compiles alone: a fork
-    copies only this thread, and a lock that another one held (numba's compiler lock)
-    would stay locked in the helper. ``meanwhile`` (if given) is called once, after
-    this process's own compiling and before it waits for the helper: other work of
-    the caller's that can fill that wait (e.g. the imports its figures need)."""
-    todo = [k for k in dict.fromkeys(kernels) if _needs_compiling(k)]
-    helper_kernels: list[Any] = []
-    if parallel and can_fork():
-        helper_kernels = split_work([k for k in todo if not _in_disk_cache(k)])
-    helper = None
-    if helper_kernels:
-        sys.stdout.flush()  # the fork must not write this process's buffers again
-        sys.stderr.flush()
-        helper = multiprocessing.get_context("fork").Process(
-            target=_ready_each, args=(helper_kernels,), daemon=True)
-        helper.start()
-    _ready_each([k for k in todo if k not in helper_kernels])
-    if meanwhile is not None:
-        meanwhile()
-    if helper is not None:
-        helper.join()
-    _ready_each(todo)
-
-
-def _ready_each(kernels: Sequence[Any]) -> None:
-    for k in kernels:
-        ready(k)
-
-
-def split_work(kernels: Sequence[Any]) -> list[Any]:
-    """The kernels of ``kernels`` that the helper process of :func:`ready_all`
-    compiles: of all ways to split them in two (neither side empty), the one whose
-    helper share of the work is nearest :data:`HELPER_SHARE` (more than 12 kernels:
-    the heaviest first while the share stays below it). The work of kernels is the
-    bytecode size of their call trees (compile time grows with it); a callee on both
-    sides counts on both (both compile it)."""
-    kernels = list(kernels)
-    if len(kernels) < 2:
-        return []
-    total = _work(kernels)
-    if len(kernels) > 12:
-        chosen: list[Any] = []
-        for k in sorted(kernels, key=lambda k: -_work([k])):
-            if len(chosen) < len(kernels) - 1 and \
-                    _work([*chosen, k]) <= HELPER_SHARE * total:
-                chosen.append(k)
-        return chosen
-    splits = ([k for i, k in enumerate(kernels) if mask >> i & 1]
-              for mask in range(1, 2 ** len(kernels) - 1))
-    return min(splits, key=lambda side: abs(_work(side) / total - HELPER_SHARE))
-
-
-def _needs_compiling(compiled: Any) -> bool:
-    """True for a kernel whose declared signature is neither compiled nor loaded."""
-    return (isinstance(compiled, Dispatcher) and compiled in _SIGNATURES
-            and _SIGNATURES[compiled] not in compiled.signatures)
-
-
-def _call_tree(compiled: Any, found: dict[int, Any]) -> dict[int, Any]:
-    """``compiled`` and every kernel it closes over or names, recursively."""
-    if id(compiled) not in found:
-        found[id(compiled)] = compiled
-        func = compiled.py_func
-        values = [c.cell_contents for c in func.__closure__ or ()]
-        values += [func.__globals__.get(name) for name in func.__code__.co_names]
-        for value in values:
-            if isinstance(value, Dispatcher):
-                _call_tree(value, found)
-    return found
-
-
-def _work(kernels: Sequence[Any]) -> int:
-    """Bytecode size [bytes] of the union of the call trees of ``kernels``."""
-    found: dict[int, Any] = {}
-    for k in kernels:
-        _call_tree(k, found)
-    return sum(len(k.py_func.__code__.co_code) for k in found.values())
-
-
-def can_fork() -> bool:
-    """True if this process can fork a helper safely: on Linux (macOS's system libraries
-    do not survive a fork; Windows has none), with no other thread running (its locks
-    would stay locked in the fork) and a core for the helper."""
-    if not sys.platform.startswith("linux"):
-        return False
-    return len(os.sched_getaffinity(0)) > 1 and threading.active_count() == 1
 
 
 class FunctionPointer(CompileResultWAP):
@@ -307,10 +205,10 @@ def kernels_cached() -> bool:
     """True if numba's disk cache holds every kernel that :func:`kernels_ready` waits
     for, for this machine's CPU, so that loading them takes a fraction of a second
     instead of compiling them. Reads numba's cache index; False if it cannot."""
-    return all(_in_disk_cache(k) for k in _pending())
+    return all(in_disk_cache(k) for k in _pending())
 
 
-def _in_disk_cache(compiled: Any) -> bool:
+def in_disk_cache(compiled: Any) -> bool:
     """True if numba's disk cache holds the declared signature of ``compiled`` for this
     machine's CPU (read from numba's cache index; False if it cannot be read)."""
     try:

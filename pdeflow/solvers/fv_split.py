@@ -28,7 +28,8 @@ from pde.trackers.base import FinishedSimulation
 
 from ..models.base import GranularPDE, check_range
 from ..numerics import layout as L
-from ..numerics.compiled import kernels_cached, kernels_ready, ready_all
+from ..numerics.compile_parallel import ready_all
+from ..numerics.compiled import kernels_cached, kernels_ready
 from ..numerics.splitting import STATUS_FAIL, STATUS_REST, python_stepping, scheme_stepper
 
 
@@ -71,7 +72,7 @@ def load_kernels(log: Any = None, pdes: Sequence[GranularPDE] = (),
         pdes: the models of the runs to come.
         splitting: 'lie' or 'strang'.
         parallel: compile on two cores where there are (a helper process compiles
-            part of the kernels, see :func:`pdeflow.numerics.compiled.ready_all`).
+            part of the kernels, see :func:`pdeflow.numerics.compile_parallel.ready_all`).
         meanwhile: work of the caller's for this process while the helper compiles
             (called once in any case; see ``ready_all``).
     """

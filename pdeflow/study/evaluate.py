@@ -119,7 +119,7 @@ def warm(spec: StudySpec) -> float:
 def load_study_kernels(spec: StudySpec) -> None:
     """Compile or load the numba kernels of every model the study's evaluations run,
     all at once (so that a cold cache is filled on two cores, see
-    :func:`pdeflow.numerics.compiled.ready_all`). The local study engine calls it before
+    :func:`pdeflow.numerics.compile_parallel.ready_all`). The local study engine calls it before
     it starts its workers, which then load the kernels instead of each compiling them."""
     from ..simulate import load_case_kernels
 

@@ -1,0 +1,175 @@
+"""Compiling a run's kernels on two cores: a helper process fills numba's disk cache.
+
+The first run on a machine spends most of its time compiling (test 5.1: ~11 s in one
+process, docs/performance.md "Cold first run"), one core busy. :func:`ready_all`
+splits the kernels a run needs in two (:func:`split_work`): a helper process compiles
+its share into numba's disk cache (the kernels' cache keys are their code, the same in
+every process, :mod:`pdeflow.numerics.compiled`) while this process compiles the rest;
+then this process loads the helper's kernels from the cache. The helper is
+
+* a **fork** of this process where that is safe (:func:`can_fork`: Linux, no other
+  thread): it starts at once and takes any kernel, closures included;
+* else a **new interpreter** (a server, a Jupyter kernel, a Dask worker: processes with
+  threads), which imports pdeflow (~1 s) and takes the kernels it can find by name
+  (module-level ones, such as the source stages).
+
+Nothing depends on the helper: if it fails, this process compiles its kernels itself.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import subprocess
+import sys
+import threading
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+from numba.core.dispatcher import Dispatcher
+
+from .compiled import in_disk_cache, needs_compiling, ready
+
+HELPER_SHARE = 0.42
+"""The helper process's share of the compile work (bytecode of the call trees) that
+:func:`split_work` aims at. Below one half because the bytecode of a closure's tree
+overcounts: it includes the kernels of the branches that its constants drop (the
+fluxes a scheme does not use). On the paper's test 5.1 the two-layer source stage is
+41 % of the bytecode and half of the compile time (5.4 of 10.7 s, one process): the
+helper takes it alone."""
+
+
+def ready_all(kernels: Sequence[Any], parallel: bool = True,
+              meanwhile: Callable[[], Any] | None = None) -> None:
+    """:func:`~pdeflow.numerics.compiled.ready` every kernel of ``kernels``; with
+    ``parallel``, two or more kernels to compile (not in the disk cache) and a second
+    core, a helper process compiles part of them meanwhile (module docstring).
+    ``meanwhile`` (if given) is called once, after this process's own compiling and
+    before it waits for the helper: other work of the caller's that can fill that wait
+    (e.g. the imports its figures need)."""
+    todo = [k for k in dict.fromkeys(kernels) if needs_compiling(k)]
+    helper, helper_kernels = None, []
+    if parallel and _cores() > 1 and len(todo) > 1:
+        cold = [k for k in todo if not in_disk_cache(k)]
+        forked = can_fork()
+        helper_kernels = split_work(cold, movable=None if forked else
+                                    [k for k in cold if _importable(k)])
+        if helper_kernels:
+            helper = _fork(helper_kernels) if forked else _interpreter(helper_kernels)
+    _ready_each([k for k in todo if k not in helper_kernels])
+    if meanwhile is not None:
+        meanwhile()
+    if helper is not None:
+        helper()
+    _ready_each(todo)
+
+
+def split_work(kernels: Sequence[Any], movable: Sequence[Any] | None = None) -> list[Any]:
+    """The kernels of ``kernels`` (only ``movable`` ones, if given) that the helper
+    process compiles: of all ways to split them in two (neither side empty), the one
+    whose helper share of the work is nearest :data:`HELPER_SHARE` (more than 12
+    candidates: the heaviest first while the share stays below it). The work of
+    kernels is the bytecode size of their call trees (compile time grows with it); a
+    callee on both sides counts on both (both compile it)."""
+    kernels = list(kernels)
+    movable = kernels if movable is None else list(movable)
+    if len(kernels) < 2 or not movable:
+        return []
+    total = _work(kernels)
+    if len(movable) > 12:
+        chosen: list[Any] = []
+        for k in sorted(movable, key=lambda k: -_work([k])):
+            if len(chosen) < len(kernels) - 1 and \
+                    _work([*chosen, k]) <= HELPER_SHARE * total:
+                chosen.append(k)
+        return chosen
+    splits = ([k for i, k in enumerate(movable) if mask >> i & 1]
+              for mask in range(1, 2 ** len(movable)))
+    return min((side for side in splits if len(side) < len(kernels)),
+               key=lambda side: abs(_work(side) / total - HELPER_SHARE), default=[])
+
+
+def can_fork() -> bool:
+    """True if this process can fork a helper safely and the helper gets a core of its
+    own: on Linux (macOS's system libraries do not survive a fork; Windows has none),
+    with no other thread running (its locks, numba's compiler lock among them, would
+    stay locked in the fork) and a second core."""
+    return (sys.platform.startswith("linux") and threading.active_count() == 1
+            and _cores() > 1)
+
+
+def helper_main(names: Sequence[str]) -> None:
+    """The new-interpreter helper: ready the kernels named ``module:qualname``."""
+    import importlib
+
+    for name in names:
+        module, _, qualname = name.partition(":")
+        ready(getattr(importlib.import_module(module), qualname))
+
+
+def _fork(kernels: Sequence[Any]) -> Callable[[], None]:
+    sys.stdout.flush()  # the fork must not write this process's buffers again
+    sys.stderr.flush()
+    process = multiprocessing.get_context("fork").Process(
+        target=_ready_each, args=(kernels,), daemon=True)
+    process.start()
+    return process.join
+
+
+def _interpreter(kernels: Sequence[Any]) -> Callable[[], None] | None:
+    names = [f"{k.py_func.__module__}:{k.py_func.__qualname__}" for k in kernels]
+    # the helper must import this pdeflow, whatever put it on this process's path
+    root = str(Path(__file__).resolve().parents[2])
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        [root, *filter(None, [os.environ.get("PYTHONPATH")])])}
+    code = ("import sys; from pdeflow.numerics.compile_parallel import helper_main; "
+            "helper_main(sys.argv[1:])")
+    try:
+        process = subprocess.Popen([sys.executable, "-c", code, *names], env=env,
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    except OSError:  # pragma: no cover - no process to spare: compile here
+        return None
+    return process.wait
+
+
+def _ready_each(kernels: Sequence[Any]) -> None:
+    for k in kernels:
+        ready(k)
+
+
+def _importable(compiled: Any) -> bool:
+    """True if a new interpreter finds ``compiled`` by its module and name."""
+    func = compiled.py_func
+    module = sys.modules.get(func.__module__)
+    return "<locals>" not in func.__qualname__ and \
+        getattr(module, func.__qualname__, None) is compiled
+
+
+def _call_tree(compiled: Any, found: dict[int, Any]) -> dict[int, Any]:
+    """``compiled`` and every kernel it closes over or names, recursively."""
+    if id(compiled) not in found:
+        found[id(compiled)] = compiled
+        func = compiled.py_func
+        values = [c.cell_contents for c in func.__closure__ or ()]
+        values += [func.__globals__.get(name) for name in func.__code__.co_names]
+        for value in values:
+            if isinstance(value, Dispatcher):
+                _call_tree(value, found)
+    return found
+
+
+def _work(kernels: Sequence[Any]) -> int:
+    """Bytecode size [bytes] of the union of the call trees of ``kernels``."""
+    found: dict[int, Any] = {}
+    for k in kernels:
+        _call_tree(k, found)
+    return sum(len(k.py_func.__code__.co_code) for k in found.values())
+
+
+def _cores() -> int:
+    """Cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not on Linux
+        return os.cpu_count() or 1
