@@ -64,7 +64,8 @@ def load_kernels(log: Any = None, pdes: Sequence[GranularPDE] = (),
     """Compile the ``fv-split`` kernels of the models ``pdes`` (their schemes, with
     ``splitting``) or load them from numba's disk cache, now, so that this time is not
     booked on a real run's wall time or progress bar. Only what these schemes call is
-    compiled. Returns the seconds it took (0 if they were already loaded).
+    compiled. Returns the seconds it took, ``meanwhile`` included (0 if the kernels
+    were already loaded).
 
     Args:
         log: a stream (e.g. ``sys.stderr``) that is told when the kernels have to be
