@@ -119,12 +119,16 @@ def warm(spec: StudySpec) -> float:
 def load_study_kernels(spec: StudySpec) -> None:
     """Compile or load the numba kernels of every model the study's evaluations run,
     all at once (so that a cold cache is filled on two cores, see
-    :func:`pdeflow.numerics.compile_parallel.ready_all`). The local study engine calls it before
-    it starts its workers, which then load the kernels instead of each compiling them."""
+    :func:`pdeflow.numerics.compile_parallel.ready_all`). The local study engine calls
+    it before it starts its workers, which then load the kernels instead of each
+    compiling them. Warming only: a failure is left to the evaluations to report."""
     from ..simulate import load_case_kernels
 
     for base, models in _bases(spec):
-        load_case_kernels(spec.case_for(base, {}, models))
+        try:
+            load_case_kernels(spec.case_for(base, {}, models))
+        except Exception:  # noqa: BLE001, S112 - warming only; evaluations report errors
+            continue
 
 
 def _bases(spec: StudySpec) -> list[tuple[Any, list[str]]]:
