@@ -56,12 +56,17 @@ def ready_all(kernels: Sequence[Any], parallel: bool = True,
         helper_kernels = split_work(cold, movable=None if forked else
                                     [k for k in cold if _importable(k)])
         if helper_kernels:
-            helper = _fork(helper_kernels) if forked else _interpreter(helper_kernels)
-    _ready_each([k for k in todo if k not in helper_kernels])
-    if meanwhile is not None:
-        meanwhile()
+            helper = _Forked(helper_kernels) if forked else _interpreter(helper_kernels)
+    try:
+        _ready_each([k for k in todo if k not in helper_kernels])
+        if meanwhile is not None:
+            meanwhile()
+    except BaseException:
+        if helper is not None:  # e.g. Ctrl-C: no helper outlives this call
+            helper.terminate()
+        raise
     if helper is not None:
-        helper()
+        helper.wait()
     _ready_each(todo)
 
 
@@ -108,16 +113,24 @@ def helper_main(names: Sequence[str]) -> None:
         ready(getattr(importlib.import_module(module), qualname))
 
 
-def _fork(kernels: Sequence[Any]) -> Callable[[], None]:
-    sys.stdout.flush()  # the fork must not write this process's buffers again
-    sys.stderr.flush()
-    process = multiprocessing.get_context("fork").Process(
-        target=_ready_each, args=(kernels,), daemon=True)
-    process.start()
-    return process.join
+class _Forked:
+    """A forked helper process, waited for like a ``subprocess.Popen``."""
+
+    def __init__(self, kernels: Sequence[Any]):
+        sys.stdout.flush()  # the fork must not write this process's buffers again
+        sys.stderr.flush()
+        self.process = multiprocessing.get_context("fork").Process(
+            target=_ready_each, args=(kernels,), daemon=True)
+        self.process.start()
+
+    def wait(self) -> None:
+        self.process.join()
+
+    def terminate(self) -> None:
+        self.process.terminate()
 
 
-def _interpreter(kernels: Sequence[Any]) -> Callable[[], None] | None:
+def _interpreter(kernels: Sequence[Any]) -> subprocess.Popen | None:
     names = [f"{k.py_func.__module__}:{k.py_func.__qualname__}" for k in kernels]
     # the helper must import this pdeflow, whatever put it on this process's path
     root = str(Path(__file__).resolve().parents[2])
@@ -126,11 +139,10 @@ def _interpreter(kernels: Sequence[Any]) -> Callable[[], None] | None:
     code = ("import sys; from pdeflow.numerics.compile_parallel import helper_main; "
             "helper_main(sys.argv[1:])")
     try:
-        process = subprocess.Popen([sys.executable, "-c", code, *names], env=env,
-                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        return subprocess.Popen([sys.executable, "-c", code, *names], env=env,
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     except OSError:  # pragma: no cover - no process to spare: compile here
         return None
-    return process.wait
 
 
 def _ready_each(kernels: Sequence[Any]) -> None:
