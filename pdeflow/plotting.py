@@ -93,10 +93,8 @@ def deposit_figure(x: np.ndarray, two: np.ndarray | None, single: np.ndarray | N
 
 def fixed_margins(fig: Any, top: float, left: float = 0.9, right: float = 0.2,
                   bottom: float = 0.5, gap: float = 0.3) -> None:
-    """Margins and the gap between stacked panels in inches, fixed: wide enough for
-    the axis labels and tick labels of up to 5 characters. (``tight_layout`` measures
-    every text first: it took half the drawing time of a case's figures, ~0.7 s of
-    a first run.)"""
+    """Margins and gap between stacked panels [inches], wide enough for axis labels
+    and 5-character tick labels (``tight_layout`` took half the drawing time)."""
     w, h = fig.get_size_inches()
     rows = len(fig.axes)
     panel = (h - top - bottom - gap * (rows - 1)) / rows
@@ -159,11 +157,10 @@ def case_figures(results: dict[str, Any], outdir: str | Path, prefix: str = "",
 
 def draw_all(jobs: Sequence[tuple[Callable, tuple, Path]],
              parallel: bool = True) -> list[Path]:
-    """Draw and save (:func:`save`) the figures ``jobs``: (figure function, its
-    arguments, path) each; returns the paths. matplotlib draws on one core (a case's
-    five figures take ~1 s): with ``parallel`` and the Agg backend (no window that a
-    fork would share), a forked process draws every second figure meanwhile (where
-    :func:`pdeflow.numerics.compile_parallel.can_fork`)."""
+    """Draw and :func:`save` the figures ``jobs`` (figure function, its arguments,
+    path); returns the paths. With ``parallel``, Agg (no window a fork would share)
+    and :func:`~pdeflow.numerics.compile_parallel.can_fork`, a forked process draws
+    every second figure meanwhile (matplotlib uses one core)."""
     agg = plt.get_backend().lower() == "agg"
     if not (parallel and len(jobs) > 1 and agg and can_fork()):
         return [_draw(job) for job in jobs]
