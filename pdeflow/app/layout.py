@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import panel as pn
 
@@ -78,13 +79,18 @@ def create_app(case_dir: str | Path | None = None, page: str | None = None) -> p
     if WARMUP.done:
         build()
     elif served():
+        polling: list[Any] = []
+
         def poll() -> None:
             status.object = f"<b>{WARMUP.message()}</b>"
-            if WARMUP.done:
-                callback.stop()
+            if WARMUP.done and polling:
                 build()
+                polling.pop().stop()
 
-        callback = pn.state.add_periodic_callback(poll, period=POLL_MS)
+        # poll once the browser has loaded the page: pages built before that, when the
+        # warm-up ended within the first second, were sometimes never shown
+        pn.state.onload(lambda: polling.append(
+            pn.state.add_periodic_callback(poll, period=POLL_MS)))
     else:
         pn.extension()  # Jupyter: load Panel's JavaScript (harmless in a script)
         print(WARMUP.message(), flush=True)
