@@ -27,9 +27,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from numba.core.dispatcher import Dispatcher
-
-from .compiled import in_disk_cache, needs_compiling, ready
+from .compiled import in_disk_cache, needs_compiling, ready, referenced_kernels
 
 HELPER_SHARE = 0.42
 """The helper process's share of the compile work (bytecode of the call trees) that
@@ -162,12 +160,9 @@ def _call_tree(compiled: Any, found: dict[int, Any]) -> dict[int, Any]:
     """``compiled`` and every kernel it closes over or names, recursively."""
     if id(compiled) not in found:
         found[id(compiled)] = compiled
-        func = compiled.py_func
-        values = [c.cell_contents for c in func.__closure__ or ()]
-        values += [func.__globals__.get(name) for name in func.__code__.co_names]
-        for value in values:
-            if isinstance(value, Dispatcher):
-                _call_tree(value, found)
+        closed, named = referenced_kernels(compiled)
+        for kernel in (*closed, *named):
+            _call_tree(kernel, found)
     return found
 
 

@@ -155,18 +155,22 @@ def first_class(compiled: Any) -> Any:
     return FunctionPointer(compiled.overloads[_SIGNATURES[compiled]])
 
 
+def referenced_kernels(compiled: Any) -> tuple[list[Any], list[Any]]:
+    """(the kernels ``compiled`` closes over, the module-level kernels its code names)."""
+    func = compiled.py_func
+    closed = [c.cell_contents for c in func.__closure__ or ()]
+    named = [func.__globals__.get(name) for name in func.__code__.co_names]
+    return ([k for k in closed if isinstance(k, Dispatcher)],
+            [k for k in named if isinstance(k, Dispatcher)])
+
+
 def _callees(compiled: Any) -> Iterator[Any]:
     """The kernels that ``compiled`` closes over, and the module-level kernels with a
     declared signature that it names. (A factory closes over what its scheme calls
     only, None for the rest, so that nothing here is compiled for nothing.)"""
-    func = compiled.py_func
-    for cell in func.__closure__ or ():
-        if isinstance(cell.cell_contents, Dispatcher):
-            yield cell.cell_contents
-    for name in func.__code__.co_names:
-        value = func.__globals__.get(name)
-        if isinstance(value, Dispatcher) and value in _SIGNATURES:
-            yield value
+    closed, named = referenced_kernels(compiled)
+    yield from closed
+    yield from (k for k in named if k in _SIGNATURES)
 
 
 def kernels() -> list[Any]:
