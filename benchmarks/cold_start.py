@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import resource
 import shutil
 import statistics
@@ -238,8 +239,10 @@ def render(data: dict[str, Any]) -> str:
              f"(*{label}*: imports, figures and the rest), the floor of a cold run; "
              f"compiling took {s['compile_s']:.1f} s of {s['wall_s']:.1f} s.")
     def names(kernels: list[str]) -> str:
-        return ", ".join(f"`{k.replace('pdeflow.numerics.', '').replace('.<locals>', '')}`"
-                         for k in kernels)
+        # a closure's name ends in a digest of its constants (compiled.specialise)
+        short = (re.sub(r"_[0-9a-f]{12}$", "", k.replace("pdeflow.numerics.", "")
+                        .replace(".<locals>", "")) for k in kernels)
+        return ", ".join(f"`{k}`" for k in short)
 
     for label, d in data.items():
         L.append(f"\nKernels compiled by the cold run, *{label}*: {names(d['kernels'])}.")

@@ -51,7 +51,9 @@ def test_the_paper_cases_compile_every_kernel_once():
     several = {k: v for k, v in kernels.items() if len(v) > 1}
     assert not several, several
     used = {k.split("#")[0] for k, v in kernels.items() if v}
-    assert "pdeflow.numerics.splitting.stepping_function.<locals>.advance" in used
+    # a closure's name ends in a digest of its constants (compiled.specialise)
+    assert any(k.startswith("pdeflow.numerics.splitting.stepping_function.<locals>"
+                            ".advance_") for k in used), sorted(used)
     assert "pdeflow.numerics.source_stage.sources_two_layer" in used
     for name in ("reconstruct_muscl", "predictor", "rusanov", "ifcp", "roe",
                  "internal_speed", "source_rate", "source_stage_"):
@@ -106,6 +108,46 @@ print("STATS" + json.dumps(out))
     assert stats[0] == [[0, 1], [0, 1]]  # compiled
     assert stats[1] == [[1, 0], [1, 0]]  # loaded, each under its own key
 
+
+
+# the single-layer advection stage of one flux (a closure over the flux's constants that
+# calls a closure for the fluctuations) on a dam-break state: rates and cache hits
+ADVECT_ONCE = r"""
+import json, sys
+import numpy as np
+from pdeflow.numerics import layout as L
+from pdeflow.numerics.advection import advection_kernel
+from pdeflow.numerics.compiled import ready
+q = np.zeros((2, 8))
+q[0, :4] = 1.0
+q[1, 2] = 0.5
+out = []
+for flux in sys.argv[1:]:
+    k = ready(advection_kernel(False, getattr(L, flux), 1, L.LIMITER_MINMOD))
+    rate = np.zeros_like(q)
+    k(q, rate, np.zeros((3, 2, 8)), 0.1, 0, 0, 9.81, 0.0, 1e-6, 0, 7)
+    out.append([rate.tolist(), sum(k.stats.cache_hits.values())])
+print("STATS" + json.dumps(out))
+"""
+
+
+def test_closures_compiled_in_two_processes_load_together(tmp_path):
+    """Two closures of one factory, each compiled in a fresh process (numba numbers
+    compiled functions with a per-process counter, so both fluctuation closures get the
+    same number), then both loaded from the disk cache in a third, each give the rates
+    they gave where they were compiled (numba issue #10486: code of two functions with
+    one name can be mixed up by the process that loads both)."""
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path), "PYTHONPATH": str(ROOT)}
+    runs = []
+    for fluxes in (["FLUX_HLL"], ["FLUX_RUSANOV"], ["FLUX_HLL", "FLUX_RUSANOV"]):
+        proc = subprocess.run([sys.executable, "-c", ADVECT_ONCE, *fluxes], env=env,
+                              cwd=ROOT, capture_output=True, text=True, timeout=900)
+        assert proc.returncode == 0, proc.stderr[-3000:]
+        line = [x for x in proc.stdout.splitlines() if x.startswith("STATS")][0]
+        runs.append(json.loads(line[len("STATS"):]))
+    (hll, hll_hits), (rusanov, rusanov_hits) = runs[0][0], runs[1][0]
+    assert hll != rusanov and hll_hits == rusanov_hits == 0  # compiled, each in its own
+    assert runs[2] == [[hll, 1], [rusanov, 1]]  # loaded together, each still itself
 
 
 @pytest.mark.skipif(config.DISABLE_JIT, reason="no cache without the JIT")

@@ -21,8 +21,12 @@ What the factories and the kernels share is kept here:
 * :func:`specialise` caches a closure on disk under a key made of the constants it
   closes over and the code of the kernels it calls (numba's own key pickles a
   closed-over kernel, which gives a new key in every process, so such a closure would
-  never be loaded from the cache); :func:`cached`, which every other kernel uses, keys
-  module-level kernels by their code and their callees' the same way.
+  never be loaded from the cache), and names it after them; :func:`kernel` and
+  :func:`cached` key module-level kernels by their code and their callees' the same way.
+* :func:`cached` helpers (and closures specialised with ``helper=True``) are
+  :class:`HelperKernel` s: only other kernels call them, so they are compiled without
+  the entry points that Python and C function pointers need, which every caller would
+  link in and compile again (a call from Python still works).
 * :func:`kernels`, :func:`kernels_ready`, :func:`kernels_cached`: what is compiled.
 
 Compiling several kernels on two cores: :mod:`pdeflow.numerics.compile_parallel`.
@@ -36,10 +40,11 @@ from collections.abc import Callable, Iterator
 from types import CodeType
 from typing import Any
 
-from numba import njit, types
+from numba import types
 from numba.core import config
 from numba.core.caching import FunctionCache
 from numba.core.dispatcher import Dispatcher
+from numba.core.registry import CPUDispatcher
 from numba.core.types.function_type import CompileResultWAP
 from numba.core.typing.typeof import typeof_impl
 
@@ -64,10 +69,11 @@ _ENTRIES: list[Any] = []
 
 def kernel(*arg_types: Any) -> Callable:
     """Decorator: a module-level numba kernel (disk-cached) with the one signature
-    ``arg_types``, compiled lazily (by :func:`ready`, or by the first caller)."""
+    ``arg_types``, compiled lazily (by :func:`ready`, or by the first caller), callable
+    from Python and through a function pointer."""
 
     def wrap(func: Callable) -> Any:
-        compiled = cached(func)
+        compiled = _jit(func)
         if isinstance(compiled, Dispatcher):  # not with NUMBA_DISABLE_JIT=1
             _SIGNATURES[compiled] = tuple(arg_types)
         return compiled
@@ -76,29 +82,67 @@ def kernel(*arg_types: Any) -> Callable:
 
 
 def cached(func: Callable | None = None, *, inline: str = "never") -> Any:
-    """Decorator: ``numba.njit`` with the disk cache keyed by the code of the function
-    and of every kernel it calls (see :class:`_CodeKeyedCache`); ``@cached`` or
-    ``@cached(inline="always")``."""
+    """Decorator: a helper kernel that other kernels call (see :class:`HelperKernel`),
+    disk-cached under the code of the function and of every kernel it calls (see
+    :class:`_CodeKeyedCache`); ``@cached`` or ``@cached(inline="always")``."""
 
     def wrap(f: Callable) -> Any:
-        compiled = njit(inline=inline)(f)
-        if isinstance(compiled, Dispatcher):  # not with NUMBA_DISABLE_JIT=1
-            compiled._cache = _CodeKeyedCache(f)
-        return compiled
+        return _jit(f, helper=True, inline=inline)
 
     return wrap(func) if func is not None else wrap
 
 
-def specialise(func: Callable, *arg_types: Any) -> Any:
+def specialise(func: Callable, *arg_types: Any, helper: bool = False,
+               pointer: bool = True) -> Any:
     """A numba kernel of the closure ``func`` with the one signature ``arg_types``,
     disk-cached under its constants (see the module docstring); compiled by
-    :func:`ready`."""
+    :func:`ready`. ``helper``: only other kernels call it (see :class:`HelperKernel`);
+    ``pointer``: it is also called through a function pointer (:func:`first_class`)."""
     if config.DISABLE_JIT:
         return func
-    compiled = njit(func)
-    compiled._cache = _CodeKeyedCache(func)
+    # numba names compiled code after the function's qualified name and a per-process
+    # counter: two closures of one factory compiled in two processes (a run and its
+    # compile helper, or two runs) can get one name, and a process that loads both
+    # from the disk cache then runs one's code for the other (numba issue #10486; it
+    # made a rate test fail). Here the name carries what the closure is made of.
+    description = repr(_describe_function(func)).encode()
+    func.__qualname__ += "_" + hashlib.sha256(description).hexdigest()[:12]
+    compiled = _jit(func, helper=helper, pointer=pointer)
     _SIGNATURES[compiled] = tuple(arg_types)
     _SPECIALISED.append(compiled)
+    return compiled
+
+
+class HelperKernel(CPUDispatcher):
+    """A kernel that other kernels call: compiled without the two entry points numba
+    gives every function by default, one for calls from Python (it unboxes the
+    arguments and boxes the result) and one for C function pointers. Their code is
+    linked into every caller with the rest of the helper and compiled again there, at
+    every level of a call tree (test 5.1's two-layer source stage is a tree of 20
+    helpers; docs/performance.md, "Cold first run", has the time saved). A call from
+    Python (a test, the app's spectrum page) goes to a twin with the entry points,
+    compiled on its first such call and cached apart. (numba cannot call a function
+    without its Python entry point from Python: the process would crash.)"""
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        twin = self.__dict__.get("_python_twin")
+        if twin is None:
+            twin = self._python_twin = _jit(self.py_func, python_twin=True)
+        return twin(*args, **kwargs)
+
+
+def _jit(func: Callable, *, helper: bool = False, pointer: bool = True,
+         inline: str = "never", python_twin: bool = False) -> Any:
+    """``numba.njit(func)`` with the disk cache of :class:`_CodeKeyedCache`; ``helper``:
+    a :class:`HelperKernel`; not ``pointer``: without the entry point for a function
+    pointer."""
+    if config.DISABLE_JIT:
+        return func
+    options = {"nopython": True, "boundscheck": None, "inline": inline,
+               "no_cpython_wrapper": helper, "no_cfunc_wrapper": helper or not pointer}
+    compiled = (HelperKernel if helper else CPUDispatcher)(
+        py_func=func, locals={}, targetoptions=options)
+    compiled._cache = _CodeKeyedCache(func, python_twin)
     return compiled
 
 
@@ -261,7 +305,13 @@ class _CodeKeyedCache(FunctionCache):
     was loaded with the old callee compiled in (a stale cache once gave a wrong test
     5.1 result); here it is recompiled."""
 
+    def __init__(self, py_func: Callable, python_twin: bool = False):
+        super().__init__(py_func)
+        # a helper's twin (see HelperKernel) has entry points the helper lacks
+        self._variant = "python twin" if python_twin else ""
+
     def _index_key(self, sig: Any, codegen: Any) -> tuple:
         own = repr(_describe_function(self._py_func)).encode()
         return (sig, codegen.magic_tuple(), (_code_digest(self._py_func.__code__),
-                                             hashlib.sha256(own).hexdigest()))
+                                             hashlib.sha256(own).hexdigest()),
+                self._variant)

@@ -131,9 +131,9 @@ def fluctuation_kernel(two_layer: bool, flux: int) -> Any:
     ifcp = flux == L.FLUX_IFCP
     if two_layer:
         return specialise(_two_layer(rusanov, ifcp), types.UniTuple(f8, 4),
-                          types.UniTuple(f8, 4), f8, f8, f8)
+                          types.UniTuple(f8, 4), f8, f8, f8, helper=True)
     return specialise(_single(rusanov, ifcp), types.UniTuple(f8, 2),
-                      types.UniTuple(f8, 2), f8, f8, f8)
+                      types.UniTuple(f8, 2), f8, f8, f8, helper=True)
 
 
 def _single(rusanov: bool, ifcp: bool):

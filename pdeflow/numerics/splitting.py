@@ -298,7 +298,7 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
     return specialise(stepping_function(ifcp, strang, step), STATE, f8, f8, f8, i8, i8,
                       PARAMS, f8, f8, f8, f8, VECTOR, FIELDS, FIELDS, VECTOR, WORK, i8, flag,
                       ADVECT, SOURCES, PREDICTOR if order == 2 else types.none,
-                      ADVECT if ifcp else types.none)
+                      ADVECT if ifcp else types.none, pointer=False)
 
 
 class Stepper:
