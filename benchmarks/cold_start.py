@@ -242,7 +242,7 @@ def render(data: dict[str, Any]) -> str:
         # a closure's name ends in a digest of its constants (compiled.specialise)
         short = (re.sub(r"_[0-9a-f]{12}$", "", k.replace("pdeflow.numerics.", "")
                         .replace(".<locals>", "")) for k in kernels)
-        return ", ".join(f"`{k}`" for k in short)
+        return ", ".join(f"`{k}`" for k in dict.fromkeys(short))
 
     for label, d in data.items():
         L.append(f"\nKernels compiled by the cold run, *{label}*: {names(d['kernels'])}.")

@@ -286,3 +286,22 @@ def test_meanwhile_is_called_once_whatever_there_is_to_compile():
     fv_split.load_kernels(None, [pdeflow.SingleLayerGranular()],
                           meanwhile=lambda: calls.append(3))
     assert calls == [1, 2, 3]
+
+
+def test_garbage_collector_walks_less_while_compiling_and_is_restored():
+    """While kernels compile, the objects that existed before are frozen and the first
+    collection threshold raised; afterwards (also after a failure) both are as before."""
+    import gc
+
+    before = gc.get_threshold(), gc.get_freeze_count()
+    seen: list[tuple] = []
+    parallel.ready_all([], meanwhile=lambda: seen.append(
+        (gc.get_threshold(), gc.get_freeze_count())))
+    assert seen[0][0] == parallel.GC_THRESHOLD and seen[0][1] > before[1]
+
+    def fail() -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        parallel.ready_all([], meanwhile=fail)
+    assert (gc.get_threshold(), gc.get_freeze_count()) == before

@@ -18,12 +18,14 @@ Nothing depends on the helper: if it fails, this process compiles its kernels it
 
 from __future__ import annotations
 
+import contextlib
+import gc
 import multiprocessing
 import os
 import subprocess
 import sys
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -34,8 +36,13 @@ HELPER_SHARE = 0.42
 :func:`split_work` aims at. Below one half because the bytecode of a closure's tree
 overcounts: it includes the kernels of the branches that its constants drop (the
 fluxes a scheme does not use). On the paper's test 5.1 the two-layer source stage is
-41 % of the bytecode and half of the compile time (5.4 of 10.7 s, one process): the
-helper takes it alone."""
+41 % of the bytecode and about half of the compile time: the helper takes it alone
+(docs/performance.md, "Cold first run", lists what each process compiled)."""
+
+
+GC_THRESHOLD = (10000, 10, 10)
+"""Python's garbage-collector thresholds while kernels compile (its default: 700, 10,
+10): a collection of the youngest objects every 10000 new ones instead of every 700."""
 
 
 def ready_all(kernels: Sequence[Any], parallel: bool = True,
@@ -46,6 +53,12 @@ def ready_all(kernels: Sequence[Any], parallel: bool = True,
     ``meanwhile`` (if given) is called once, after this process's own compiling and
     before it waits for the helper: other work of the caller's that can fill that wait
     (e.g. the imports its figures need)."""
+    with _fewer_collections():
+        _ready_all(kernels, parallel, meanwhile)
+
+
+def _ready_all(kernels: Sequence[Any], parallel: bool,
+               meanwhile: Callable[[], Any] | None) -> None:
     todo = [k for k in dict.fromkeys(kernels) if needs_compiling(k)]
     helper, helper_kernels = None, []
     if parallel and _cores() > 1 and len(todo) > 1:
@@ -66,6 +79,24 @@ def ready_all(kernels: Sequence[Any], parallel: bool = True,
     if helper is not None:
         helper.wait()
     _ready_each(todo)
+
+
+@contextlib.contextmanager
+def _fewer_collections() -> Iterator[None]:
+    """Python's garbage collector, while numba compiles, walks less: numba's compiler
+    makes and drops objects by the million, and a collection started every
+    :data:`GC_THRESHOLD` [0] new objects walked also everything imported so far (numba,
+    py-pde, scipy). Frozen, the objects that exist now are not walked; restored after.
+    (Test 5.1 in one process: 0.7-0.8 s collecting of 8.5-10.4 s compiling, 0.2 s
+    with this.)"""
+    thresholds = gc.get_threshold()
+    gc.freeze()
+    gc.set_threshold(*GC_THRESHOLD)
+    try:
+        yield
+    finally:
+        gc.set_threshold(*thresholds)
+        gc.unfreeze()
 
 
 def split_work(kernels: Sequence[Any], movable: Sequence[Any] | None = None) -> list[Any]:
@@ -106,9 +137,10 @@ def helper_main(names: Sequence[str]) -> None:
     """The new-interpreter helper: ready the kernels named ``module:qualname``."""
     import importlib
 
-    for name in names:
-        module, _, qualname = name.partition(":")
-        ready(getattr(importlib.import_module(module), qualname))
+    with _fewer_collections():
+        for name in names:
+            module, _, qualname = name.partition(":")
+            ready(getattr(importlib.import_module(module), qualname))
 
 
 class _Forked:
