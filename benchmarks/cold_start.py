@@ -189,8 +189,15 @@ def measure(repeats: int = 3, tree: Path = ROOT, log: Any = None,
         "kernels": sorted({k for k, _ in kernels}),
         "signatures": len(kernels),
         "helper_kernels": split[-1].get("helper_kernels", []),
+        "other_tree": Path(tree).resolve() != ROOT,
     }
     return out
+
+
+def latest(data: dict[str, Any]) -> tuple[str, dict[str, Any]]:
+    """(label, measurement) of the last measurement of this checkout's code (not of
+    another tree measured for comparison, ``--tree``)."""
+    return [(k, d) for k, d in data.items() if not d.get("other_tree")][-1]
 
 
 INTRO = """
@@ -207,6 +214,23 @@ of the kernels on the second core, `pdeflow.numerics.compile_parallel.ready_all`
 reading the case, both runs, the summary). *warm*: the command again with the cache
 the cold run left. *load*: 1-minute load average of the machine at the start (2 cores).
 """
+CHANGES = {
+    "before": "every kernel compiled for every scheme, some with several signatures",
+    "after": "kernels built per scheme (closures over its choices), one signature each",
+    "session3": "the same, after the stepping loop took its kernels as function "
+                "pointers and the cache keys followed the code of every callee",
+    "session4": "compiled on two cores (a forked helper process compiles the two-layer "
+                "source stage), figures drawn on two cores without `tight_layout`",
+    "session5": "helper kernels compiled without the Python and function-pointer entry "
+                "points that every caller linked in and compiled again "
+                "(`compiled.HelperKernel`), fewer garbage collections while compiling, "
+                "none at exit (26 kernels: the two advection stages, closures, now have "
+                "names of their own)",
+    "session5-before": "the code of *session4* (7ae905d), measured again half an hour "
+                       "after *session5* on the same day (the machine's speed drifts "
+                       "within a day: its CPU time moves with it)",
+}
+"""what the code of each measured label changed (rendered under the table)"""
 COLUMNS = ("code", "runs", "load", "`python -m pdeflow run` wall [s]", "CPU [s]",
            "`pdeflow` script wall [s]", "imports [s]", "compile [s]", "figures [s]",
            "rest [s]", "warm wall [s]", "kernels compiled (signatures)")
@@ -232,7 +256,9 @@ def render(data: dict[str, Any]) -> str:
                  f"{f(s['imports_s'])} | {f(s['compile_s'])} | {f(s.get('figures_s'))} | "
                  f"{f(s['other_s'])} | "
                  f"{f(d['warm']['wall_s'])} | {len(d['kernels'])} ({d['signatures']}) |")
-    label, d = list(data.items())[-1]
+    L.append("")
+    L += [f"* *{label}*: {CHANGES[label]}." for label in data if label in CHANGES]
+    label, d = latest(data)
     s = d["split"]
     rest = s["imports_s"] + s.get("figures_s", 0.0) + s["other_s"]
     L.append(f"\nWithout any compilation the command would still take {rest:.1f} s "

@@ -319,7 +319,7 @@ def _render_targets(b: dict[str, Any], cold_runs: dict[str, Any] | None = None) 
              f"run of the process {_f(warm.get('single_layer_first_s'))} s vs "
              f"{_f(c.get('cold', {}).get('single_layer_first_s'))} s cold | {_met(ok)} |")
     if cold_runs:
-        label, d = list(cold_runs.items())[-1]
+        label, d = cold_start.latest(cold_runs)
         plain = d["commands"]["python -m pdeflow run"]
         walls = ", ".join(f"{w:.1f}" for w in sorted(plain.get("walls", [])))
         L.append(f"| cold first run of `pdeflow run cases/paper_5_1_dam_break.toml` <= 8 s "

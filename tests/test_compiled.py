@@ -305,3 +305,19 @@ def test_garbage_collector_walks_less_while_compiling_and_is_restored():
     with pytest.raises(KeyboardInterrupt):
         parallel.ready_all([], meanwhile=fail)
     assert (gc.get_threshold(), gc.get_freeze_count()) == before
+
+
+def test_a_helper_kernel_called_from_python_runs_its_twin():
+    """A helper (compiled without the entry point Python needs: calling it would crash
+    the process) answers a call from Python through a twin that has it, under a cache
+    key of its own."""
+    from pdeflow.numerics.state import velocity
+
+    assert isinstance(velocity, compiled.HelperKernel)
+    assert velocity.targetoptions["no_cpython_wrapper"]
+    assert velocity(2.0, 3.0, 1e-6) == 1.5 and velocity(1e-9, 3.0, 1e-6) == 0.0
+    twin = velocity._python_twin
+    assert not isinstance(twin, compiled.HelperKernel)
+    sig = compiled.f8(compiled.f8, compiled.f8, compiled.f8).args
+    codegen = velocity.targetctx.codegen()
+    assert twin._cache._index_key(sig, codegen) != velocity._cache._index_key(sig, codegen)

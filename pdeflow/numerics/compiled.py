@@ -103,8 +103,9 @@ def specialise(func: Callable, *arg_types: Any, helper: bool = False,
     # numba names compiled code after the function's qualified name and a per-process
     # counter: two closures of one factory compiled in two processes (a run and its
     # compile helper, or two runs) can get one name, and a process that loads both
-    # from the disk cache then runs one's code for the other (numba issue #10486; it
-    # made a rate test fail). Here the name carries what the closure is made of.
+    # from the disk cache may run one's code for the other (numba issue #10486; a rate
+    # test failed once with a cache that many test processes had filled). Here the name
+    # carries what the closure is made of.
     description = repr(_describe_function(func)).encode()
     func.__qualname__ += "_" + hashlib.sha256(description).hexdigest()[:12]
     compiled = _jit(func, helper=helper, pointer=pointer)
@@ -119,7 +120,7 @@ class HelperKernel(CPUDispatcher):
     arguments and boxes the result) and one for C function pointers. Their code is
     linked into every caller with the rest of the helper and compiled again there, at
     every level of a call tree (test 5.1's two-layer source stage is a tree of 20
-    helpers; docs/performance.md, "Cold first run", has the time saved). A call from
+    helpers; docs/performance.md, "Cold first run", session5). A call from
     Python (a test, the app's spectrum page) goes to a twin with the entry points,
     compiled on its first such call and cached apart. (numba cannot call a function
     without its Python entry point from Python: the process would crash.)"""
