@@ -94,6 +94,21 @@ def test_discriminant_agrees_with_roots_on_random_states():
         assert is_hyperbolic(h1, h2, u1, u2, 9.81, r, 1) == real
 
 
+def test_eigenvalues_of_many_velocities_are_the_roots_one_by_one():
+    """One call for an array of du gives, row by row, the roots of P(lambda) that a
+    call per du gives; they are roots (|P| small against its scale) sorted by real part."""
+    g, h1, h2, r = 9.81, 0.4, 1.1, 0.7
+    du = np.linspace(-12.0, 12.0, 97)
+    lam = eigenvalues(h1, h2, du, 0.5, g, r)
+    assert lam.shape == (97, 4)
+    for row, d in zip(lam, du, strict=True):
+        one = eigenvalues(h1, h2, d, 0.5, g, r)
+        np.testing.assert_allclose(np.sort_complex(row), np.sort_complex(one), atol=1e-12)
+        assert np.all(np.diff(row.real) >= -1e-12)
+        p = ((row - d) ** 2 - g * h1) * ((row - 0.5) ** 2 - g * h2) - r * g * g * h1 * h2
+        assert np.abs(p).max() < 1e-9 * (g * (h1 + h2) + d * d) ** 2
+
+
 def test_fl_is_a_lower_bound_of_the_exact_threshold():
     rng = np.random.default_rng(4)
     for _ in range(500):

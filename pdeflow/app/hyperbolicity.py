@@ -179,7 +179,7 @@ class HyperbolicityPage:
             return
         sp = local_spectrum(v["h1"], v["h2"], v["r"], v["du"], self.g)
         du = np.linspace(0.0, max(1.3 * sp.f_r, 1.1 * abs(sp.du)), 400)
-        lam = np.array([eigenvalues(sp.h1, sp.h2, d, 0.0, sp.g, sp.r) for d in du])
+        lam = eigenvalues(sp.h1, sp.h2, du, 0.0, sp.g, sp.r)
         with pn.io.hold():
             self.src_curves.data = {"du": du, "l1": lam[:, 0].real, "l2": lam[:, 1].real,
                                     "l3": lam[:, 2].real, "l4": lam[:, 3].real,

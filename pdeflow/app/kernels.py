@@ -1,7 +1,7 @@
 """The numba kernels, loaded in the background so that the app can say what it waits for.
 
 pdeflow's kernels are compiled on their first use and cached on disk (the app's first
-picture came 18 s after a start with an empty cache on the two-core development machine,
+picture came 13 s after a start with an empty cache on the two-core development machine,
 docs/teaching.md; they load in a fraction of a second afterwards). The app starts
 :data:`WARMUP` when it is served or displayed; its pages show :meth:`KernelWarmup.message`
 (with the elapsed time) until the kernels are ready, instead of looking frozen.
@@ -30,16 +30,21 @@ def warm_kernels() -> None:
     from ..numerics import hyperbolicity as hyp
     from ..simulate import load_case_kernels, run_model
 
+    def spectrum_functions() -> None:
+        # called from Python by the hyperbolicity page: compiled as Python-callable
+        # twins of the kernels (numerics.compiled.HelperKernel) while a helper process
+        # compiles the source stages
+        g, r, h1, h2 = 9.81, 0.67, 0.5, 1.0
+        hyp.discriminant(h1, h2, 3.0, 0.0, g, r)
+        hyp.lower_bound_fl(h1, h2, g, r)
+        hyp.upper_bound_fr(h1, h2, g, r)
+        hyp.band_lower_edge(h1, h2, g, r, 3.0)
+
     case = Case.from_dict(WARMUP_CASE, source="<kernel warm-up>")
-    load_case_kernels(case)  # both models' kernels at once: compiled on two cores
+    # both models' kernels at once: compiled on two cores
+    load_case_kernels(case, meanwhile=spectrum_functions)
     for model in case.models:
         run_model(case, model)
-    g, r, h1, h2 = 9.81, 0.67, 0.5, 1.0
-    hyp.eigenvalues(h1, h2, 3.0, 0.0, g, r)
-    hyp.discriminant(h1, h2, 3.0, 0.0, g, r)
-    hyp.lower_bound_fl(h1, h2, g, r)
-    hyp.upper_bound_fr(h1, h2, g, r)
-    hyp.band_lower_edge(h1, h2, g, r, 3.0)
 
 
 class KernelWarmup:

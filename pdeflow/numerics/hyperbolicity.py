@@ -20,8 +20,8 @@ real iff its discriminant
 
 is non-negative (evaluated in units of g H to avoid overflow; as a quartic in
 A = (du/2)^2/(g H), see :func:`_quartic_in_a`). This is the paper's "inner eigenvalues
-real" test without computing the roots; :func:`eigenvalues` computes them (for
-diagnostics and tests).
+real" test without computing the roots; :func:`eigenvalues` computes them (numpy, for
+the app's spectrum page and tests).
 
 Restoration (33)-(34): F_extra moves momentum between the layers, -dt F/rho1 to the
 upper and +dt F/rho2 to the lower one (total momentum unchanged), inside the implicit
@@ -60,10 +60,14 @@ def upper_bound_fr(h1: float, h2: float, g: float, r: float) -> float:
     return math.sqrt(2.0 * g * (h1 + h2) * (1.0 + math.sqrt(r)))
 
 
-@cached
-def eigenvalues(h1: float, h2: float, u1: float, u2: float, g: float,
-                r: float) -> np.ndarray:
-    """The four roots of P(lambda), sorted by real part (complex array) [m/s]."""
+def eigenvalues(h1: float, h2: float, u1: float | np.ndarray, u2: float | np.ndarray,
+                g: float, r: float) -> np.ndarray:
+    """The four roots of P(lambda) [m/s], sorted by real part (a complex-conjugate pair
+    in either order): a complex array of shape (4,), or (..., 4) for arrays of
+    velocities u1, u2 (broadcast). numpy, not a kernel: only Python calls it (the app's
+    spectrum page, tests), and as a kernel (numba's ``np.roots``) it was the slowest of
+    all to compile; for many velocities at once it is one batched eigenvalue solve."""
+    u1, u2 = np.broadcast_arrays(np.asarray(u1, dtype=float), np.asarray(u2, dtype=float))
     um = 0.5 * (u1 + u2)  # shift for conditioning; P depends on du only up to a shift
     a = u1 - um
     b = u2 - um
@@ -71,15 +75,16 @@ def eigenvalues(h1: float, h2: float, u1: float, u2: float, g: float,
     s = g * h2
     a0 = a * a - p
     b0 = b * b - s
-    coeffs = np.empty(5)
-    coeffs[0] = 1.0
-    coeffs[1] = -2.0 * (a + b)
-    coeffs[2] = a0 + b0 + 4.0 * a * b
-    coeffs[3] = -2.0 * (a * b0 + b * a0)
-    coeffs[4] = a0 * b0 - r * p * s
-    roots = np.roots(coeffs.astype(np.complex128))
-    order = np.argsort(roots.real)
-    return roots[order] + um
+    # companion matrix of the monic quartic x^4 + c1 x^3 + c2 x^2 + c3 x + c4 = P(x + um)
+    companion = np.zeros((*u1.shape, 4, 4))
+    companion[..., 0, 0] = 2.0 * (a + b)
+    companion[..., 0, 1] = -(a0 + b0 + 4.0 * a * b)
+    companion[..., 0, 2] = 2.0 * (a * b0 + b * a0)
+    companion[..., 0, 3] = -(a0 * b0 - r * p * s)
+    companion[..., [1, 2, 3], [0, 1, 2]] = 1.0
+    roots = np.linalg.eigvals(companion).astype(complex)
+    order = np.argsort(roots.real, axis=-1)
+    return np.take_along_axis(roots, order, axis=-1) + um[..., None]
 
 
 @cached
