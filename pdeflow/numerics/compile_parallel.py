@@ -54,31 +54,26 @@ def ready_all(kernels: Sequence[Any], parallel: bool = True,
     before it waits for the helper: other work of the caller's that can fill that wait
     (e.g. the imports its figures need)."""
     with _fewer_collections():
-        _ready_all(kernels, parallel, meanwhile)
-
-
-def _ready_all(kernels: Sequence[Any], parallel: bool,
-               meanwhile: Callable[[], Any] | None) -> None:
-    todo = [k for k in dict.fromkeys(kernels) if needs_compiling(k)]
-    helper, helper_kernels = None, []
-    if parallel and _cores() > 1 and len(todo) > 1:
-        cold = [k for k in todo if not in_disk_cache(k)]
-        forked = can_fork()
-        helper_kernels = split_work(cold, movable=None if forked else
-                                    [k for k in cold if _importable(k)])
-        if helper_kernels:
-            helper = _Forked(helper_kernels) if forked else _interpreter(helper_kernels)
-    try:
-        _ready_each([k for k in todo if k not in helper_kernels])
-        if meanwhile is not None:
-            meanwhile()
-    except BaseException:
-        if helper is not None:  # e.g. Ctrl-C: no helper outlives this call
-            helper.terminate()
-        raise
-    if helper is not None:
-        helper.wait()
-    _ready_each(todo)
+        todo = [k for k in dict.fromkeys(kernels) if needs_compiling(k)]
+        helper, helper_kernels = None, []
+        if parallel and _cores() > 1 and len(todo) > 1:
+            cold = [k for k in todo if not in_disk_cache(k)]
+            forked = can_fork()
+            helper_kernels = split_work(cold, movable=None if forked else
+                                        [k for k in cold if _importable(k)])
+            if helper_kernels:
+                helper = _Forked(helper_kernels) if forked else _interpreter(helper_kernels)
+        try:
+            _ready_each([k for k in todo if k not in helper_kernels])
+            if meanwhile is not None:
+                meanwhile()
+        except BaseException:
+            if helper is not None:  # e.g. Ctrl-C: no helper outlives this call
+                helper.terminate()
+            raise
+        if helper is not None:
+            helper.wait()
+        _ready_each(todo)
 
 
 @contextlib.contextmanager
