@@ -9,8 +9,6 @@ in m^2/s^2, times in s.
 
 from __future__ import annotations
 
-import multiprocessing
-import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,7 +18,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .io import atomic_path
-from .numerics.compile_parallel import can_fork
+from .numerics.compile_parallel import can_fork, fork_context
 from .numerics.state import DRY_TOLERANCE, velocity_profile
 
 DRY = 1e-9
@@ -164,9 +162,7 @@ def draw_all(jobs: Sequence[tuple[Callable, tuple, Path]],
     agg = plt.get_backend().lower() == "agg"
     if not (parallel and len(jobs) > 1 and agg and can_fork()):
         return [_draw(job) for job in jobs]
-    sys.stdout.flush()  # the fork must not write this process's buffers again
-    sys.stderr.flush()
-    with multiprocessing.get_context("fork").Pool(1) as pool:
+    with fork_context().Pool(1) as pool:
         theirs = pool.map_async(_draw, jobs[1::2])
         mine = [_draw(job) for job in jobs[::2]]
         paths = theirs.get()

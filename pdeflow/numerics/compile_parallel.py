@@ -128,6 +128,14 @@ def can_fork() -> bool:
             and _cores() > 1)
 
 
+def fork_context() -> Any:
+    """multiprocessing's "fork" context, with this process's output flushed first (a
+    fork must not write this process's buffers again); only where :func:`can_fork`."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    return multiprocessing.get_context("fork")
+
+
 def helper_main(names: Sequence[str]) -> None:
     """The new-interpreter helper: ready the kernels named ``module:qualname``."""
     import importlib
@@ -142,10 +150,8 @@ class _Forked:
     """A forked helper process, waited for like a ``subprocess.Popen``."""
 
     def __init__(self, kernels: Sequence[Any]):
-        sys.stdout.flush()  # the fork must not write this process's buffers again
-        sys.stderr.flush()
-        self.process = multiprocessing.get_context("fork").Process(
-            target=_ready_each, args=(kernels,), daemon=True)
+        self.process = fork_context().Process(target=_ready_each, args=(kernels,),
+                                              daemon=True)
         self.process.start()
 
     def wait(self) -> None:
