@@ -182,9 +182,11 @@ import pdeflow
 from pdeflow.cases import load_case
 from pdeflow.simulate import run_model
 from pdeflow.numerics import compiled, layout as L
+from pdeflow.numerics.bundles import TWO_LAYER
 from pdeflow.numerics.splitting import scheme_stepper
 t_import = time.perf_counter() - t0
-loop = scheme_stepper(True, L.FLUX_HLL, 1, L.LIMITER_MINMOD, False).loop  # both models
+loop = scheme_stepper(TWO_LAYER, L.FLUX_HLL, 1, L.LIMITER_MINMOD, False,
+                      L.GEOMETRY_PLANAR).loop  # both models
 c = load_case(sys.argv[1], ["output.snapshot_times=[]", "grid.dx=0.05"])
 out = {"import_s": t_import}
 for model in ("single_layer", "two_layer"):

@@ -35,7 +35,7 @@ from __future__ import annotations
 import copy
 import math
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
@@ -46,16 +46,23 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
+from . import systems
 from .models.base import check_range
+from .numerics.layout import GEOMETRIES
 from .variant import Variant, VariantError, variant_of
 
-MODEL_NAMES = ("two_layer", "single_layer")
+PAPER_MODEL = "two_layer"
+"""the registered name of the paper's two-layer model"""
+BASELINE_MODEL = "single_layer"
+"""the registered name of the single-layer Coulomb baseline (exact solutions are its)"""
+DEFAULT_MODELS = [PAPER_MODEL]
+"""case.models when a case names none"""
 
 SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
     "case": {"name": (str,), "description": (str,), "t_end": (float, int),
              "models": (list,)},
     "grid": {"length": (float, int), "dx": (float, int), "cells": (int,),
-             "x_start": (float, int)},
+             "x_start": (float, int), "geometry": (str,)},
     "boundaries": {"left": (str,), "right": (str,)},
     "initial": {"shape": (str,), "L0": (float, int), "H0": (float, int),
                 "wedge_angle_deg": (float, int), "x_dam": (float, int),
@@ -65,8 +72,6 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
     "numerics": {"solver": (str,), "cfl": (float, int), "dt": (float, int),
                  "flux": (str,), "reconstruction": (str,), "limiter": (str,),
                  "splitting": (str,)},
-    "two_layer": {},  # checked by TwoLayerParameters
-    "single_layer": {},  # checked by SingleLayerParameters
     "output": {"snapshot_times": (list,), "front_threshold": (float, int)},
     "sweep": {"aspect_ratios": (list,)},
 }
@@ -132,16 +137,16 @@ class Case:
     def validate(self) -> None:
         """Check sections, keys, types and ranges; raise CaseError naming the key."""
         from .checks import check_memory
-        from .models import SingleLayerParameters, TwoLayerParameters
 
         for section, content in self.data.items():
-            if section not in SCHEMA:
-                raise self._err(f"unknown section [{section}]; allowed: {list(SCHEMA)}")
+            if section not in SCHEMA and section not in systems.names():
+                raise self._err(f"unknown section [{section}]; allowed: "
+                                f"{[*SCHEMA, *systems.names()]}")
             if not isinstance(content, dict):
                 raise self._err(f"[{section}] must be a table")
-            allowed = SCHEMA[section]
+            allowed = SCHEMA.get(section)
             if not allowed:
-                continue
+                continue  # a model's section: checked by its parameter class
             for key, value in content.items():
                 if key not in allowed:
                     raise self._err(f"unknown key {section}.{key}; allowed: "
@@ -150,16 +155,15 @@ class Case:
                     names = " or ".join(t.__name__ for t in allowed[key])
                     raise self._err(f"{section}.{key} must be {names}, got {value!r}")
                 self._check_finite(f"{section}.{key}", value)
-        for name, cls in (("two_layer", TwoLayerParameters),
-                          ("single_layer", SingleLayerParameters)):
+        for name in systems.names():
             try:
-                cls.from_dict(self.data.get(name, {}))
+                systems.get(name).parameters_class.from_dict(self.data.get(name, {}))
             except (ValueError, TypeError) as err:
                 raise self._err(f"[{name}] {err}") from None
         for model in self.models:
-            if model not in MODEL_NAMES:
+            if model not in systems.names():
                 raise self._err(f"case.models: unknown model {model!r}; allowed: "
-                                f"{list(MODEL_NAMES)}")
+                                f"{list(systems.names())}")
         try:
             check_range("case.t_end", self.t_end, 0, math.inf, low_open=True, unit="s")
             check_range("grid.length", self.length, 0, math.inf, low_open=True,
@@ -179,6 +183,7 @@ class Case:
                         low_open=True, unit="m")
         except ValueError as err:
             raise self._err(str(err)) from None
+        self._check_geometry()
         for side in ("left", "right"):
             bc = self.data.get("boundaries", {}).get(side, "wall" if side == "left"
                                                       else "open")
@@ -198,6 +203,21 @@ class Case:
             check_memory(self)
         except ValueError as err:
             raise self._err(str(err)) from None
+
+    def _check_geometry(self) -> None:
+        """grid.geometry is 'planar' or 'axisymmetric'; an axisymmetric grid starts at the
+        axis (x_start = 0), whose boundary is a wall (mirror symmetry: no flux)."""
+        if self.geometry not in GEOMETRIES:
+            raise self._err(f"grid.geometry must be one of {list(GEOMETRIES)}, got "
+                            f"{self.geometry!r}")
+        if self.geometry != "axisymmetric":
+            return
+        if self.x_start != 0.0:
+            raise self._err(f"grid.x_start must be 0 on an axisymmetric grid (the axis), "
+                            f"got {self.x_start:g}")
+        if self.bc[0] != "wall":
+            raise self._err("boundaries.left is the axis on an axisymmetric grid and must "
+                            f"be 'wall' (symmetry: no flux), got {self.bc[0]!r}")
 
     def _check_finite(self, key: str, value: Any) -> None:
         """Numbers (also inside lists) must be finite: TOML allows nan and inf."""
@@ -268,7 +288,7 @@ class Case:
 
     @property
     def models(self) -> list[str]:
-        return list(self._get("case", "models", ["two_layer"]))
+        return list(self._get("case", "models", DEFAULT_MODELS))
 
     @property
     def t_end(self) -> float:
@@ -277,6 +297,12 @@ class Case:
     @property
     def length(self) -> float:
         return float(self._get("grid", "length", 1.0))
+
+    @property
+    def geometry(self) -> str:
+        """'planar' (a slope, per unit width; the default) or 'axisymmetric' (radial flow
+        on a horizontal plane, r in [0, grid.length])."""
+        return self._get("grid", "geometry", "planar")
 
     @property
     def x_start(self) -> float:
@@ -327,41 +353,49 @@ class Case:
     @property
     def variant(self) -> Variant:
         """How the case is solved: the :class:`~pdeflow.variant.Variant` its
-        ``[numerics]`` and two-layer ``hyperbolicity`` select."""
-        return variant_of(self.data.get("numerics", {}),
-                          self.data.get("two_layer", {}).get("hyperbolicity", "exact"))
+        ``[numerics]`` and the models' ``hyperbolicity`` parameter select."""
+        return variant_of(self.data.get("numerics", {}), self._hyperbolicity())
+
+    def _hyperbolicity(self) -> str:
+        """The ``hyperbolicity`` parameter of the first model that has one ('exact', the
+        paper's, by default)."""
+        for name in _hyperbolicity_sections():
+            if "hyperbolicity" in self.data.get(name, {}):
+                return self.data[name]["hyperbolicity"]
+        return "exact"
 
     def with_variant(self, variant: Variant) -> Case:
         """A copy solved with ``variant`` (its other numerics, e.g. cfl and dt, kept);
-        the two-layer ``hyperbolicity`` parameter is set unless it is the case's own."""
+        the models' ``hyperbolicity`` parameter is set unless it is the case's own."""
         c = self.copy()
         num = c.data.setdefault("numerics", {})
         for key in ("flux", "reconstruction", "limiter", "splitting", "solver"):
             num.pop(key, None)
         num.update(variant.numerics())
-        if variant.hyperbolicity != c.data.get("two_layer", {}).get("hyperbolicity",
-                                                                    "exact"):
-            c.data.setdefault("two_layer", {})["hyperbolicity"] = variant.hyperbolicity
+        if variant.hyperbolicity != c._hyperbolicity():
+            for name in _hyperbolicity_sections():
+                c.data.setdefault(name, {})["hyperbolicity"] = variant.hyperbolicity
         c.validate()
         return c
 
     # --- model set-up ---------------------------------------------------------------------
     def make_grid(self):
-        from pde import CartesianGrid
+        """py-pde's grid of the case: a ``CartesianGrid`` (planar) or a ``PolarSymGrid``
+        on [0, length] (axisymmetric)."""
+        from pde import CartesianGrid, PolarSymGrid
 
+        if self.geometry == "axisymmetric":
+            return PolarSymGrid((0.0, self.length), self.cells)
         return CartesianGrid([[self.x_start, self.x_start + self.length]], self.cells)
 
     def make_pde(self, model: str):
-        from .models import SingleLayerGranular, TwoLayerGranular
-
+        """The PDE of the registered model ``model`` with this case's parameters,
+        boundaries and scheme."""
+        system = systems.get(model)
         num = self.data.get("numerics", {})
         scheme = {k: num[k] for k in ("flux", "reconstruction", "limiter") if k in num}
         try:
-            if model == "two_layer":
-                return TwoLayerGranular(self.data.get("two_layer", {}), bc=self.bc,
-                                        **scheme)
-            return SingleLayerGranular(self.data.get("single_layer", {}), bc=self.bc,
-                                       **scheme)
+            return system.pde_class(self.data.get(model, {}), bc=self.bc, **scheme)
         except ValueError as err:
             raise self._err(f"[numerics] {err}") from None
 
@@ -370,46 +404,41 @@ class Case:
         return self._get("numerics", "splitting", "lie")
 
     def initial_profiles(self, model: str, grid=None) -> dict[str, np.ndarray]:
-        """Depth and velocity profiles of the initial state for ``model``."""
+        """Depth and velocity profiles of the initial state for ``model`` (at rest; the
+        model's system splits the total depth into its layers)."""
+        system = systems.get(model)
         grid = grid or self.make_grid()
         x = grid.axes_coords[0] - self.x_start
         ini = self.initial
         shape = ini["shape"]
-        zeros = np.zeros_like(x)
-        two = model == "two_layer"
         if shape == "file":
-            return self._profiles_from_file(model, x.size)
+            return self._profiles_from_file(system, x.size)
         if shape == "column":
-            L0, H0 = float(ini["L0"]), float(ini["H0"])
-            h = np.where(x < L0, H0, 0.0)
-            if not two:
-                return {"h": h, "u": zeros}
-            phi_int = float(self.data.get("two_layer", {}).get("phi_int_deg", 30.0))
-            alpha = float(ini.get("wedge_angle_deg", 45.0 + phi_int / 2))
-            h2 = np.where(x < L0, np.minimum(H0, (L0 - x) * math.tan(math.radians(alpha))),
-                          0.0)
-            return {"h1": h - h2, "u1": zeros, "h2": h2, "u2": zeros}
-        if shape == "dam_break":
+            h = np.where(x < float(ini["L0"]), float(ini["H0"]), 0.0)
+        elif shape == "dam_break":
             h = np.where(x < float(ini["x_dam"]), float(ini["h_left"]),
                          float(ini.get("h_right", 0.0)))
         else:  # heap
             slope = math.tan(math.radians(float(ini["slope_deg"])))
             h = np.maximum(float(ini["height"]) - slope * np.abs(x - float(ini["center"])),
                            0.0)
-        if not two:
-            return {"h": h, "u": zeros}
-        f = float(ini.get("upper_fraction", 0.5))
-        return {"h1": f * h, "u1": zeros, "h2": (1 - f) * h, "u2": zeros}
+        params = system.parameters_class.from_dict(self.data.get(model, {}))
+        depths = system.layer_depths(h, x, ini, params)
+        out: dict[str, np.ndarray] = {}
+        for layer, depth in zip(system.layers, depths, strict=True):
+            out[layer.depth] = depth
+            out[layer.velocity] = np.zeros_like(x)
+        return out
 
-    def _profiles_from_file(self, model: str, n: int) -> dict[str, np.ndarray]:
+    def _profiles_from_file(self, system: Any, n: int) -> dict[str, np.ndarray]:
         path = self.base_dir / self.initial["path"]
-        keys = ("h1", "u1", "h2", "u2") if model == "two_layer" else ("h", "u")
+        keys = system.profile_names
         try:
             with np.load(path) as data:
                 missing = [k for k in keys if k not in data]
                 if missing:
                     raise self._err(f"initial profile {path.name} lacks arrays "
-                                    f"{missing} needed by the {model} model")
+                                    f"{missing} needed by the {system.name} model")
                 out = {k: np.asarray(data[k], dtype=float) for k in keys}
         except (OSError, ValueError) as err:
             if isinstance(err, CaseError):
@@ -432,6 +461,12 @@ class Case:
                 raise
             raise self._err(f"initial state: {err}") from None
         return eq, state
+
+
+def _hyperbolicity_sections() -> list[str]:
+    """Models whose parameters have a ``hyperbolicity`` treatment (a Variant's choice)."""
+    return [name for name in systems.names()
+            if "hyperbolicity" in {f.name for f in fields(systems.get(name).parameters_class)}]
 
 
 def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:

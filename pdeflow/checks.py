@@ -28,11 +28,9 @@ from typing import Any
 
 import numpy as np
 
+from . import systems
 from .metrics import total_depth
 
-#: memory of a run per cell [bytes]: peak of tracemalloc over run_model on 200,000 cells
-#: without snapshots (312 two layers, 168 one layer), rounded up
-BYTES_PER_CELL = {"two_layer": 320, "single_layer": 180}
 #: cells x steps per second of the compiled fv-split loop on this development machine:
 #: 0.9e7 (two layers, test 5.1, dx = 0.05 m) to 1.3e8 over the cases in cases/ (dry
 #: cells cost little); the slow end, only used to put the work into words
@@ -111,14 +109,16 @@ def max_initial_depth(case: Any) -> float:
 
 def memory_bytes(case: Any, model: str) -> float:
     """Peak memory [bytes] of running ``model``: the solver's arrays and the snapshots."""
-    rows = 4 if model == "two_layer" else 2
-    per_cell = BYTES_PER_CELL[model] + 8 * (rows + 1) * len(case.snapshot_times)
+    system = systems.get(model)
+    rows = len(system.field_names)
+    per_cell = system.bytes_per_cell + 8 * (rows + 1) * len(case.snapshot_times)
     return float(case.cells * per_cell)
 
 
 def run_cost(case: Any, model: str | None = None) -> RunCost:
-    """Memory and work of running ``model`` (default: the costlier of the case's)."""
-    model = model or ("two_layer" if "two_layer" in case.models else case.models[0])
+    """Memory and work of running ``model`` (default: the case's model with the most
+    fields, the costliest)."""
+    model = model or max(case.models, key=lambda m: len(systems.get(m).field_names))
     params = case.make_pde(model).parameters
     theta = math.radians(params.theta_deg)
     gz, gx = params.g * math.cos(theta), params.g * math.sin(theta)
@@ -140,7 +140,7 @@ def run_cost(case: Any, model: str | None = None) -> RunCost:
 def stops_by_friction(params: Any) -> bool:
     """A Coulomb mass on a bed flatter than its friction angle comes to rest in finite
     time; frictionless cases (exact solutions, phi_b within 1 deg of the slope) do not."""
-    return bool(params.phi_b_deg > params.theta_deg + 1.0)
+    return bool(params.basal_friction_deg > params.theta_deg + 1.0)
 
 
 def physical_memory() -> int | None:

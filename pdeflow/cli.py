@@ -176,12 +176,11 @@ def cmd_run(args: argparse.Namespace) -> int:
             written.append(write_npz(_model_path(args.final, m, i == 0),
                                      results[m].final_arrays()))
     if args.plot or outdir:
-        from .plotting import case_figures, deposit_figure, save
+        from .case_figures import case_figures, deposit_figure
+        from .plotting import save
     if args.plot:
-        two = results.get("two_layer")
-        one = results.get("single_layer")
-        fig = deposit_figure((two or one).x, two.state.data if two else None,
-                             one.state.data if one else None, case.name)
+        runs = list(results.values())
+        fig = deposit_figure(runs[0].x, [(r.model, r.state.data) for r in runs], case.name)
         written.append(save(fig, args.plot))
     if outdir:
         written.extend(case_figures(results, outdir))

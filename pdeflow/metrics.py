@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 
@@ -21,12 +23,20 @@ def front_position(x: np.ndarray, data: np.ndarray, threshold: float = 1e-3,
     return float(x[i] + (0.5 * dx if dx else 0.0))
 
 
-def mass(data: np.ndarray, dx: float, density_ratio: float | None = None) -> float:
-    """Mass per unit width divided by the lower density rho2 [m^2]:
-    sum (r h1 + h2) dx for two layers, sum h dx for one."""
-    if density_ratio is None:
-        return float(np.sum(data[0]) * dx)
-    return float(np.sum(density_ratio * data[0] + data[2]) * dx)
+def mass(data: np.ndarray, cells: float | np.ndarray,
+         densities: Sequence[float] | None = None) -> float:
+    """Mass divided by the densest layer's density: sum_i sum_k rho_k/rho_max h_k V_i
+    over the cells i and layers k, ``densities`` the relative densities of the layers
+    (the system's ``densities``; None: all 1), e.g. sum (r h1 + h2) dx for two layers,
+    sum h dx for one. ``cells``: dx [m] of uniform planar cells (the mass per unit
+    width [m^2]), or the cells' volumes V_i (a Metric's ``volumes``; [m^3])."""
+    weights = densities if densities is not None else [1.0] * (data.shape[0] // 2)
+    total = weights[0] * data[0]
+    for k in range(1, len(weights)):
+        total = total + weights[k] * data[2 * k]
+    if np.ndim(cells) == 0:
+        return float(np.sum(total) * cells)
+    return float(np.sum(total * cells))
 
 
 def momentum(data: np.ndarray, dx: float, density_ratio: float | None = None) -> float:

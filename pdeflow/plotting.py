@@ -1,15 +1,16 @@
 """Figures of runs: stacked layers, velocities and F_extra (as the paper's Figs. 3-7).
 
-Static figures of finished runs (:func:`snapshot_figure`, :func:`deposit_figure`,
-:func:`case_figures`) and :class:`RunFigure`, a figure of one or more runs that is
-redrawn in place: the live plots of :mod:`pdeflow.trackers.live`, movies, and the
-figures of stored runs (``pdeflow plot``). Depths in m, velocities in m/s, F_extra/rho1
+How each layer is drawn (:data:`LAYER_STYLES`), shared helpers, and :class:`RunFigure`,
+a figure of one or more runs that is redrawn in place: the live plots of
+:mod:`pdeflow.trackers.live`, movies, and the figures of stored runs (``pdeflow plot``);
+the static figures of a case's runs are in :mod:`pdeflow.case_figures`. Depths in m,
+velocities in m/s, F_extra/rho1
 in m^2/s^2, times in s.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -17,8 +18,8 @@ from typing import Any
 import matplotlib.pyplot as plt
 import numpy as np
 
+from . import systems
 from .io import atomic_path
-from .numerics.compile_parallel import can_fork, fork_context
 from .numerics.state import DRY_TOLERANCE, velocity_profile
 
 DRY = 1e-9
@@ -30,63 +31,25 @@ def _velocity(h: np.ndarray, m: np.ndarray, dry: float = DRY_TOLERANCE) -> np.nd
     return velocity_profile(h, m, dry, fill=np.nan)
 
 
-def plot_depths(ax, x: np.ndarray, two: np.ndarray | None,
-                single: np.ndarray | None) -> None:
-    """Lower layer filled from the bed, upper layer stacked on it, single layer as a line."""
-    if two is not None:
-        h1, h2 = two[0], two[2]
-        ax.fill_between(x, 0, h2, color="tab:brown", alpha=0.6, lw=0,
-                        label="lower layer $h_2$")
-        ax.fill_between(x, h2, h1 + h2, color="tab:orange", alpha=0.5, lw=0,
-                        label="upper layer $h_1$")
-        ax.plot(x, h1 + h2, color="tab:orange", lw=1)
-    if single is not None:
-        ax.plot(x, single[0], color="k", lw=1.2, label="single layer")
-    ax.set_ylabel("depth [m]")
+#: how a layer is drawn, by its :attr:`~pdeflow.systems.Layer.style`: fill colour and
+#: opacity (fill None: the paper's figures draw the layer as its surface line), and the
+#: colour of its lines
+LAYER_STYLES: dict[str, tuple[str | None, float, str]] = {
+    "upper": ("tab:orange", 0.5, "tab:orange"),
+    "lower": ("tab:brown", 0.6, "tab:brown"),
+    "single": (None, 0.7, "k"),
+}
+#: the fill of a line-drawn layer where a :class:`RunFigure` fills its first run
+LINE_LAYER_FILL = "tan"
 
 
-def plot_velocities(ax, x: np.ndarray, two: np.ndarray | None,
-                    single: np.ndarray | None) -> None:
-    """Velocities where a layer is present (gaps where it is dry)."""
-    if two is not None:
-        ax.plot(x, _velocity(two[0], two[1]), color="tab:orange", label="$u_1$ (upper)")
-        ax.plot(x, _velocity(two[2], two[3]), color="tab:brown", label="$u_2$ (lower)")
-    if single is not None:
-        ax.plot(x, _velocity(single[0], single[1]), color="k", lw=1.2,
-                label="single layer")
-    ax.set_ylabel("velocity [m/s]")
+def _symbol(name: str) -> str:
+    """'h1' -> '$h_1$' (mathtext), 'h' -> '$h$'."""
+    return f"${name[0]}_{name[1:]}$" if len(name) > 1 else f"${name}$"
 
 
-def snapshot_figure(x: np.ndarray, t: float, two: np.ndarray | None,
-                    single: np.ndarray | None, fextra: np.ndarray | None,
-                    title: str = "") -> Any:
-    """Three stacked panels at time t, like the paper's Figs. 3-6."""
-    fig, axes = plt.subplots(3, 1, figsize=(7, 7.5), sharex=True)
-    plot_depths(axes[0], x, two, single)
-    plot_velocities(axes[1], x, two, single)
-    axes[2].plot(x, fextra if fextra is not None else np.zeros_like(x), color="tab:red")
-    axes[2].set_ylabel(r"$F_{extra}/\rho_1$ [m$^2$/s$^2$]")
-    axes[0].legend(loc="upper right", fontsize=8)
-    axes[1].legend(loc="upper right", fontsize=8)
-    axes[2].set_xlabel("x [m]")
-    for ax in axes:
-        ax.grid(alpha=0.3)
-    fig.suptitle(f"{title} t = {t:g} s".strip())
-    fixed_margins(fig, top=0.45)
-    return fig
-
-
-def deposit_figure(x: np.ndarray, two: np.ndarray | None, single: np.ndarray | None,
-                   title: str = "", times: str = "") -> Any:
-    """Final deposits of both models (paper's Fig. 7)."""
-    fig, ax = plt.subplots(figsize=(7, 3.2))
-    plot_depths(ax, x, two, single)
-    ax.legend(loc="upper right", fontsize=8)
-    ax.set_xlabel("x [m]")
-    ax.grid(alpha=0.3)
-    ax.set_title(f"{title}: final deposits\n{times}".strip(), fontsize=10)
-    fixed_margins(fig, top=0.55)
-    return fig
+def _short(layer: Any) -> str:
+    return layer.label.replace(" layer", "")
 
 
 def fixed_margins(fig: Any, top: float, left: float = 0.9, right: float = 0.2,
@@ -123,57 +86,6 @@ def save(fig: Any, path: str | Path) -> Path:
     return path
 
 
-def case_figures(results: dict[str, Any], outdir: str | Path, prefix: str = "",
-                 parallel: bool = True) -> list[Path]:
-    """Snapshot figures at every stored time and the final-deposit figure (drawn by
-    :func:`draw_all`, on two cores with ``parallel``)."""
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    two = results.get("two_layer")
-    one = results.get("single_layer")
-    any_res = two or one
-    x = any_res.x
-    times = sorted(set(two.snapshots if two else {}) | set(one.snapshots if one else {}))
-    jobs = []
-    for t in times:
-        s2 = two.snapshots.get(t) if two else None
-        s1 = one.snapshots.get(t) if one else None
-        jobs.append((snapshot_figure, (x, t, s2[0] if s2 else None, s1[0] if s1 else None,
-                                       s2[1] if s2 else None, any_res.case.name),
-                     outdir / f"{prefix}snapshot_t{t:g}.png"))
-    stop = []
-    for res in (two, one):
-        if res is not None:
-            st = res.summary.get("stop_time")
-            stop.append(f"{res.model}: t={st:.2f} s" if st else f"{res.model}: moving")
-    jobs.append((deposit_figure, (x, two.state.data if two else None,
-                                  one.state.data if one else None, any_res.case.name,
-                                  "(" + ", ".join(stop) + ")"),
-                 outdir / f"{prefix}final_deposits.png"))
-    return draw_all(jobs, parallel)
-
-
-def draw_all(jobs: Sequence[tuple[Callable, tuple, Path]],
-             parallel: bool = True) -> list[Path]:
-    """Draw and :func:`save` the figures ``jobs`` (figure function, its arguments,
-    path); returns the paths. With ``parallel``, Agg (no window a fork would share)
-    and :func:`~pdeflow.numerics.compile_parallel.can_fork`, a forked process draws
-    every second figure meanwhile (matplotlib uses one core)."""
-    agg = plt.get_backend().lower() == "agg"
-    if not (parallel and len(jobs) > 1 and agg and can_fork()):
-        return [_draw(job) for job in jobs]
-    with fork_context().Pool(1) as pool:
-        theirs = pool.map_async(_draw, jobs[1::2])
-        mine = [_draw(job) for job in jobs[::2]]
-        paths = theirs.get()
-    return [mine[i // 2] if i % 2 == 0 else paths[i // 2] for i in range(len(jobs))]
-
-
-def _draw(job: tuple[Callable, tuple, Path]) -> Path:
-    make, args, path = job
-    return save(make(*args), path)
-
-
 # --- figures that can be redrawn in place: live plots, movies, stored runs ------------------
 
 #: colours of the runs drawn as lines (the first run is drawn filled)
@@ -193,7 +105,7 @@ class Series:
     x: np.ndarray
     """cell centres [m]"""
     model: str
-    """'two_layer' (state h1, h1u1, h2, h2u2) or 'single_layer' (state h, hu)"""
+    """the registered name of its model (:mod:`pdeflow.systems`)"""
     label: str = ""
     """legend label (default: the model name)"""
     dry: float = DRY_TOLERANCE
@@ -273,9 +185,10 @@ class RunFigure:
             self.ax_u.set_ylabel("velocity [m/s]")
             self.ax_f.set_ylabel(r"$F_{extra}/\rho_1$ [m$^2$/s$^2$]")
             self.ax_f.set_xlabel("x [m]")
-            if not any(s.model == "two_layer" for s in self.series):
-                self.ax_f.text(0.5, 0.5, "single layer: no F_extra", ha="center",
-                               va="center", transform=self.ax_f.transAxes, color="0.4")
+            if not any(systems.get(s.model).has_fextra for s in self.series):
+                self.ax_f.text(0.5, 0.5, f"{systems.get(self.series[0].model).label}: "
+                               "no F_extra", ha="center", va="center",
+                               transform=self.ax_f.transAxes, color="0.4")
             self.ax_u.axhline(0.0, color="0.5", lw=0.6)
         for ax in axes:
             ax.grid(alpha=0.3)
@@ -283,62 +196,72 @@ class RunFigure:
         self.t: float | None = None
 
     def name(self, s: Series) -> str:
-        """A run's name: its label, else its model ('two layers', 'single layer')."""
-        return s.label or ("two layers" if s.model == "two_layer" else "single layer")
+        """A run's name: its label, else its model's ('two layers', 'single layer')."""
+        return s.label or systems.get(s.model).label
 
     def _prefix(self, s: Series) -> str:
         return f"{self.name(s)}: " if self._named else ""
 
     def _add_lines(self, s: Series, *, filled: bool, free: list[str]) -> dict[str, Any]:
-        """The (empty) lines of one run; ``free``: line colours not taken yet."""
+        """The (empty) lines of one run; ``free``: line colours not taken yet. A run
+        drawn filled gets its layers' own colours (its fills carry the legend, the lines
+        are their edges); a comparison one colour, the first one-layer run black."""
+        system = systems.get(s.model)
         name, pre = self.name(s), self._prefix(s)
         nan = np.full(s.x.size, np.nan)
-        ln: dict[str, Any] = {}
-        if s.model == "two_layer":
-            if filled:  # the fills carry the legend; the lines are their edges
-                c_up, c_lo, hide = "tab:orange", "tab:brown", "_"
-                up, lo = f"{pre}$u_1$ (upper)", f"{pre}$u_2$ (lower)"
-            else:
-                c_up = c_lo = free.pop(0) if free else "0.5"
-                hide = ""
-                up, lo = f"{name}: $u_1$ (upper)", f"{name}: $u_2$ (lower)"
-            ln["surface"], = self.ax_h.plot(s.x, nan, color=c_up, lw=1.0,
-                                            label=f"{hide}{name}: free surface")
-            ln["interface"], = self.ax_h.plot(s.x, nan, color=c_lo, lw=1.0,
-                                              ls="-" if filled else "--",
-                                              label=f"{hide}{name}: interface")
-            if self.ax_u is not None and self.ax_f is not None:
-                ln["u1"], = self.ax_u.plot(s.x, nan, color=c_up, lw=1.2, label=up)
-                ln["u2"], = self.ax_u.plot(s.x, nan, color=c_lo, lw=1.2,
-                                           ls="-" if filled else "--", label=lo)
-                ln["fextra"], = self.ax_f.plot(s.x, nan, color="tab:red" if filled
-                                               else c_up, lw=1.2, label=name)
-        else:
-            # black, as in the run's figures, for the first single layer only
-            color = "k" if self._black_free else (free.pop(0) if free else "0.5")
+        one = len(system.layers) == 1
+        if filled:
+            colours = [LAYER_STYLES[layer.style][2] for layer in system.layers]
+            if one:
+                self._black_free = False
+        elif one and self._black_free:
+            colours = ["k"]
             self._black_free = False
-            label = f"_{name}" if filled else name  # a filled layer: its patch
-            ln["surface"], = self.ax_h.plot(s.x, nan, color=color, lw=1.2, label=label)
-            if self.ax_u is not None:
-                ln["u"], = self.ax_u.plot(s.x, nan, color=color, lw=1.2, label=name)
+        else:
+            colours = [free.pop(0) if free else "0.5"] * len(system.layers)
+        hide = "_" if filled else ""
+        ln: dict[str, Any] = {}
+        ln["surface"], = self.ax_h.plot(s.x, nan, color=colours[0], lw=1.2 if one else 1.0,
+                                        label=f"{hide}{name}" if one else
+                                        f"{hide}{name}: free surface")
+        for k in range(1, len(system.layers)):
+            ln[f"interface{k}"], = self.ax_h.plot(s.x, nan, color=colours[k], lw=1.0,
+                                                  ls="-" if filled else "--",
+                                                  label=f"{hide}{name}: interface")
+        if self.ax_u is None or self.ax_f is None:
+            return ln
+        for k, layer in enumerate(system.layers):
+            label = name if one else (
+                f"{pre if filled else name + ': '}{_symbol(layer.velocity)} "
+                f"({_short(layer)})")
+            ln[f"u{k}"], = self.ax_u.plot(s.x, nan, color=colours[k], lw=1.2,
+                                          ls="-" if filled or k == 0 else "--", label=label)
+        if system.has_fextra:
+            ln["fextra"], = self.ax_f.plot(s.x, nan, color="tab:red" if filled
+                                           else colours[0], lw=1.2, label=name)
         return ln
 
     def _legend(self) -> None:
         from matplotlib.patches import Patch
 
         first = self.series[0]
+        system = systems.get(first.model)
         pre = self._prefix(first)
-        if first.model == "two_layer":
-            patches = [Patch(color="tab:brown", alpha=0.6, label=f"{pre}lower layer $h_2$"),
-                       Patch(color="tab:orange", alpha=0.5, label=f"{pre}upper layer $h_1$")]
+        if len(system.layers) == 1:
+            patches = [Patch(color=LAYER_STYLES[system.layers[0].style][0]
+                             or LINE_LAYER_FILL, alpha=LAYER_STYLES[system.layers[0].style][1],
+                             label=self.name(first))]
         else:
-            patches = [Patch(color="tan", alpha=0.7, label=self.name(first))]
+            patches = [Patch(color=LAYER_STYLES[layer.style][0],
+                             alpha=LAYER_STYLES[layer.style][1],
+                             label=f"{pre}{layer.label} {_symbol(layer.depth)}")
+                       for layer in reversed(system.layers)]
         lines = [ln for ln in self.ax_h.get_lines()[1:]  # [0] is the bed line
                  if not ln.get_label().startswith("_")]
         self.ax_h.legend(handles=patches + lines, loc="upper right", fontsize=7)
         if self.ax_u is not None and self.ax_f is not None:
             self.ax_u.legend(loc="upper right", fontsize=7)
-            if sum(s.model == "two_layer" for s in self.series) > 1:
+            if sum(systems.get(s.model).has_fextra for s in self.series) > 1:
                 self.ax_f.legend(loc="upper right", fontsize=7)
 
     def update(self, t: float, states: Sequence[np.ndarray | None],
@@ -370,32 +293,7 @@ class RunFigure:
                                                strict=True)):
             if d is None:
                 continue
-            if s.model == "two_layer":
-                h1, h2 = d[0], d[2]
-                top = h1 + h2
-                ln["surface"].set_ydata(np.where(top > DRY, top, np.nan))
-                ln["interface"].set_ydata(np.where(h2 > DRY, h2, np.nan))
-                u1, u2 = _velocity(h1, d[1], s.dry), _velocity(h2, d[3], s.dry)
-                _set(ln, "u1", u1)
-                _set(ln, "u2", u2)
-                us = [u1, u2]
-                f = np.zeros_like(h1) if fx is None else np.asarray(fx)
-                _set(ln, "fextra", f)
-                self._f_max = max(self._f_max, float(np.max(f)) if f.size else 0.0)
-                if i == 0:
-                    self._fills.append(self.ax_h.fill_between(
-                        s.x, 0, h2, color="tab:brown", alpha=0.6, lw=0))
-                    self._fills.append(self.ax_h.fill_between(
-                        s.x, h2, top, color="tab:orange", alpha=0.5, lw=0))
-            else:
-                h = d[0]
-                ln["surface"].set_ydata(np.where(h > DRY, h, np.nan))
-                u = _velocity(h, d[1], s.dry)
-                _set(ln, "u", u)
-                us = [u]
-                if i == 0:
-                    self._fills.append(self.ax_h.fill_between(
-                        s.x, 0, h, color="tan", alpha=0.7, lw=0))
+            us = self._draw_run(i, s, d, fx, ln)
             for u in us:
                 if np.any(np.isfinite(u)):
                     self._u_lim[0] = min(self._u_lim[0], float(np.nanmin(u)))
@@ -416,6 +314,36 @@ class RunFigure:
             if engine is not None:
                 engine.execute(self.fig)
                 self.fig.set_layout_engine("none")
+
+    def _draw_run(self, i: int, s: Series, d: np.ndarray, fx: np.ndarray | None,
+                  ln: dict[str, Any]) -> list[np.ndarray]:
+        """Set the lines of run ``i`` (and fill its layers if it is the first); returns
+        its velocities."""
+        system = systems.get(s.model)
+        n = len(system.layers)
+        tops = [d[2 * (n - 1)]]  # surfaces of the layers stacked from the bed
+        for k in range(n - 2, -1, -1):
+            tops.append(tops[-1] + d[2 * k])
+        ln["surface"].set_ydata(np.where(tops[-1] > DRY, tops[-1], np.nan))
+        for k in range(1, n):
+            h = tops[n - 1 - k]
+            ln[f"interface{k}"].set_ydata(np.where(h > DRY, h, np.nan))
+        us = [_velocity(d[2 * k], d[2 * k + 1], s.dry) for k in range(n)]
+        for k, u in enumerate(us):
+            _set(ln, f"u{k}", u)
+        if system.has_fextra:
+            f = np.zeros_like(d[0]) if fx is None else np.asarray(fx)
+            _set(ln, "fextra", f)
+            self._f_max = max(self._f_max, float(np.max(f)) if f.size else 0.0)
+        if i == 0:
+            base: Any = 0
+            for k in range(n - 1, -1, -1):
+                fill, alpha, _ = LAYER_STYLES[system.layers[k].style]
+                top = tops[n - 1 - k]
+                self._fills.append(self.ax_h.fill_between(
+                    s.x, base, top, color=fill or LINE_LAYER_FILL, alpha=alpha, lw=0))
+                base = top
+        return us
 
     def set_title(self, text: str) -> None:
         """Title: the figure's ``title`` followed by ``text`` (normally the time)."""

@@ -19,11 +19,13 @@ from typing import Any
 import numpy as np
 from pde import FieldCollection
 
+from . import systems
 from .cases import Case
 from .checks import RunWarning, cost_warning, domain_ends, result_warnings, solver_warning
 from .metrics import front_position, mass
 from .models.base import GranularPDE
 from .numerics import layout as L
+from .numerics.layout import GEOMETRIES
 from .numerics.state import velocity_profile
 from .solvers.diagnostics import SplitDiagnostics
 from .solvers.fv_split import SimulationBlowUp, load_kernels
@@ -63,11 +65,10 @@ class RunResult:
         out = {"x": self.x, "t": np.float64(self.t_final)}
         d = self.state.data
         dry = self.pde.parameters.dry_tolerance
-        names = ("h1", "u1", "h2", "u2") if self.model == "two_layer" else ("h", "u")
-        for k in range(0, d.shape[0], 2):
-            h = d[k]
-            out[names[k]] = h.copy()
-            out[names[k + 1]] = velocity_profile(h, d[k + 1], dry)
+        for k, layer in enumerate(self.pde.system.layers):
+            h = d[2 * k]
+            out[layer.depth] = h.copy()
+            out[layer.velocity] = velocity_profile(h, d[2 * k + 1], dry)
         return out
 
 
@@ -83,7 +84,7 @@ def load_case_kernels(case: Case, log: Any = None,
             meanwhile()
         return 0.0
     return load_kernels(log, [case.make_pde(m) for m in case.models], case.splitting,
-                        meanwhile=meanwhile)
+                        meanwhile=meanwhile, geometry=GEOMETRIES[case.geometry])
 
 
 class Run:
@@ -91,7 +92,7 @@ class Run:
 
     Args:
         case: the case (not modified; with ``variant`` a copy solved that way).
-        model: ``"two_layer"`` or ``"single_layer"``.
+        model: the registered name of the model (:func:`pdeflow.systems.names`).
         variant: how to solve it; default: what the case file selects.
         backend: ``"numba"`` (compiled stepping loop) or ``"numpy"`` (fv-split only).
 
@@ -140,8 +141,8 @@ class Run:
         for message in (solver_warning(case), cost_warning(case, model)):
             if message:
                 warnings.warn(message, RunWarning, stacklevel=2)
-        r = self.pde.parameters.density_ratio if model == "two_layer" else None
-        mass0 = mass(self.state.data, case.dx, r)
+        mass0 = mass(self.state.data, self.pde.metric(self.state.grid).cells,
+                     self.pde.system.densities(self.pde.parameters))
         snaps = FextraStorageTracker(sorted(case.snapshot_times))
         trackers: list[Any] = [snaps] if case.snapshot_times else []
         if tracker is not None:
@@ -149,7 +150,8 @@ class Run:
         if not self.variant.is_mol and self.backend == "numba":
             # compiling (first run on a machine) or loading the kernels is not the run's
             # wall time, nor should it hold up its progress bar
-            load_kernels(pdes=[self.pde], splitting=self.variant.splitting)
+            load_kernels(pdes=[self.pde], splitting=self.variant.splitting,
+                         geometry=self.pde.metric(self.state.grid).code)
         wall0 = time.perf_counter()
         final, info = self.pde.solve(self.state, t_range=case.t_end, tracker=trackers,
                                      ret_info=True, **self.solver_arguments())
@@ -188,32 +190,23 @@ class Run:
 
 def run_model(case: Case, model: str, *, tracker: Any = None,
               backend: str = "numba") -> RunResult:
-    """Run ``model`` ('two_layer' or 'single_layer') of ``case`` to rest or t_end:
+    """Run ``model`` (a registered name) of ``case`` to rest or t_end:
     ``Run(case, model, backend=backend).execute(tracker)``."""
     return Run(case, model, backend=backend).execute(tracker)
-
-
-def _stop_time(last_moving: float, t_final: float, at_rest: bool) -> float | None:
-    """Stop time from the last time a layer moved: None if still moving at the end."""
-    if last_moving >= t_final and not at_rest:
-        return None
-    return float(last_moving)
 
 
 _COMMON_KEYS = ("model", "solver", "t_final", "at_rest", "front_position", "runout",
                 "mass_relative_error", "steps", "wall_time_s", "stop_reason", "stop_time",
                 "max_fextra_over_rho1", "flux_fallback_steps", "mass_change",
                 "runout_lower_bound", "domain_ends", "warnings")
-SUMMARY_KEYS: dict[str, tuple[str, ...]] = {
-    "two_layer": (*_COMMON_KEYS, "lower_stop_time", "upper_stop_time", "lower_slow_time",
-                  "upper_slow_time", "max_fextra_x", "max_fextra_time",
-                  "hyperbolicity_events", "hyperbolicity_bisections", "deposited_volume",
-                  "eroded_volume", "upper_volume_final", "lower_volume_final"),
-    "single_layer": (*_COMMON_KEYS, "slow_time"),
-}
-"""Keys of :func:`summarize` per model with the fv-split solver (other py-pde solvers
-give the common keys; stop times are then None). ``domain_ends`` (a table) and
-``warnings`` (a list) are not numbers: a study records them as JSON text."""
+
+
+def summary_keys(model: str) -> tuple[str, ...]:
+    """Keys of :func:`summarize` for ``model`` with the fv-split solver: the common ones
+    and the system's own (other py-pde solvers give the common keys; stop times are
+    then None). ``domain_ends`` (a table) and ``warnings`` (a list) are not numbers: a
+    study records them as JSON text."""
+    return (*_COMMON_KEYS, *systems.get(model).summary_keys)
 
 
 def summarize(res: RunResult, mass0: float, wall: float,
@@ -223,7 +216,8 @@ def summarize(res: RunResult, mass0: float, wall: float,
     case = res.case
     dx = case.dx
     d = res.state.data
-    r = res.pde.parameters.density_ratio if res.model == "two_layer" else None
+    weights = res.pde.system.densities(res.pde.parameters)
+    cells = res.pde.metric(res.state.grid).cells
     front = front_position(res.x, d, case.front_threshold, dx)
     at_rest = "rest_time" in res.info.get("solver", {})
     diag = res.diagnostics
@@ -235,8 +229,8 @@ def summarize(res: RunResult, mass0: float, wall: float,
         "front_position": front,
         "runout": (front - case.x_start - case.L0) if (front is not None and case.L0)
         else None,
-        "mass_relative_error": abs(mass(d, dx, r) - mass0) / mass0 if mass0 else 0.0,
-        "mass_change": (mass(d, dx, r) - mass0) / mass0 if mass0 else 0.0,
+        "mass_relative_error": abs(mass(d, cells, weights) - mass0) / mass0 if mass0 else 0.0,
+        "mass_change": (mass(d, cells, weights) - mass0) / mass0 if mass0 else 0.0,
         "steps": int(res.info.get("solver", {}).get("steps", 0)),
         "wall_time_s": wall,
         "stop_reason": res.info.get("controller", {}).get("stop_reason"),
@@ -244,32 +238,8 @@ def summarize(res: RunResult, mass0: float, wall: float,
     if diag is not None:
         # steps that IFCP could not keep positive, redone with HLL (0 for other fluxes)
         out["flux_fallback_steps"] = diag.flux_fallbacks
-        tf = res.t_final
-        up = _stop_time(diag.last_move_upper, tf, at_rest)
-        if res.model == "two_layer":
-            lo = _stop_time(diag.last_move_lower, tf, at_rest)
-            out.update({
-                "lower_stop_time": lo,
-                "upper_stop_time": up,
-                "stop_time": None if (lo is None or up is None) else max(lo, up),
-                "lower_slow_time": _stop_time(diag.last_fast_lower, tf, False),
-                "upper_slow_time": _stop_time(diag.last_fast_upper, tf, False),
-                "max_fextra_over_rho1": diag.fextra_max,
-                "max_fextra_x": float(res.x[diag.fextra_cell]),
-                "max_fextra_time": diag.fextra_time,
-                "hyperbolicity_events": diag.hyperbolicity_events,
-                "hyperbolicity_bisections": diag.hyperbolicity_bisections,
-                "deposited_volume": float(diag.deposited * dx),
-                "eroded_volume": float(diag.eroded * dx),
-                "upper_volume_final": float(np.sum(d[0]) * dx),
-                "lower_volume_final": float(np.sum(d[2]) * dx),
-            })
-        else:
-            out.update({
-                "stop_time": up,
-                "slow_time": _stop_time(diag.last_fast_upper, tf, False),
-                "max_fextra_over_rho1": 0.0,
-            })
+        out.update(res.pde.system.summarize(diag, res.t_final, at_rest, res.x, d,
+                                            res.pde.metric(res.state.grid)))
     else:
         out.update({"stop_time": None, "max_fextra_over_rho1": None})
     if initial is not None:

@@ -4,8 +4,8 @@ Writing (``pdeflow run CASE --store out.h5 [--store-every DT]``, or in Python)::
 
     from pdeflow.storage import RunStorageTracker, open_run, run_metadata
     tracker = RunStorageTracker("out.h5", interrupts=0.05,
-                                metadata=run_metadata(case, "two_layer"))
-    run_model(case, "two_layer", tracker=tracker)          # or eq.solve(..., tracker=...)
+                                metadata=run_metadata(case, PAPER_MODEL))
+    run_model(case, PAPER_MODEL, tracker=tracker)          # or eq.solve(..., tracker=...)
     run = open_run("out.h5")                                # -> StoredRun
     run.times, run.x, run.profiles(-1)["h1"], run.metadata["parameters"]
     run.to_csv("out.csv"); run.to_netcdf("out.nc")          # NetCDF needs xarray
@@ -44,20 +44,25 @@ from typing import Any
 import numpy as np
 from pde.trackers.base import InfoDict
 
+from . import systems
 from .io import PendingFile, atomic_path, jsonable
 from .numerics.state import DRY_TOLERANCE, velocity_profile
 from .trackers.frames import (
     FEXTRA_LABEL,
-    STATE_LABELS,
     FextraStorageTracker,
-    model_of,
     show_final_state,
+    state_labels,
 )
 
 FORMAT = "pdeflow-run/1"
-UNITS = {"h1": "m", "h2": "m", "h": "m", "u1": "m/s", "u2": "m/s", "u": "m/s",
-         "h1u1": "m^2/s", "h2u2": "m^2/s", "hu": "m^2/s", FEXTRA_LABEL: "m^2/s^2",
-         "x": "m", "t": "s"}
+
+
+def units(system: systems.EquationSystem) -> dict[str, str]:
+    """Units of the stored fields and exported columns of ``system``'s runs."""
+    out = {"x": "m", "t": "s", FEXTRA_LABEL: "m^2/s^2"}
+    for layer in system.layers:
+        out.update({layer.depth: "m", layer.velocity: "m/s", layer.discharge: "m^2/s"})
+    return out
 
 
 class StorageError(ValueError):
@@ -89,7 +94,7 @@ def _variant_parts(case: Any, eq: Any) -> list[str]:
         parts.append(f"{splitting} splitting")
     params = eq.parameters.to_dict()
     for key in ("exchange_closure", "hyperbolicity"):
-        if key in params and getattr(eq, "two_layer", False):
+        if key in params:
             parts.append(f"{key}={params[key]}")
     return parts
 
@@ -158,14 +163,15 @@ class RunStorageTracker(FextraStorageTracker):
         from . import __version__
 
         require_h5py()
-        model = model_of(field)
-        meta = {"format": FORMAT, "model": model, **self.metadata}
+        system = (systems.get(self.metadata["model"]) if "model" in self.metadata
+                  else systems.of_fields(state_labels(field)))
+        meta = {"format": FORMAT, "model": system.name, **self.metadata}
         meta.setdefault("pdeflow_version", __version__)
         meta["py_pde_version"] = pde.__version__
         meta["created"] = datetime.datetime.now(datetime.timezone.utc).isoformat(
             timespec="seconds")
-        meta["fields"] = [*STATE_LABELS[model], FEXTRA_LABEL]
-        meta["units"] = {k: UNITS[k] for k in meta["fields"]}
+        meta["fields"] = [*system.field_names, FEXTRA_LABEL]
+        meta["units"] = {k: units(system)[k] for k in meta["fields"]}
         self._pending = PendingFile(self.path)
         self.storage = FileStorage(self._pending.tmp, info={"pdeflow": jsonable(meta)},
                                    write_mode="truncate_once",
@@ -235,11 +241,12 @@ class StoredRun:
 
     @property
     def model(self) -> str:
-        return self.metadata.get("model") or model_of(self.data[0])
+        return self.metadata["model"]
 
     @property
-    def two_layer(self) -> bool:
-        return self.model == "two_layer"
+    def system(self) -> systems.EquationSystem:
+        """The run's equation system."""
+        return systems.get(self.model)
 
     @property
     def dry_tolerance(self) -> float:
@@ -273,18 +280,19 @@ class StoredRun:
     def profiles(self, i: int) -> dict[str, np.ndarray]:
         """Depths [m], velocities [m/s] and F_extra/rho1 [m^2/s^2] of frame i."""
         d = self.data[i]
-        names = ("h1", "u1", "h2", "u2") if self.two_layer else ("h", "u")
         out: dict[str, np.ndarray] = {}
-        for k in range(0, d.shape[0], 2):
-            out[names[k]] = d[k].copy()
-            out[names[k + 1]] = velocity_profile(d[k], d[k + 1], self.dry_tolerance)
-        if self.two_layer:
+        for k, layer in enumerate(self.system.layers):
+            out[layer.depth] = d[2 * k].copy()
+            out[layer.velocity] = velocity_profile(d[2 * k], d[2 * k + 1],
+                                                   self.dry_tolerance)
+        if self.system.has_fextra:
             out[FEXTRA_LABEL] = self.fextra[i].copy()
         return out
 
     def columns(self) -> list[str]:
         """Names of the exported quantities (after t and x)."""
-        return (["h1", "u1", "h2", "u2", FEXTRA_LABEL] if self.two_layer else ["h", "u"])
+        return [*self.system.profile_names,
+                *([FEXTRA_LABEL] if self.system.has_fextra else [])]
 
     def table(self) -> np.ndarray:
         """Long table: one row per (time, cell), columns t, x, then :meth:`columns`."""
@@ -323,7 +331,7 @@ class StoredRun:
                                "pip install 'pdeflow[export]'") from None
         per = [self.profiles(i) for i in range(len(self.times))]
         data_vars = {name: (("t", "x"), np.stack([p[name] for p in per]),
-                            {"units": UNITS[name]}) for name in self.columns()}
+                            {"units": units(self.system)[name]}) for name in self.columns()}
         attrs = {"pdeflow_metadata": json.dumps(self.metadata),
                  "model": self.model, "source": str(self.path)}
         for key in ("case_name", "pdeflow_version", "variant"):
@@ -400,9 +408,13 @@ def open_run(path: str | Path) -> StoredRun:
         state, fextra = data[:, :-1], data[:, -1]
     else:
         state, fextra = data, np.zeros((data.shape[0], data.shape[2]))
-    if state.shape[1] not in (2, 4):
-        raise StorageError(f"{path}: {rows} fields per frame is no granular run")
-    meta.setdefault("model", model_of(state[0]))
+    if "model" not in meta:
+        fields = meta.get("fields", [])[:state.shape[1]]
+        try:
+            meta["model"] = systems.of_fields(fields).name
+        except ValueError:
+            raise StorageError(f"{path}: {rows} fields per frame {fields} are no granular "
+                               "run of a registered model") from None
     return StoredRun(path, times, x, state, fextra, meta)
 
 

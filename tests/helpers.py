@@ -22,11 +22,12 @@ def step(eq, state, t_end: float, cfl: float = 0.3, stop_at_rest: bool = False,
     """Run the compiled fv-split loop directly; returns (q, t, steps, status, diag)."""
     q = state.data.copy()
     diag = eq.new_diagnostics(q.shape[1])
-    dx = float(state.grid.discretization[0])
-    stepper = scheme_stepper(eq.two_layer, *eq.scheme_codes, strang)
-    t, steps, status = stepper(q, 0.0, t_end, dx, *eq.bc_codes, eq.parameter_array(), cfl,
-                               diag, np.empty_like(q), np.empty_like(q),
-                               np.empty((3, *q.shape)), max_steps, stop_at_rest)
+    metric = eq.metric(state.grid)
+    stepper = scheme_stepper(eq.kernels, *eq.scheme_codes, strang, metric.code)
+    t, steps, status = stepper(q, 0.0, t_end, metric.dx, metric.array(), *eq.bc_codes,
+                               eq.parameter_array(), cfl, diag, np.empty_like(q),
+                               np.empty_like(q), np.empty((3, *q.shape)), max_steps,
+                               stop_at_rest)
     return q, t, steps, status, diag
 
 

@@ -21,7 +21,7 @@ import pdeflow
 from pdeflow import FVSplitSolver, SimulationBlowUp
 from pdeflow.cases import CaseError, load_case
 from pdeflow.io import atomic_path, write_json, write_npz
-from pdeflow.numerics import layout as L
+from pdeflow.numerics import layout_two_layer as T
 from pdeflow.numerics.vectorized import advection_rate
 from pdeflow.solvers.fv_split import diagnose_blowup
 
@@ -115,7 +115,7 @@ def test_muscl_above_cfl_one_half_is_rejected():
 
 @pytest.mark.parametrize("bad_grid, words", [
     (CartesianGrid([[0, 1], [0, 1]], [4, 4]), "1D CartesianGrid"),
-    (PolarSymGrid(1.0, 8), "1D CartesianGrid"),
+    (PolarSymGrid((0.5, 1.0), 8), "must start at the axis"),
     (CartesianGrid([[0, 1]], 8, periodic=True), "must not be periodic"),
 ])
 def test_grid_that_is_not_1d_cartesian_is_rejected(bad_grid, words):
@@ -312,7 +312,7 @@ def test_blowup_beyond_the_cfl_limit_stops_with_a_diagnostic():
     # ... and one more step from it really goes negative in the reported cell
     # (recomputed independently with the numpy implementation of the HLL update)
     P = eq.parameter_array()
-    rate, smax = advection_rate(kept, 0.1, eq.bc_codes, P[L.G_Z], P[L.DRY], P[L.R])
+    rate, smax = advection_rate(kept, 0.1, eq.bc_codes, P[T.G_Z], P[T.DRY], P[T.R])
     dt = 1.5 * 0.1 / smax
     assert err.report["dt"] == pytest.approx(dt, rel=1e-12)
     new = kept + dt * rate

@@ -7,6 +7,7 @@ from hypothesis import strategies as st
 
 import pdeflow
 from pdeflow.numerics import layout as L
+from pdeflow.numerics import layout_two_layer as T
 from pdeflow.numerics.hyperbolicity import (
     band_lower_edge,
     discriminant,
@@ -189,21 +190,21 @@ def test_direct_restoration_is_the_bisection_limit(mode):
                                       phi_b_deg=rng.uniform(1e-6, 40),
                                       density_ratio=rng.uniform(0.5, 0.99))
         P = eq.parameter_array()
-        P[L.HYPERBOLICITY] = mode
+        P[T.HYPERBOLICITY] = mode
         h1, h2 = rng.uniform(0.01, 1.5, 2)
         b1, b2 = rng.uniform(-8, 8, 2)
         dt = rng.uniform(1e-4, 1e-2)
-        kc = (P[L.K], P[L.C])  # the paper's interface stress t1 (no erosion this step)
+        kc = (P[T.K], P[T.C])  # the paper's interface stress t1 (no erosion this step)
         v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, 0.0, *kc)
-        if is_hyperbolic(h1, h2, v1, v2, P[L.G_Z], P[L.R], mode):
+        if is_hyperbolic(h1, h2, v1, v2, P[T.G_Z], P[T.R], mode):
             continue
         f, u1, u2, bisected = restore_hyperbolicity(b1, b2, h1, h2, v1, v2, dt, P, *kc)
         assert not bisected  # the direct solve found it
-        assert is_hyperbolic(h1, h2, u1, u2, P[L.G_Z], P[L.R], mode)
+        assert is_hyperbolic(h1, h2, u1, u2, P[T.G_Z], P[T.R], mode)
         assert (u1, u2) == implicit_friction(b1, b2, h1, h2, dt, P, f, *kc)
         f_w = bisect_fextra(b1, b2, h1, h2, v1 - v2, dt, P, *kc)
         assert abs(f) <= abs(f_w) * (1 + 1e-12)
-        P[L.W] = 1e-12
+        P[T.W] = 1e-12
         f_fine = bisect_fextra(b1, b2, h1, h2, v1 - v2, dt, P, *kc)
         du_fine = np.subtract(*implicit_friction(b1, b2, h1, h2, dt, P, f_fine, *kc))
         assert abs((u1 - u2) - du_fine) <= 2e-8 * abs(du_fine)

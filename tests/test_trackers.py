@@ -96,8 +96,10 @@ def _pdeflow_imports(path: Path) -> set[str]:
         if isinstance(node, ast.ImportFrom):
             base = pkg.split(".")[:len(pkg.split(".")) - node.level + 1] if node.level \
                 else []
-            name = ".".join([*base, node.module] if node.module else base)
-            out.add(name)
+            if node.module:
+                out.add(".".join([*base, node.module]))
+            else:  # from . import module, ...
+                out.update(".".join([*base, a.name]) for a in node.names)
         elif isinstance(node, ast.Import):
             out.update(a.name for a in node.names)
     return {n for n in out if n.split(".")[0] == "pdeflow"}
@@ -105,12 +107,14 @@ def _pdeflow_imports(path: Path) -> set[str]:
 
 def test_trackers_sit_below_models_solvers_and_storage():
     """As in py-pde (a PDE's solve makes its trackers), pdeflow's trackers import only
-    the numerics, io and plotting, never the models, solvers, storage or what is above."""
-    allowed = ("pdeflow.numerics", "pdeflow.io", "pdeflow.plotting", "pdeflow.trackers")
+    the numerics, io, plotting and the systems registry, never the models, solvers,
+    storage or what is above."""
+    allowed = ("pdeflow.numerics", "pdeflow.io", "pdeflow.plotting", "pdeflow.trackers",
+               "pdeflow.systems")
     for path in sorted((ROOT / "pdeflow" / "trackers").glob("*.py")):
         bad = [n for n in _pdeflow_imports(path) if not n.startswith(allowed)]
         assert not bad, f"{path.name} imports {bad}"
     for name in ("io.py", "plotting.py"):
         bad = [n for n in _pdeflow_imports(ROOT / "pdeflow" / name)
-               if not n.startswith(("pdeflow.numerics", "pdeflow.io"))]
+               if not n.startswith(("pdeflow.numerics", "pdeflow.io", "pdeflow.systems"))]
         assert not bad, f"{name} imports {bad}"

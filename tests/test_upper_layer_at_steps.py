@@ -7,8 +7,9 @@ import pytest
 
 from pdeflow.numerics import layout as L
 from pdeflow.numerics.advection import rate_kernel
+from pdeflow.numerics.bundles import TWO_LAYER
 from pdeflow.numerics.compiled import ready
-from pdeflow.numerics.pvm import fluctuation_kernel
+from pdeflow.numerics.pvm import fluctuations_two_layer
 
 G = 9.81
 R = 0.67
@@ -18,7 +19,7 @@ DRY = 1e-6
 def _fluct(flux: int, left: tuple, right: tuple):
     """Face fluctuations of the two-layer system; states as (h1, u1, h2) with the lower
     layer at rest."""
-    fluct = ready(fluctuation_kernel(True, flux))
+    fluct = ready(fluctuations_two_layer(flux))
     (h1L, u1L, h2L), (h1R, u1R, h2R) = left, right
     return fluct((h1L, h1L * u1L, h2L, 0.0), (h1R, h1R * u1R, h2R, 0.0), G, R, DRY)
 
@@ -60,7 +61,7 @@ def test_a_step_the_upper_layer_covers_keeps_the_fluxs_fluctuations():
     left = (0.4, 0.3, 0.2)
     right = (0.15, 0.25, 0.5)
     dm, dp, _ = _fluct(L.FLUX_HLL, left, right)
-    fluct = ready(fluctuation_kernel(True, L.FLUX_HLL))
+    fluct = ready(fluctuations_two_layer(L.FLUX_HLL))
     (h1L, u1L, h2L), (h1R, u1R, h2R) = left, right
     ref_m, ref_p, _ = fluct((h1L, h1L * u1L, h2L, 1e-300), (h1R, h1R * u1R, h2R, 1e-300),
                             G, R, DRY)
@@ -78,8 +79,10 @@ def test_pool_in_a_hollow_puts_no_mass_on_the_steps_and_no_potential_energy_in()
     u1 = np.where(h1 > 0, 0.02, 0.0)
     q = np.array([h1, h1 * u1, h2, np.zeros(n)])
     rate = np.zeros_like(q)
-    advect = ready(rate_kernel(True, L.FLUX_HLL, 1, L.LIMITER_MINMOD))
-    advect(q, rate, np.zeros((2, *q.shape)), dx, L.BC_WALL, L.BC_WALL, G, R, DRY)
+    advect = ready(rate_kernel(TWO_LAYER, L.FLUX_HLL, 1, L.LIMITER_MINMOD,
+                               L.GEOMETRY_PLANAR))
+    advect(q, rate, np.zeros((2, *q.shape)), dx, np.zeros((L.N_METRIC, n + 1)), L.BC_WALL,
+           L.BC_WALL, G, R, DRY)
     rims = h2 == 0.5
     assert np.all(rate[0][rims] <= 0.0)
     assert np.sum(R * G * (h1 + h2) * rate[0]) * dx <= 1e-12

@@ -46,6 +46,7 @@ from pdeflow.analysis.stability_problems import (  # noqa: E402
     shear_band,
 )
 from pdeflow.io import atomic_path  # noqa: E402
+from pdeflow.metrics import mass, total_depth  # noqa: E402
 from pdeflow.models import SingleLayerGranular, TwoLayerGranular  # noqa: E402
 from pdeflow.numerics.hyperbolicity import lower_bound_fl, upper_bound_fr  # noqa: E402
 from pdeflow.variant import Variant  # noqa: E402
@@ -217,8 +218,7 @@ def _column(n: int, length: float, L0: float, H0: float, two: bool, x0: float = 
 
 
 def _mass(eq: Any, q: np.ndarray) -> float:
-    return float(np.sum(eq.parameters.density_ratio * q[0] + q[2]) if eq.two_layer
-                 else np.sum(q[0]))
+    return mass(q, 1.0, eq.system.densities(eq.parameters))
 
 
 def extremes(log: Callable[[str], None] = print) -> list[dict[str, Any]]:
@@ -232,7 +232,7 @@ def extremes(log: Callable[[str], None] = print) -> list[dict[str, Any]]:
         wall = time.perf_counter() - t0
         q = final.data
         x = final.grid.axes_coords[0]
-        H = q[0] + (q[2] if eq.two_layer else 0.0)
+        H = total_depth(q)
         wet = np.nonzero(H > 1e-3)[0]
         m0 = _mass(eq, st0.data)
         row = {"case": name, "cells": q.shape[1], "steps": int(info["solver"]["steps"]),

@@ -32,7 +32,8 @@ from typing import Any
 
 import numpy as np
 
-from ..cases import Case, CaseError, load_case
+from .. import systems
+from ..cases import PAPER_MODEL, Case, CaseError, load_case
 from ..simulate import load_case_kernels
 from .study import Executor, Point, Study, refined, serial
 
@@ -60,12 +61,14 @@ def qoi_row(point: Point, volume_times: tuple[float, ...]) -> dict[str, Any]:
             data = res.state.data  # stationary from t_final on
         else:
             data = None
+        # the volume of the top layer of a layered model (the upper layer of the paper's)
+        layered = len(systems.get(point.model).layers) > 1
         row[f"V1({t:g})"] = (float(np.sum(data[0]) * c.dx)
-                             if data is not None and point.model == "two_layer" else None)
+                             if data is not None and layered else None)
     return row
 
 
-def converge(case: Case, levels: int, model: str = "two_layer",
+def converge(case: Case, levels: int, model: str = PAPER_MODEL,
              volume_times: tuple[float, ...] = (0.01, 0.1, 0.25, 0.5, 1.0),
              executor: Executor = serial) -> dict[str, Any]:
     """Run ``model`` of ``case`` on ``levels`` halvings of dx; QoIs per level."""
@@ -128,7 +131,7 @@ def fit_row(point: Point) -> dict[str, Any]:
             "points": res["points"], "wall_time_s": time.perf_counter() - t0}
 
 
-def converge_sweep(case: Case, levels: int, model: str = "two_layer",
+def converge_sweep(case: Case, levels: int, model: str = PAPER_MODEL,
                    executor: Executor = serial) -> dict[str, Any]:
     """Refine a sweep case; fitted prefactor and exponent per level."""
     points = [Point(refined(case, level), model) for level in range(levels)]
@@ -186,7 +189,7 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--levels", type=int, default=4, help="number of grids (dx halved)")
     ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                     help="override a case value (repeatable)")
-    ap.add_argument("--model", default="two_layer", choices=["two_layer", "single_layer"])
+    ap.add_argument("--model", default=PAPER_MODEL, choices=list(systems.names()))
     ap.add_argument("--summary", metavar="OUT.json", help="write the results as JSON")
     ap.add_argument("--all", action="store_true",
                     help="print every quantity (default: stop times, run-out, F_extra, "

@@ -8,6 +8,9 @@ from typing import Any
 
 import numpy as np
 
+from .. import systems
+from ..cases import BASELINE_MODEL
+
 
 def ritter(x: np.ndarray, t: float, h0: float, x0: float = 0.0,
            g: float = 9.81) -> tuple[np.ndarray, np.ndarray]:
@@ -135,19 +138,21 @@ class ExactSolution:
         return h.mean(axis=1), (h * u).mean(axis=1)
 
 
-def exact_solution_for(case: Any, model: str = "single_layer") -> ExactSolution | None:
+def exact_solution_for(case: Any, model: str = BASELINE_MODEL) -> ExactSolution | None:
     """The exact solution of a case, or None if it has none.
 
-    Single-layer dam breaks (``initial.shape = "dam_break"``): onto a dry bed with
-    phi_B <= theta, Mangeney's solution (Ritter's for theta = phi_B = 0); onto a wet bed
-    (``h_right > 0``) on a flat frictionless bed, Stoker's. Valid while the waves stay
-    inside the domain.
+    Dam breaks (``initial.shape = "dam_break"``) of a one-layer Saint-Venant model with
+    Coulomb friction (``basal_friction_deg`` of its parameters; 0: frictionless):
+    onto a dry bed with phi_B <= theta, Mangeney's solution (Ritter's for
+    theta = phi_B = 0); onto a wet bed (``h_right > 0``) on a flat frictionless bed,
+    Stoker's. Valid while the waves stay inside the domain.
     """
     ini = case.initial
-    if model != "single_layer" or ini.get("shape") != "dam_break":
+    if len(systems.get(model).layers) != 1 or ini.get("shape") != "dam_break":
         return None
-    p = case.make_pde("single_layer").parameters
-    delta = p.phi_b_deg if p.phi_b_deg > FRICTIONLESS_DEG else 0.0
+    p = case.make_pde(model).parameters
+    phi_b = p.basal_friction_deg
+    delta = phi_b if phi_b > FRICTIONLESS_DEG else 0.0
     h_right = float(ini.get("h_right", 0.0))
     x0 = case.x_start + float(ini["x_dam"])
     if h_right > 0:

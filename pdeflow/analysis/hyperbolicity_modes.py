@@ -7,7 +7,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from ..cases import Case
+from ..cases import PAPER_MODEL, Case
 from ..simulate import Run
 from ..variant import Variant
 from .study import case_on_grid, resolve_case
@@ -30,7 +30,7 @@ def hyperbolicity_study(case_path: str | Path | Case,
     for gr in list(grids or [base.dx]):
         for mode in modes:
             c = case_on_grid(base, gr, Variant(hyperbolicity=mode))
-            run = Run(c, "two_layer")
+            run = Run(c, PAPER_MODEL)
             run.execute()  # warm-up (compiles once per process)
             walls, s = [], {}
             for _ in range(max(1, repeats)):

@@ -25,7 +25,6 @@ from typing import Any
 import numpy as np
 
 from ..numerics import hyperbolicity as hyp
-from ..numerics import layout as L
 from ..variant import Variant
 
 G = 9.81  #: gravity of all problems [m/s^2]
@@ -118,7 +117,6 @@ def reference_speed(problem: Problem) -> float:
     (fv-split, hyperbolicity 'exact', CFL 0.3); stored in ``problem.s_ref``."""
     from pde.trackers.base import FinishedSimulation
 
-    from ..numerics.vectorized import advection_rate
     from ..solvers.fv_split import FVSplitSolver
 
     eq, state = problem.make(REFERENCE)
@@ -126,8 +124,8 @@ def reference_speed(problem: Problem) -> float:
     stepper = FVSplitSolver(eq, cfl=0.3, max_steps=1).make_stepper(state)
     t, smax = 0.0, 0.0
     while t < problem.t_end:
-        smax = max(smax, advection_rate(state.data, problem.dx, eq.bc_codes, P[L.G_Z],
-                                        P[L.DRY], P[L.R])[1])
+        smax = max(smax, eq.kernels.numpy_advection(state.data, problem.dx, eq.bc_codes,
+                                                    P)[1])
         try:
             t = stepper(state, t, problem.t_end)
         except FinishedSimulation:

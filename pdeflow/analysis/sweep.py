@@ -22,11 +22,11 @@ from typing import Any
 
 import numpy as np
 
-from ..cases import Case, CaseError, load_case
+from .. import systems
+from ..cases import PAPER_MODEL, Case, CaseError, load_case
 from ..simulate import load_case_kernels
 from .study import Executor, Point, Study, serial, with_sets
 
-PAPER_FITS = {"single_layer": (2.25, 1.06), "two_layer": (1.61, 0.84)}
 DEM_EXPONENT = 0.83
 
 PUBLISHED_LAWS = {"Lube et al. 2005": (1.8, 2.8), "Lajeunesse et al. 2005": (2.3, 2.3)}
@@ -115,8 +115,8 @@ def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
             "runs": rows,
             "prefactor": p,
             "exponent": e,
-            "paper_prefactor": PAPER_FITS[model][0],
-            "paper_exponent": PAPER_FITS[model][1],
+            "paper_prefactor": (systems.get(model).paper_runout_law or (None, None))[0],
+            "paper_exponent": (systems.get(model).paper_runout_law or (None, None))[1],
             "all_at_rest": all(row["at_rest"] for row in rows),
         }
     out["wall_time_s"] = time.perf_counter() - wall0
@@ -130,12 +130,16 @@ def sweep_figure(summary: dict[str, Any], path: str | Path) -> Path:
     from ..plotting import ASPECT_TICKS, log_ticks, save
 
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
-    styles = {"single_layer": ("k", "o", "single layer"),
-              "two_layer": ("tab:orange", "s", "two layers")}
+    from ..plotting import LAYER_STYLES
+
+    markers = ("s", "o", "^", "v", "D")  # by registration: two layers, single layer, ...
     amin, amax = np.inf, 0.0
     rs: list[float] = []
     for model, res in summary["models"].items():
-        color, marker, label = styles[model]
+        system = systems.get(model)
+        color = LAYER_STYLES[system.layers[0].style][2]
+        marker = markers[systems.names().index(model) % len(markers)]
+        label = system.label
         pts = np.array([p for p in res["points"] if p[1]], dtype=float)
         if pts.size == 0:
             continue
@@ -147,10 +151,11 @@ def sweep_figure(summary: dict[str, Any], path: str | Path) -> Path:
             ax.loglog(aa, res["prefactor"] * aa ** res["exponent"], "-", color=color,
                       lw=1, label=f"fit {res['prefactor']:.2f} a^{res['exponent']:.2f}")
         p, e = res["paper_prefactor"], res["paper_exponent"]
-        ax.loglog(aa, p * aa**e, ":", color=color, lw=1, label=f"paper {p} a^{e}")
+        if p is not None:
+            ax.loglog(aa, p * aa**e, ":", color=color, lw=1, label=f"paper {p} a^{e}")
     if amax > 0:
         aa = np.geomspace(amin, amax, 50)
-        two = summary["models"].get("two_layer", {})
+        two = summary["models"].get(PAPER_MODEL, {})
         anchor = (two.get("prefactor") or 1.0) * amin ** (two.get("exponent") or DEM_EXPONENT)
         ax.loglog(aa, anchor * (aa / amin) ** DEM_EXPONENT, "--", color="gray", lw=1,
                   label=f"DEM slope a^{DEM_EXPONENT} (Lacaze et al.)")

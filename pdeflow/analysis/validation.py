@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from pde import CartesianGrid
 
-from ..cases import Case, CaseError
+from ..cases import BASELINE_MODEL, Case, CaseError
 from ..checks import RunWarning
 from ..models import SingleLayerGranular, TwoLayerGranular
 from ..variant import Variant
@@ -74,7 +74,7 @@ def exact_study(case: Case, levels: list[int], label: str | None = None,
                         "frictionless bed)")
     base = case.copy()
     base.data.setdefault("output", {})["snapshot_times"] = []
-    points = [Point(on_grid(base, cells=n), "single_layer", v,
+    points = [Point(on_grid(base, cells=n), BASELINE_MODEL, v,
                     {"variant": v.name, "cells": n}) for v in variants for n in levels]
     runs = Study(points, final_state).execute()
     t = case.t_end

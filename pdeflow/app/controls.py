@@ -18,9 +18,9 @@ from typing import Any, ClassVar
 
 import panel as pn
 
+from .. import systems
 from ..analysis.workprecision import DEFAULT_VARIANTS
 from ..cases import Case, CaseError, load_case
-from ..models import SingleLayerParameters, TwoLayerParameters
 from ..variant import Variant
 
 CLOSURES = ("paper", "relaxed")
@@ -126,8 +126,8 @@ def case_value(case: Case, key: str) -> Any:
     section, name = key.split(".", 1)
     if section == "initial":
         return case.initial.get(name)
-    if section in ("two_layer", "single_layer"):
-        cls = TwoLayerParameters if section == "two_layer" else SingleLayerParameters
+    if section in systems.names():
+        cls = systems.get(section).parameters_class
         return getattr(cls.from_dict(case.data.get(section, {})), name)
     return case.data.get(section, {}).get(name)
 

@@ -25,7 +25,8 @@ import param
 from bokeh.models import ColumnDataSource, Div, Range1d, Span
 from bokeh.plotting import figure
 
-from ..cases import Case, CaseError
+from .. import systems
+from ..cases import BASELINE_MODEL, PAPER_MODEL, Case, CaseError
 from ..numerics.state import velocity_profile
 from ..plotting import DRY
 from ..simulate import RunResult, print_summary, run_model
@@ -40,7 +41,7 @@ COLOURS = {"upper": "#ff7f0e", "lower": "#8c564b", "single": "black", "fextra": 
 SEND_MS = 40
 """Time given to the server to send a new picture before it records the frames [ms]
 (the frames' run would otherwise hold the message back until it is done)."""
-LABELS = {"two_layer": "two layers", "single_layer": "single layer"}
+LABELS = {m: systems.get(m).label for m in (PAPER_MODEL, BASELINE_MODEL)}
 """The models as the pages name them."""
 
 
@@ -126,7 +127,7 @@ def _set_frames(run: DamBreakRun,
         t = np.array([f[0] for f in items])
         idx = np.clip(np.searchsorted(t, run.times + 1e-9, side="right") - 1, 0, None)
         run.states[m] = np.array([items[i][1] for i in idx])
-        if m == "two_layer":
+        if m == PAPER_MODEL:
             run.fextra = np.array([items[i][2] for i in idx])
 
 
@@ -194,9 +195,9 @@ class DamBreakPage:
             f.legend.click_policy = "hide"
         self.fronts = {m: Span(location=0, dimension="height", line_dash="dotted",
                                line_width=2, visible=False,
-                               line_color=COLOURS["upper" if m == "two_layer"
+                               line_color=COLOURS["upper" if m == PAPER_MODEL
                                                   else "single"])
-                       for m in ("two_layer", "single_layer")}
+                       for m in (PAPER_MODEL, BASELINE_MODEL)}
         for s in self.fronts.values():
             fh.add_layout(s)
         for f, name in ((fh, "depths"), (fu, "velocities"), (ff, "fextra")):
@@ -278,7 +279,7 @@ class DamBreakPage:
         i = int(min(max(i, 0), len(run.times) - 1))
         x = run.x
         nan = np.full(x.size, np.nan)
-        two = run.states.get("two_layer")
+        two = run.states.get(PAPER_MODEL)
         if two is not None:
             h1, m1, h2, m2 = two[i]
             self.src_two.data = {"x": x, "zero": np.zeros_like(x), "h2": h2,
@@ -287,7 +288,7 @@ class DamBreakPage:
         else:
             self.src_two.data = {"x": x, "zero": nan, "h2": nan, "top": nan, "u1": nan,
                                  "u2": nan, "f": nan}
-        one = run.states.get("single_layer")
+        one = run.states.get(BASELINE_MODEL)
         if one is not None:
             h, m = one[i]
             self.src_one.data = {"x": x, "h": np.where(h > DRY, h, np.nan),

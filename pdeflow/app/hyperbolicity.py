@@ -27,6 +27,7 @@ from bokeh.models import (
 from bokeh.palettes import Reds256
 from bokeh.plotting import figure
 
+from ..cases import PAPER_MODEL
 from ..numerics import hyperbolicity as hyp
 from ..numerics.hyperbolicity import (
     discriminant,
@@ -88,8 +89,8 @@ def format_eigenvalue(z: complex) -> str:
 
 def cell_state(run: DamBreakRun, frame: int, cell: int) -> dict[str, float]:
     """h1, h2 [m], u1, u2, du [m/s], F_extra/rho1 [m^2/s^2], r and g_z of a run's cell."""
-    h1, m1, h2, m2 = run.states["two_layer"][frame][:, cell]
-    p = run.case.make_pde("two_layer").parameters
+    h1, m1, h2, m2 = run.states[PAPER_MODEL][frame][:, cell]
+    p = run.case.make_pde(PAPER_MODEL).parameters
     u1 = velocity_profile(h1, m1, p.dry_tolerance)
     u2 = velocity_profile(h2, m2, p.dry_tolerance)
     return {"h1": float(h1), "h2": float(h2), "u1": float(u1), "u2": float(u2),
@@ -270,7 +271,7 @@ class HyperbolicityPage:
             f"u2 = {s['u2']:.4g} m/s, du = {s['du']:.4g} m/s, "
             f"<b>F_extra/ρ1 = {s['fextra']:.4g} m²/s²</b> (r = {s['r']:.3g}).</p>"
             f"<p>The largest F_extra/ρ1 over every step of the summary's run: "
-            f"{run.results['two_layer'].summary['max_fextra_over_rho1']:.4g} m²/s² (the "
+            f"{run.results[PAPER_MODEL].summary['max_fextra_over_rho1']:.4g} m²/s² (the "
             f"frames come from the animation's run, which stops at every frame).</p>"
             + ("" if s["h1"] > DRY and s["h2"] > DRY else
                "<p>a layer is dry here: nothing to analyse</p>"))

@@ -13,11 +13,13 @@ import threading
 import time
 from collections.abc import Callable
 
+from ..cases import BASELINE_MODEL, PAPER_MODEL
+
 #: a case that touches every kernel the pages use: both models, the fv-split stepping
 #: loop with its trackers' interrupts, on a grid small enough to run in milliseconds
 WARMUP_CASE = {
     "case": {"name": "kernel warm-up", "t_end": 0.05,
-             "models": ["two_layer", "single_layer"]},
+             "models": [PAPER_MODEL, BASELINE_MODEL]},
     "grid": {"length": 1.0, "cells": 20},
     "initial": {"shape": "column", "L0": 0.5, "H0": 0.5},
     "output": {"snapshot_times": [0.02]},

@@ -20,21 +20,23 @@ import panel as pn
 from bokeh.models import ColumnDataSource, Legend, Range1d, Span
 from bokeh.plotting import figure
 
+from .. import systems
 from ..analysis.sweep import (
-    PAPER_FITS,
     PUBLISHED_EXPONENTS,
     PUBLISHED_LAWS,
     fit_power_law,
     published_law,
     run_sweep,
 )
-from ..cases import CaseError
+from ..cases import BASELINE_MODEL, PAPER_MODEL, CaseError
 from ..solvers.fv_split import SimulationBlowUp
 from .controls import KNOBS, ParameterControls, Slider, is_column, list_cases, served
 from .dam_break import COLOURS, LABELS
 
-MODEL_STYLE = {"two_layer": (COLOURS["upper"], "square", LABELS["two_layer"]),
-               "single_layer": (COLOURS["single"], "circle", LABELS["single_layer"])}
+MODEL_STYLE = {PAPER_MODEL: (COLOURS["upper"], "square", LABELS[PAPER_MODEL]),
+               BASELINE_MODEL: (COLOURS["single"], "circle", LABELS[BASELINE_MODEL])}
+PAPER_FITS = {m: systems.get(m).paper_runout_law for m in MODEL_STYLE}
+"""the paper's fits of test 5.2, (prefactor, exponent) per model"""
 A_RANGE = (1.0, 35.0)
 """a axis of the figure"""
 
@@ -163,7 +165,7 @@ class RunoutPage:
             law = f.line(aa, published_law(name, aa), color=colour, line_dash="dashed",
                          line_width=2)
             items.append((f"{name} (experiments)", [law]))
-        p2, e2 = PAPER_FITS["two_layer"]
+        p2, e2 = PAPER_FITS[PAPER_MODEL]
         for (name, (e, _)), colour in zip(PUBLISHED_EXPONENTS.items(),
                                           ("#bcbd22", "#9467bd", "#2ca02c"), strict=True):
             # an exponent alone has no prefactor: drawn through the paper's two-layer

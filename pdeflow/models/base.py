@@ -23,9 +23,10 @@ from pde import CartesianGrid, FieldCollection, ScalarField
 from pde.pdes.base import PDEBase
 
 from ..numerics import layout as L
+from ..numerics.geometry import Metric, metric_of
 from ..numerics.state import DRY_TOLERANCE
 
-BC_NAMES = {"wall": L.BC_WALL, "open": L.BC_OPEN}
+BC_NAMES = L.BOUNDARIES
 RECONSTRUCTIONS = {"first-order": 1, "muscl": 2}
 
 
@@ -65,6 +66,13 @@ def _named_progress(tracker: Any, t_range: Any) -> Any:
     t0, t1 = (0.0, t_range) if np.isscalar(t_range) else t_range
     bar = ProgressBar((float(t1) - float(t0)) / 100)
     return [bar if t == "progress" else t for t in names]
+
+
+def stop_time(last_moving: float, t_final: float, at_rest: bool) -> float | None:
+    """Stop time [s] from the last time a layer moved: None if still moving at the end."""
+    if last_moving >= t_final and not at_rest:
+        return None
+    return float(last_moving)
 
 
 class ParametersBase:
@@ -127,18 +135,34 @@ class SharedParameters(ParametersBase):
     def validate_model(self) -> None:  # pragma: no cover - overridden
         """Check the model's own parameters (see :meth:`validate`)."""
 
+    @property
+    def basal_friction_deg(self) -> float:
+        """The Coulomb friction angle of the bed [deg] (its ``phi_b_deg``; 0 for a model
+        without basal friction)."""
+        return float(getattr(self, "phi_b_deg", 0.0))
+
 
 class GranularPDE(PDEBase):
-    """Base of :class:`TwoLayerGranular` and :class:`SingleLayerGranular`."""
+    """Base of the models' PDE classes (:class:`TwoLayerGranular`,
+    :class:`SingleLayerGranular`, ...): everything model-specific comes from the class's
+    :attr:`system` (its :class:`~pdeflow.systems.EquationSystem`)."""
 
     explicit_time_dependence = False
     check_implementation = False
-    #: names of the fields of the state, in order
-    field_names: tuple[str, ...] = ()
-    two_layer: bool = False
-
+    #: the model's equation system (set by each model's class)
+    system: Any = None
     #: the parameter dataclass of the model
     parameters_class: type[SharedParameters] = SharedParameters
+
+    @property
+    def field_names(self) -> tuple[str, ...]:
+        """Names of the fields of the state, in order."""
+        return self.system.field_names
+
+    @property
+    def kernels(self) -> Any:
+        """The model's :class:`~pdeflow.numerics.model_kernels.ModelKernels`."""
+        return self.system.kernels
 
     def __init__(self, parameters: SharedParameters | dict | None = None, *,
                  bc: Sequence[str] = ("wall", "open"), flux: str = "hll",
@@ -212,42 +236,47 @@ class GranularPDE(PDEBase):
     # --- states ---------------------------------------------------------------------------
     @staticmethod
     def check_grid(grid: Any) -> float:
-        """Return dx [m] of a uniform non-periodic 1D Cartesian grid, else raise."""
-        if not isinstance(grid, CartesianGrid) or grid.num_axes != 1:
-            raise ValueError(f"grid must be a 1D CartesianGrid, got {grid!r}")
-        if grid.periodic[0]:
-            raise ValueError("grid must not be periodic: use wall or open boundaries")
-        return float(grid.discretization[0])
+        """Return dx [m] of a uniform non-periodic 1D grid (a ``CartesianGrid``, or a
+        ``PolarSymGrid`` from the axis), else raise."""
+        return metric_of(grid).dx
+
+    def metric(self, grid: Any) -> Metric:
+        """The finite-volume metric of ``grid`` (:func:`~pdeflow.numerics.geometry.metric_of`);
+        on an axisymmetric grid the left boundary is the axis and must be 'wall'."""
+        metric = metric_of(grid)
+        if metric.geometry == "axisymmetric" and self.bc[0] != "wall":
+            raise ValueError(f"on an axisymmetric grid the left boundary is the axis: "
+                             f"bc[0] must be 'wall', got {self.bc[0]!r}")
+        return metric
 
     def make_state(self, grid: CartesianGrid, **profiles: np.ndarray) -> FieldCollection:
-        """State from depth and velocity profiles (names: h1, u1, h2, u2 or h, u)."""
+        """State from depth and velocity profiles (names: the system's
+        :attr:`~pdeflow.systems.EquationSystem.profile_names`, e.g. h1, u1, h2, u2)."""
         self.check_grid(grid)
         n = grid.shape[0]
-        known = [f"{p}{name[1:]}" for name in self.field_names[::2] for p in "hu"]
+        known = list(self.system.profile_names)
         unknown = sorted(set(profiles) - set(known))
         if unknown:
             raise ValueError(f"unknown profile(s) {unknown} for {self.__class__.__name__}; "
                              f"allowed: {known}")
         fields = []
-        for k in range(0, len(self.field_names), 2):
-            hname = self.field_names[k]
-            uname = "u" + hname[1:]
-            h = np.asarray(profiles.get(hname, np.zeros(n)), dtype=float)
-            u = np.asarray(profiles.get(uname, np.zeros(n)), dtype=float)
-            for name, arr in ((hname, h), (uname, u)):
+        for layer in self.system.layers:
+            h = np.asarray(profiles.get(layer.depth, np.zeros(n)), dtype=float)
+            u = np.asarray(profiles.get(layer.velocity, np.zeros(n)), dtype=float)
+            for name, arr in ((layer.depth, h), (layer.velocity, u)):
                 if arr.shape != (n,):
                     raise ValueError(f"{name} must have shape ({n},), got {arr.shape}")
                 if not np.all(np.isfinite(arr)):
                     raise ValueError(f"{name} must be finite (no NaN or inf)")
             if np.any(h < 0):
-                raise ValueError(f"{hname} must be >= 0 m, got min {h.min():g}")
-            fields.append(ScalarField(grid, h, label=hname))
-            fields.append(ScalarField(grid, h * u, label=self.field_names[k + 1]))
+                raise ValueError(f"{layer.depth} must be >= 0 m, got min {h.min():g}")
+            fields.append(ScalarField(grid, h, label=layer.depth))
+            fields.append(ScalarField(grid, h * u, label=layer.discharge))
         return FieldCollection(fields)
 
     def check_state(self, state: FieldCollection) -> float:
-        """Validate a state for this model; return dx."""
-        dx = self.check_grid(state.grid)
+        """Validate a state for this model (and its grid, see :meth:`metric`); return dx."""
+        dx = self.metric(state.grid).dx
         if state.data.shape[0] != len(self.field_names):
             raise ValueError(f"state must have {len(self.field_names)} fields "
                              f"{self.field_names}, got {state.data.shape[0]}")
@@ -269,27 +298,24 @@ class GranularPDE(PDEBase):
     # --- rates ----------------------------------------------------------------------------
     def evolution_rate(self, state: FieldCollection, t: float = 0) -> FieldCollection:
         """Method-of-lines rate: HLL flux divergence (29) plus sources (26)-(27)."""
-        from ..numerics.vectorized import advection_rate, source_rate
-
-        self._require_numpy_variant()
+        self._require_numpy_variant(state.grid)
         dx = self.check_grid(state.grid)
         P = self.parameter_array()
         q = state.data
-        rate, _ = advection_rate(q, dx, self.bc_codes, P[L.G_Z], self._dry(P),
-                                 P[L.R] if self.two_layer else None)
-        rate += source_rate(q, P, self.two_layer)
+        rate, _ = self.kernels.numpy_advection(q, dx, self.bc_codes, P)
+        rate += self.kernels.numpy_sources(q, P)
         out = state.copy()
         out.data[...] = rate
         return out
 
-    def _require_numpy_variant(self) -> None:
+    def _require_numpy_variant(self, grid: Any) -> None:
         if self.flux != "hll" or self.reconstruction != "first-order":
             raise NotImplementedError(
                 f"the numpy backend implements hll/first-order only, not {self.variant}; "
                 "use the numba backend")
-
-    def _dry(self, P: np.ndarray) -> float:
-        return float(P[L.DRY] if self.two_layer else P[L.S_DRY])
+        if self.metric(grid).geometry != "planar":
+            raise NotImplementedError("the numpy backend implements the planar geometry "
+                                      "only; use the numba backend")
 
     def make_evolution_rate(self, state: FieldCollection, backend: Any) -> Callable:
         """Compiled method-of-lines rate (numba backend): the advection rate of this
@@ -301,23 +327,21 @@ class GranularPDE(PDEBase):
 
         from ..numerics.advection import rate_kernel
         from ..numerics.compiled import ready
-        from ..numerics.mol import source_rate_single, source_rate_two_layer
 
-        dx = self.check_grid(state.grid)
+        metric = self.metric(state.grid)
+        dx, M = metric.dx, metric.array()
         P = self.parameter_array()
         bcl, bcr = self.bc_codes
-        g = float(P[L.G_Z])
-        r = float(P[L.R]) if self.two_layer else 0.0
-        dry = self._dry(P)
-        advect = ready(rate_kernel(self.two_layer, *self.scheme_codes))
-        sources = ready(source_rate_two_layer if self.two_layer else source_rate_single)
+        g, r, dry = self.kernels.constants(P)
+        advect = ready(rate_kernel(self.kernels, *self.scheme_codes, metric.code))
+        sources = ready(self.kernels.mol_sources)
         shape = (2, *state.data.shape)  # closure arrays are read-only in numba
 
         @njit
         def rate(state_data, t):  # pragma: no cover - compiled
             out = np.empty_like(state_data)
             work = np.empty(shape)
-            advect(state_data, out, work, dx, bcl, bcr, g, r, dry)
+            advect(state_data, out, work, dx, M, bcl, bcr, g, r, dry)
             sources(state_data, out, P)
             return out
 
@@ -330,9 +354,7 @@ class GranularPDE(PDEBase):
 
     def source_kernel(self) -> Callable:
         """The compiled source stage ``(q, dt, t, P, diag) -> None`` of this model."""
-        from ..numerics.source_stage import source_stage_single, source_stage_two_layer
-
-        return source_stage_two_layer if self.two_layer else source_stage_single
+        return self.kernels.source_stage
 
     def make_post_step_hook(self, state: FieldCollection, backend: Any = "numpy"):
         """Post-step hook applying the split source stage with dt = data[0].

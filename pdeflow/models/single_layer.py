@@ -15,11 +15,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from ..numerics import layout as L
-from .base import GranularPDE, SharedParameters, check_range
+from .. import systems
+from ..numerics import layout_single_layer as S
+from ..numerics.bundles import SINGLE_LAYER as KERNELS
+from .base import GranularPDE, SharedParameters, check_range, stop_time
 
 
 @dataclass
@@ -37,15 +40,16 @@ class SingleLayerParameters(SharedParameters):
                     unit="deg")
 
     def to_array(self) -> np.ndarray:
+        """Kernel parameter vector (layout in :mod:`pdeflow.numerics.layout_single_layer`)."""
         th = math.radians(self.theta_deg)
-        P = np.zeros(L.N_SINGLE_LAYER)
-        P[L.S_G_Z] = self.g * math.cos(th)
-        P[L.S_G_X] = self.g * math.sin(th)
-        P[L.S_TAN_B] = math.tan(math.radians(self.phi_b_deg))
-        P[L.S_DRY] = self.dry_tolerance
-        P[L.S_SLOW_U] = self.rest_speed
-        P[L.S_SLOW_H] = self.rest_depth
-        P[L.S_MOL_EPS] = self.mol_eps
+        P = np.zeros(S.SIZE)
+        P[S.G_Z] = self.g * math.cos(th)
+        P[S.G_X] = self.g * math.sin(th)
+        P[S.TAN_B] = math.tan(math.radians(self.phi_b_deg))
+        P[S.DRY] = self.dry_tolerance
+        P[S.SLOW_U] = self.rest_speed
+        P[S.SLOW_H] = self.rest_depth
+        P[S.MOL_EPS] = self.mol_eps
         return P
 
 
@@ -55,6 +59,23 @@ class SingleLayerGranular(GranularPDE):
     State: ``FieldCollection`` of h [m] and hu [m^2/s] on a 1D ``CartesianGrid``.
     """
 
-    field_names = ("h", "hu")
-    two_layer = False
     parameters_class = SingleLayerParameters
+
+
+def summarize(diag, tf: float, at_rest: bool, x: np.ndarray, d: np.ndarray,
+              metric: Any) -> dict:
+    """The single-layer numbers of a run's summary."""
+    return {"stop_time": stop_time(diag.last_move_upper, tf, at_rest),
+            "slow_time": stop_time(diag.last_fast_upper, tf, False),
+            "max_fextra_over_rho1": 0.0}
+
+
+SYSTEM = systems.register(systems.EquationSystem(
+    name="single_layer", label="single layer", adjective="single-layer",
+    layers=(systems.Layer("h", "hu", "u", "single layer", "single"),),
+    parameters_class=SingleLayerParameters, pde_class=SingleLayerGranular,
+    kernels=KERNELS, densities=lambda p: (1.0,), layer_depths=lambda h, x, ini, p: (h,),
+    summarize=summarize, bytes_per_cell=180, paper_runout_law=(2.25, 1.06),
+    quantities=(systems.Quantity("slow_time", "slow", "s"),)))
+"""The single-layer Coulomb baseline as an equation system."""
+SingleLayerGranular.system = SYSTEM

@@ -23,10 +23,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import systems
 from ..numerics import layout as L
-from .base import GranularPDE, SharedParameters, check_range
+from ..numerics import layout_two_layer as T
+from ..numerics.bundles import TWO_LAYER as KERNELS
+from ..numerics.geometry import Metric
+from .base import GranularPDE, SharedParameters, check_range, stop_time
 
-HYPERBOLICITY_MODES = {"none": 0, "exact": 1, "bound": 2}
+HYPERBOLICITY_MODES = L.HYPERBOLICITY_MODES
 
 
 @dataclass
@@ -79,34 +83,34 @@ class TwoLayerParameters(SharedParameters):
         check_range("film_depth", self.film_depth, 0, 1, unit="m")
         check_range("du_reg", self.du_reg, 0, math.inf, unit="m/s")
         check_range("tau_star", self.tau_star, 0, math.inf, low_open=True)
-        if self.exchange_closure not in ("paper", "relaxed", "none"):
-            raise ValueError("exchange_closure must be 'paper', 'relaxed' or 'none', got "
+        if self.exchange_closure not in L.CLOSURES:
+            raise ValueError(f"exchange_closure must be one of {list(L.CLOSURES)}, got "
                              f"{self.exchange_closure!r}")
         if self.hyperbolicity not in HYPERBOLICITY_MODES:
             raise ValueError(f"hyperbolicity must be one of {list(HYPERBOLICITY_MODES)}, "
                              f"got {self.hyperbolicity!r}")
 
     def to_array(self) -> np.ndarray:
-        """Kernel parameter vector (layout in :mod:`pdeflow.numerics.layout`)."""
+        """Kernel parameter vector (layout in :mod:`pdeflow.numerics.layout_two_layer`)."""
         th = math.radians(self.theta_deg)
-        P = np.zeros(L.N_TWO_LAYER)
-        P[L.G_Z] = self.g * math.cos(th)
-        P[L.G_X] = self.g * math.sin(th)
-        P[L.R] = self.density_ratio
-        P[L.TAN_INT] = math.tan(math.radians(self.phi_int_deg))
-        P[L.TAN_B] = math.tan(math.radians(self.phi_b_deg))
-        P[L.K] = self.k
-        P[L.C] = self.c
-        P[L.W] = self.w
-        P[L.DRY] = self.dry_tolerance
-        P[L.FILM] = self.film_depth
-        P[L.DU_REG] = self.du_reg
-        P[L.HYPERBOLICITY] = HYPERBOLICITY_MODES[self.hyperbolicity]
-        P[L.SLOW_U] = self.rest_speed
-        P[L.SLOW_H] = self.rest_depth
-        P[L.MOL_EPS] = self.mol_eps
-        P[L.TAU_STAR] = {"paper": 0.0, "relaxed": self.tau_star,
-                         "none": -1.0}[self.exchange_closure]
+        P = np.zeros(T.SIZE)
+        P[T.G_Z] = self.g * math.cos(th)
+        P[T.G_X] = self.g * math.sin(th)
+        P[T.R] = self.density_ratio
+        P[T.TAN_INT] = math.tan(math.radians(self.phi_int_deg))
+        P[T.TAN_B] = math.tan(math.radians(self.phi_b_deg))
+        P[T.K] = self.k
+        P[T.C] = self.c
+        P[T.W] = self.w
+        P[T.DRY] = self.dry_tolerance
+        P[T.FILM] = self.film_depth
+        P[T.DU_REG] = self.du_reg
+        P[T.HYPERBOLICITY] = L.HYPERBOLICITY_MODES[self.hyperbolicity]
+        P[T.SLOW_U] = self.rest_speed
+        P[T.SLOW_H] = self.rest_depth
+        P[T.MOL_EPS] = self.mol_eps
+        P[T.CLOSURE] = L.CLOSURES[self.exchange_closure]
+        P[T.TAU_STAR] = self.tau_star
         return P
 
 
@@ -118,6 +122,70 @@ class TwoLayerGranular(GranularPDE):
     ``solver="fv-split"`` (the paper's scheme) or any py-pde solver (method of lines).
     """
 
-    field_names = ("h1", "h1u1", "h2", "h2u2")
-    two_layer = True
     parameters_class = TwoLayerParameters
+
+
+def layer_depths(h: np.ndarray, x: np.ndarray, initial: dict,
+                 p: TwoLayerParameters) -> tuple[np.ndarray, np.ndarray]:
+    """(h1, h2) [m] of an initial total depth ``h``: a column's lower layer is the
+    Rankine wedge of angle ``initial.wedge_angle_deg`` (default 45 + phi_int/2 deg, the
+    active failure plane) at its front ``x = L0``; other shapes split ``h`` by
+    ``initial.upper_fraction`` (default 0.5)."""
+    if initial.get("shape") == "column":
+        L0, H0 = float(initial["L0"]), float(initial["H0"])
+        alpha = float(initial.get("wedge_angle_deg", 45.0 + p.phi_int_deg / 2))
+        h2 = np.where(x < L0, np.minimum(H0, (L0 - x) * math.tan(math.radians(alpha))),
+                      0.0)
+        return h - h2, h2
+    f = float(initial.get("upper_fraction", 0.5))
+    return f * h, (1 - f) * h
+
+
+def summarize(diag, tf: float, at_rest: bool, x: np.ndarray, d: np.ndarray,
+              metric: Metric) -> dict:
+    """The two-layer numbers of a run's summary (see :data:`SYSTEM`). The exchanged
+    volumes are booked per cell depth by the source stage: on a planar grid times dx;
+    on other grids they are not known (None)."""
+    planar = metric.geometry == "planar"
+    dx = metric.dx
+    lo = stop_time(diag.last_move_lower, tf, at_rest)
+    up = stop_time(diag.last_move_upper, tf, at_rest)
+    return {
+        "lower_stop_time": lo,
+        "upper_stop_time": up,
+        "stop_time": None if (lo is None or up is None) else max(lo, up),
+        "lower_slow_time": stop_time(diag.last_fast_lower, tf, False),
+        "upper_slow_time": stop_time(diag.last_fast_upper, tf, False),
+        "max_fextra_over_rho1": diag.fextra_max,
+        "max_fextra_x": float(x[diag.fextra_cell]),
+        "max_fextra_time": diag.fextra_time,
+        "hyperbolicity_events": diag.hyperbolicity_events,
+        "hyperbolicity_bisections": diag.hyperbolicity_bisections,
+        "deposited_volume": float(diag.deposited * dx) if planar else None,
+        "eroded_volume": float(diag.eroded * dx) if planar else None,
+        "upper_volume_final": metric.integral(d[0]),
+        "lower_volume_final": metric.integral(d[2]),
+    }
+
+
+Q = systems.Quantity
+SYSTEM = systems.register(systems.EquationSystem(
+    name="two_layer", label="two layers", adjective="two-layer",
+    layers=(systems.Layer("h1", "h1u1", "u1", "upper layer", "upper"),
+            systems.Layer("h2", "h2u2", "u2", "lower layer", "lower")),
+    parameters_class=TwoLayerParameters, pde_class=TwoLayerGranular, kernels=KERNELS,
+    densities=lambda p: (p.density_ratio, 1.0), layer_depths=layer_depths,
+    summarize=summarize, has_fextra=True, bytes_per_cell=320,
+    paper_runout_law=(1.61, 0.84),
+    quantities=(
+        Q("lower_stop_time", "lower stop", "s"), Q("upper_stop_time", "upper stop", "s"),
+        Q("lower_slow_time", "lower slow", "s"), Q("upper_slow_time", "upper slow", "s"),
+        Q("max_fextra_x", "x of max F_extra", "m"),
+        Q("max_fextra_time", "t of max F_extra", "s"),
+        Q("hyperbolicity_events", "restorations", ""),
+        Q("hyperbolicity_bisections", "bisections", ""),
+        Q("deposited_volume", "deposited", "m2"), Q("eroded_volume", "eroded", "m2"),
+        Q("upper_volume_final", "upper volume", "m2"),
+        Q("lower_volume_final", "lower volume", "m2"))))
+"""The two-layer model of the paper as an equation system."""
+TwoLayerGranular.system = SYSTEM

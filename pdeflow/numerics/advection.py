@@ -32,8 +32,8 @@ from typing import Any
 import numpy as np
 
 from . import layout as L
-from .compiled import FIELDS, STATE, WORK, cached, f8, i8, kernel, specialise
-from .pvm import face_single, face_two_layer, fluctuation_kernel
+from .compiled import FIELDS, METRIC, STATE, WORK, cached, f8, i8, kernel, specialise
+from .model_kernels import ModelKernels
 from .state import velocity
 
 
@@ -158,32 +158,52 @@ def cell_jump_two_layer(qm: np.ndarray, qp: np.ndarray, rate: np.ndarray, lo: in
                        + g * 0.5 * (h2l + h2r) * (dh2 + r * dh1)) * inv_dx
 
 
-ADVECT_SIGNATURE = (STATE, FIELDS, WORK, f8, i8, i8, f8, f8, f8, i8, i8)
+ADVECT_SIGNATURE = (STATE, FIELDS, WORK, f8, METRIC, i8, i8, f8, f8, f8, i8, i8)
 
 
 @functools.cache
-def advection_kernel(two_layer: bool, flux: int, order: int, limiter: int) -> Any:
-    """The advection stage of one scheme: ``advect(q, rate, work, dx, bc_left, bc_right,
-    g, r, dry, start, stop) -> (smax, r_lo, r_hi)``.
+def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
+                     geometry: int) -> Any:
+    r"""The advection stage of one model's scheme on one geometry: ``advect(q, rate,
+    work, dx, metric, bc_left, bc_right, g, r, dry, start, stop) -> (smax, r_lo, r_hi)``.
 
     Writes the rate of the state ``q`` (fields x cells) into ``rate`` in the cells it can
     change, ``r_lo..r_hi``: the wet cells within ``start..stop`` (:func:`wet_cells`; all
     others must be dry) widened by one, clipped to the grid; the rest of ``rate`` is left
     as it was. Returns the largest wave speed over the faces visited [m/s] and
     ``r_lo, r_hi`` (``0.0, 1, 0`` if nothing is wet). ``work`` is scratch space of shape
-    (2, fields, cells); ``g`` = g_z [m/s^2], ``r`` = rho1/rho2 (two layers), ``dry`` [m].
-    ``flux`` (layout.FLUX_*), ``order`` (1: first order, 2: MUSCL) and ``limiter``
-    (layout.LIMITER_*) choose the scheme.
-    """
-    fluct = fluctuation_kernel(two_layer, flux)
-    face = face_two_layer if two_layer else face_single
-    fields = 4 if two_layer else 2
-    muscl = order == 2
-    # the MUSCL kernels, only where they are called (see compiled.ready)
-    reconstruct = reconstruct_muscl if muscl else None
-    cell_jump = (cell_jump_two_layer if two_layer else cell_jump_single) if muscl else None
+    (2, fields, cells); ``g``, ``r``, ``dry``: the model's constants
+    (:attr:`ModelKernels.constants`). ``model`` gives the face states, fluctuations and
+    the MUSCL cell jump; ``flux`` (layout.FLUX_*), ``order`` (1: first order, 2: MUSCL)
+    and ``limiter`` (layout.LIMITER_*) choose the scheme.
 
-    def advect(q, rate, work, dx, bc_left, bc_right, g, r, dry, start, stop):
+    ``geometry`` (layout.GEOMETRY_*) and ``metric`` (the rows layout.M_* of
+    :class:`~pdeflow.numerics.geometry.Metric`) weight the faces. Planar: every weight is
+    1/dx (``metric`` is not read). Axisymmetric, with face areas A and cell volumes V,
+
+    .. math:: \frac{dq_i}{dt} = -\frac{A_{i-1/2} D^+_{i-1/2} + A_{i+1/2} D^-_{i+1/2}
+              + \bar A_i \mathcal{A}(q_i^-, q_i^+)}{V_i}
+              - \frac{A_{i+1/2} - A_{i-1/2}}{V_i} \overline{F^{adv}}_i,
+
+    \bar A_i the mean of the cell's face areas and F^adv = (h u, h u^2) of each layer
+    averaged over the cell's two face values: the flux difference
+    A_{i+1/2} F_{i+1/2} - A_{i-1/2} F_{i-1/2} written with the fluctuations, the
+    pressure kept in gradient form g h d(h...)/dr. Mass is conserved exactly (the cell
+    term cancels the area change of the mass fluctuations), and a layer at rest feels
+    the area-weighted mean of its two one-sided slopes (exactly the slope where it is
+    uniform), so that friction holds a cone whose flanks are below the friction angle.
+    """
+    fluct = model.fluctuations(flux)
+    face = model.face
+    fields = model.fields
+    muscl = order == 2
+    axisymmetric = geometry == L.GEOMETRY_AXISYMMETRIC
+    # the MUSCL and axisymmetric kernels, only where they are called (see compiled.ready)
+    reconstruct = reconstruct_muscl if muscl else None
+    cell_jump = model.cell_jump if muscl else None
+    area_change = _area_change if axisymmetric else None
+
+    def advect(q, rate, work, dx, metric, bc_left, bc_right, g, r, dry, start, stop):
         lo, hi = wet_cells(q, dry, start, stop)
         n = q.shape[1]
         if lo > hi:
@@ -199,6 +219,8 @@ def advection_kernel(two_layer: bool, flux: int, order: int, limiter: int) -> An
             qm = q  # first order: both face values are the cell average
             qp = q
         inv_dx = 1.0 / dx
+        w_l = inv_dx  # weights of a face's fluctuations in the cells left and right
+        w_r = inv_dx
         # at the ends of the grid a ghost cell: a wall mirrors the face value next to
         # it, an open end copies it
         s_left = -1.0 if bc_left == L.BC_WALL else 1.0
@@ -208,37 +230,64 @@ def advection_kernel(two_layer: bool, flux: int, order: int, limiter: int) -> An
             # face i - 1/2, between cells i - 1 and i
             dm, dp, s = fluct(face(qp, i - 1, 1.0), face(qm, i, 1.0), g, r, dry)
             smax = max(smax, s)
+            if axisymmetric:
+                w_l = metric[L.M_AREA, i] * metric[L.M_INV_VOLUME, i - 1]
+                w_r = metric[L.M_AREA, i] * metric[L.M_INV_VOLUME, i]
             for k in range(fields):
-                rate[k, i - 1] -= dm[k] * inv_dx
-                rate[k, i] -= dp[k] * inv_dx
+                rate[k, i - 1] -= dm[k] * w_l
+                rate[k, i] -= dp[k] * w_r
         if lo == 0:
             dm, dp, s = fluct(face(qm, 0, s_left), face(qm, 0, 1.0), g, r, dry)
             smax = max(smax, s)
+            if axisymmetric:
+                w_r = metric[L.M_AREA, 0] * metric[L.M_INV_VOLUME, 0]
             for k in range(fields):
-                rate[k, 0] -= dp[k] * inv_dx
+                rate[k, 0] -= dp[k] * w_r
         if hi == n - 1:
             dm, dp, s = fluct(face(qp, n - 1, 1.0), face(qp, n - 1, s_right), g, r, dry)
             smax = max(smax, s)
+            if axisymmetric:
+                w_l = metric[L.M_AREA, n] * metric[L.M_INV_VOLUME, n - 1]
             for k in range(fields):
-                rate[k, n - 1] -= dm[k] * inv_dx
-        if muscl:
+                rate[k, n - 1] -= dm[k] * w_l
+        if muscl and not axisymmetric:
             cell_jump(qm, qp, rate, r_lo, r_hi, inv_dx, g, r, dry)
+        elif muscl:
+            for i in range(r_lo, r_hi + 1):
+                cell_jump(qm, qp, rate, i, i, metric[L.M_MEAN_AREA, i], g, r, dry)
+        if axisymmetric:
+            area_change(qm, qp, rate, r_lo, r_hi, metric, dry)
         return smax, r_lo, r_hi
 
     return specialise(advect, *ADVECT_SIGNATURE)
 
 
-@functools.cache
-def rate_kernel(two_layer: bool, flux: int, order: int, limiter: int) -> Any:
-    """The advection rate of one scheme on the whole grid (method of lines):
-    ``rate(q, out, work, dx, bc_left, bc_right, g, r, dry) -> smax`` writes every cell
-    of ``out``; arguments as :func:`advection_kernel`."""
-    advect = advection_kernel(two_layer, flux, order, limiter)
+@cached
+def _area_change(qm, qp, rate, lo, hi, metric, dry):
+    """Subtract (A_{i+1/2} - A_{i-1/2}) / V_i F^adv_i in the cells lo..hi, F^adv =
+    (h u, h u^2) of each layer averaged over the cell's face values qm, qp."""
+    for i in range(lo, hi + 1):
+        c = metric[L.M_AREA_CHANGE, i]
+        for k in range(0, qm.shape[0], 2):
+            mm = qm[k + 1, i]
+            mp = qp[k + 1, i]
+            um = velocity(qm[k, i], mm, dry)
+            up = velocity(qp[k, i], mp, dry)
+            rate[k, i] -= c * 0.5 * (mm + mp)
+            rate[k + 1, i] -= c * 0.5 * (mm * um + mp * up)
 
-    def advection_rate(q, out, work, dx, bc_left, bc_right, g, r, dry):
+
+@functools.cache
+def rate_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
+                geometry: int) -> Any:
+    """The advection rate of one scheme on the whole grid (method of lines):
+    ``rate(q, out, work, dx, metric, bc_left, bc_right, g, r, dry) -> smax`` writes
+    every cell of ``out``; arguments as :func:`advection_kernel`."""
+    advect = advection_kernel(model, flux, order, limiter, geometry)
+
+    def advection_rate(q, out, work, dx, metric, bc_left, bc_right, g, r, dry):
         out[:, :] = 0.0
-        return advect(q, out, work, dx, bc_left, bc_right, g, r, dry, 0,
+        return advect(q, out, work, dx, metric, bc_left, bc_right, g, r, dry, 0,
                       q.shape[1] - 1)[0]
 
     return specialise(advection_rate, *ADVECT_SIGNATURE[:-2])
-

@@ -59,6 +59,8 @@ WORK = types.Array(f8, 3, "C")
 """scratch array of shape (stages, fields, cells)"""
 VECTOR = types.Array(f8, 1, "C")
 """the diagnostics vector (see :mod:`pdeflow.numerics.layout`)"""
+METRIC = types.Array(f8, 2, "C", readonly=True)
+"""the grid's metric (see :mod:`pdeflow.numerics.geometry`)"""
 PARAMS = types.Array(f8, 1, "C", readonly=True)
 """the parameter vector (see :mod:`pdeflow.numerics.layout`)"""
 

@@ -16,6 +16,8 @@ from __future__ import annotations
 import numpy as np
 
 from . import layout as L
+from . import layout_single_layer as S
+from . import layout_two_layer as T
 from .compiled import PARAMS, STATE, cached, f8, i8, kernel
 from .hyperbolicity import band_lower_edge, is_hyperbolic, lower_bound_fl
 from .sources import _drag_root, coulomb_single, friction_two_layer
@@ -27,9 +29,9 @@ def implicit_friction(b1, b2, h1, h2, dt, P, f, k, c):
     """Implicit stage (32) for one cell with extra exchange ``f`` = F_extra/rho2 and the
     interface law (22) with friction reduction ``k`` and collisional coefficient ``c``
     (the parameters', or those of t1 - M du in a cell that eroded this step)."""
-    r = P[L.R]
-    g = P[L.G_Z]
-    dry = P[L.DRY]
+    r = P[T.R]
+    g = P[T.G_Z]
+    dry = P[T.DRY]
     wet1 = h1 > dry
     wet2 = h2 > dry
     if wet1 and wet2:
@@ -37,17 +39,17 @@ def implicit_friction(b1, b2, h1, h2, dt, P, f, k, c):
         if f != 0.0:
             b1 = b1 - dt * f / m1
             b2 = b2 + dt * f / h2
-        kdt = dt * k * r * g * h1 * P[L.TAN_INT]
-        bdt = dt * g * (r * h1 + h2) * P[L.TAN_B]
+        kdt = dt * k * r * g * h1 * P[T.TAN_INT]
+        bdt = dt * g * (r * h1 + h2) * P[T.TAN_B]
         return friction_two_layer(b1, b2, m1, h2, kdt, dt * c, bdt)
     if wet1:
         # no lower layer: the upper layer rubs on the bed with the interface law (22)
         m1 = r * h1
-        kdt = dt * k * r * g * h1 * P[L.TAN_INT]
+        kdt = dt * k * r * g * h1 * P[T.TAN_INT]
         u1 = _drag_root(m1 * abs(b1) - kdt, m1, dt * c)
         return (u1 if b1 > 0.0 else -u1), 0.0
     if wet2:
-        mu_dt = dt * g * P[L.TAN_B] * (h2 + r * max(h1, 0.0)) / h2
+        mu_dt = dt * g * P[T.TAN_B] * (h2 + r * max(h1, 0.0)) / h2
         return 0.0, coulomb_single(b2, mu_dt)
     return 0.0, 0.0
 
@@ -57,10 +59,10 @@ def bisect_fextra(b1, b2, h1, h2, du0, dt, P, k, c):
     """F_extra/rho2 [m^2/s^2] by bracketing and bisection on the hyperbolicity test:
     the fallback of :func:`restore_hyperbolicity`, stopping when the bracket in du is
     below w."""
-    g = P[L.G_Z]
-    r = P[L.R]
-    mode = int(P[L.HYPERBOLICITY])
-    w = P[L.W]
+    g = P[T.G_Z]
+    r = P[T.R]
+    mode = int(P[T.HYPERBOLICITY])
+    w = P[T.W]
     # Bracket: f_lo leaves du of the original sign and non-hyperbolic; f_hi makes the
     # state hyperbolic or flips the sign of du (du(f) decreases monotonically in f, so
     # the smallest hyperbolic f lies before the sign change).
@@ -113,11 +115,11 @@ def restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P, k, c):
     if none passes (round-off at a branch boundary), bisection decides
     (:func:`bisect_fextra`).
     """
-    g = P[L.G_Z]
-    r = P[L.R]
-    mode = int(P[L.HYPERBOLICITY])
+    g = P[T.G_Z]
+    r = P[T.R]
+    mode = int(P[T.HYPERBOLICITY])
     du0 = u1 - u2
-    if mode == 2:
+    if mode == L.HYPERBOLICITY_BOUND:
         edge = lower_bound_fl(h1, h2, g, r)
     else:
         edge = band_lower_edge(h1, h2, g, r, abs(du0))
@@ -127,9 +129,9 @@ def restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P, k, c):
         m1 = r * h1
         m2 = h2
         mt = m1 + m2
-        kdt = dt * k * r * g * h1 * P[L.TAN_INT]
+        kdt = dt * k * r * g * h1 * P[T.TAN_INT]
         cdt = dt * c
-        bdt = dt * g * (r * h1 + h2) * P[L.TAN_B]
+        bdt = dt * g * (r * h1 + h2) * P[T.TAN_B]
         s_first = 1.0 if u2 >= 0.0 else -1.0
         for branch in range(3):
             if branch == 2:
@@ -143,7 +145,7 @@ def restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P, k, c):
                 continue
             v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, f, k, c)
             # below the edge is hyperbolic down to F_L (the band is one interval)
-            if edge - P[L.W] <= sgn * (v1 - v2) <= edge:
+            if edge - P[T.W] <= sgn * (v1 - v2) <= edge:
                 return f, v1, v2, False
     f = bisect_fextra(b1, b2, h1, h2, du0, dt, P, k, c)
     v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, f, k, c)
@@ -158,15 +160,15 @@ def predictor_two_layer(q: np.ndarray, dt: float, P: np.ndarray, lo: int,
     otherwise the predictor's pressure momentum, which friction balances, moves mass and
     heaps creep. Moving layers are left untouched (friction proper is applied once, in
     the source stage)."""
-    dry = P[L.DRY]
+    dry = P[T.DRY]
     for i in range(lo, hi + 1):
         h1 = max(q[0, i], 0.0)
         h2 = max(q[2, i], 0.0)
         if h1 <= dry and h2 <= dry:
             continue
-        b1 = velocity(h1, q[1, i], dry) + dt * P[L.G_X] if h1 > dry else 0.0
-        b2 = velocity(h2, q[3, i], dry) + dt * P[L.G_X] if h2 > dry else 0.0
-        u1, u2 = implicit_friction(b1, b2, h1, h2, dt, P, 0.0, P[L.K], P[L.C])
+        b1 = velocity(h1, q[1, i], dry) + dt * P[T.G_X] if h1 > dry else 0.0
+        b2 = velocity(h2, q[3, i], dry) + dt * P[T.G_X] if h2 > dry else 0.0
+        u1, u2 = implicit_friction(b1, b2, h1, h2, dt, P, 0.0, P[T.K], P[T.C])
         if u1 == 0.0:
             q[1, i] = 0.0
         if u2 == 0.0:
@@ -176,11 +178,11 @@ def predictor_two_layer(q: np.ndarray, dt: float, P: np.ndarray, lo: int,
 @kernel(STATE, f8, PARAMS, i8, i8)
 def predictor_single(q: np.ndarray, dt: float, P: np.ndarray, lo: int, hi: int) -> None:
     """:func:`predictor_two_layer` for the single layer (Coulomb friction)."""
-    dry = P[L.S_DRY]
+    dry = P[S.DRY]
     for i in range(lo, hi + 1):
         h = max(q[0, i], 0.0)
         if h > dry:
-            u = coulomb_single(q[1, i] / h + dt * P[L.S_G_X],
-                               dt * P[L.S_G_Z] * P[L.S_TAN_B])
+            u = coulomb_single(q[1, i] / h + dt * P[S.G_X],
+                               dt * P[S.G_Z] * P[S.TAN_B])
             if u == 0.0:
                 q[1, i] = 0.0

@@ -43,6 +43,7 @@ import math
 
 import numpy as np
 
+from . import layout as L
 from .compiled import cached
 
 
@@ -123,14 +124,15 @@ def discriminant(h1: float, h2: float, u1: float, u2: float, g: float,
 @cached
 def is_hyperbolic(h1: float, h2: float, u1: float, u2: float, g: float, r: float,
                   mode: int) -> bool:
-    """Hyperbolicity test: mode 1 exact inner roots (paper), mode 2 the bound F_L only.
+    """Hyperbolicity test: ``mode`` layout.HYPERBOLICITY_EXACT: the inner roots (paper);
+    HYPERBOLICITY_BOUND: the bound F_L only.
 
-    Two roots of P are always real, so the discriminant alone decides mode 1: it is
-    negative exactly when one conjugate pair is complex (cheaper than the screens)."""
+    Two roots of P are always real, so the discriminant alone decides the exact mode:
+    it is negative exactly when one conjugate pair is complex (cheaper than the screens)."""
     du = u1 - u2
     if du * du <= (1.0 - r) * g * (h1 + h2):
         return True  # below F_L (1 - sqrt(1 - x) >= x/2 gives F_L^2 >= (1 - r) g H)
-    if mode == 2:
+    if mode == L.HYPERBOLICITY_BOUND:
         # the bound alone is conservative: it also flags the band's top
         return abs(du) <= lower_bound_fl(h1, h2, g, r)
     return discriminant(h1, h2, u1, u2, g, r) >= 0.0

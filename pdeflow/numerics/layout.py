@@ -1,43 +1,21 @@
-"""Index layout of the flat parameter and diagnostics arrays shared by the kernels.
+"""Index layout of the flat arrays the kernels share, and the codes of named choices.
 
 Numba kernels receive the physical and numerical parameters as one float64 array, so
 that a single compiled kernel (cached on disk) serves every parameter set and grid of
-a sweep. The model classes in :mod:`pdeflow.models` fill these arrays; nothing else
-should index them by number.
+a sweep. Each model has its own parameter layout (:mod:`.layout_two_layer`,
+:mod:`.layout_single_layer`); every layout starts with the header below, which the
+model-independent kernels (the stepping loop) read. The model classes in
+:mod:`pdeflow.models` fill these arrays; nothing else indexes them by number.
 
 All stresses and mass fluxes inside the kernels are *kinematic*, i.e. divided by the
 lower-layer density rho2: a momentum exchange F [Pa] appears as F/rho2 [m^2/s^2] and a
 mass flux M [kg m^-2 s^-1] as M/rho2 [m/s]. Only the density ratio r = rho1/rho2 enters.
 """
 
-# --- two-layer parameter vector -------------------------------------------------------
+# --- header of every model's parameter vector -----------------------------------------
 G_Z = 0  #: gravity normal to the bed, g cos(theta) [m/s^2]
 G_X = 1  #: gravity along the bed (down-slope positive), g sin(theta) [m/s^2]
-R = 2  #: density ratio rho1/rho2 [-]
-TAN_INT = 3  #: tan(phi_int), internal friction at the interface [-]
-TAN_B = 4  #: tan(phi_B), basal friction of the lower layer [-]
-K = 5  #: friction reduction k of the upper side of the interface [-]
-C = 6  #: collisional coefficient c of eq. (17) [-]
-W = 7  #: tolerance in du of the hyperbolicity restoration (paper: threshold of (34)) [m/s]
-DRY = 8  #: dry tolerance: a layer thinner than this has zero velocity [m]
-FILM = 9  #: upper-layer films thinner than this are deposited whole [m]
-DU_REG = 10  #: lower bound of |u1 - u2| in the closure denominator (0: paper) [m/s]
-HYPERBOLICITY = 11  #: 0 none, 1 exact inner eigenvalues (paper), 2 bound F_L
-SLOW_U = 12  #: speed below which a layer counts as "practically at rest" [m/s]
-SLOW_H = 13  #: depth above which the practical rest test looks at a cell [m]
-MOL_EPS = 14  #: velocity scale regularising sgn(u) in the method-of-lines rate [m/s]
-TAU_STAR = 15  #: relaxed closure tau = TAU_STAR sqrt(H/g_z); 0: paper's; < 0: no exchange
-N_TWO_LAYER = 16
-
-# --- single-layer parameter vector (first entries coincide with the two-layer one) -----
-S_G_Z = 0
-S_G_X = 1
-S_TAN_B = 2
-S_DRY = 3
-S_SLOW_U = 4
-S_SLOW_H = 5
-S_MOL_EPS = 6
-N_SINGLE_LAYER = 7
+N_HEADER = 2
 
 # --- diagnostics vector (post-step data of the splitting hook) -------------------------
 D_DT = 0  #: time step of the step just taken; 0 => the hook only cleans up [s]
@@ -63,8 +41,9 @@ N_DIAG = 17  #: the per-cell F_extra/rho1 of the last step follows at N_DIAG
 # --- boundary conditions ---------------------------------------------------------------
 BC_WALL = 0
 BC_OPEN = 1
+BOUNDARIES = {"wall": BC_WALL, "open": BC_OPEN}
 
-# --- interface fluxes, reconstructions, limiters, splittings ----------------------------
+# --- interface fluxes, reconstructions, limiters ---------------------------------------
 FLUX_HLL = 0
 FLUX_RUSANOV = 1
 FLUX_IFCP = 2
@@ -72,3 +51,24 @@ FLUXES = {"hll": FLUX_HLL, "rusanov": FLUX_RUSANOV, "ifcp": FLUX_IFCP}
 LIMITER_MINMOD = 0
 LIMITER_MC = 1
 LIMITERS = {"minmod": LIMITER_MINMOD, "mc": LIMITER_MC}
+
+# --- two-layer choices (stored as codes in the two-layer parameter vector) -------------
+CLOSURE_PAPER = 0  #: closure (25) as published
+CLOSURE_RELAXED = 1  #: (25) bounded by the relaxation towards the equilibrium depth
+CLOSURE_NONE = 2  #: no mass exchange (two immiscible layers)
+CLOSURES = {"paper": CLOSURE_PAPER, "relaxed": CLOSURE_RELAXED, "none": CLOSURE_NONE}
+HYPERBOLICITY_NONE = 0  #: no restoration
+HYPERBOLICITY_EXACT = 1  #: the paper's: the smallest F_extra that makes the spectrum real
+HYPERBOLICITY_BOUND = 2  #: F_L, a bound on the exchange that suffices
+HYPERBOLICITY_MODES = {"none": HYPERBOLICITY_NONE, "exact": HYPERBOLICITY_EXACT,
+                       "bound": HYPERBOLICITY_BOUND}
+
+# --- geometry of the grid (pdeflow.numerics.geometry) -----------------------------------
+GEOMETRY_PLANAR = 0  #: a 1D Cartesian grid: the planar slope, per unit width
+GEOMETRY_AXISYMMETRIC = 1  #: py-pde's PolarSymGrid: radial flow on a horizontal plane
+GEOMETRIES = {"planar": GEOMETRY_PLANAR, "axisymmetric": GEOMETRY_AXISYMMETRIC}
+M_AREA = 0  #: metric row: area of face i - 1/2 (1 planar; 2 pi r [m] axisymmetric), n + 1
+M_INV_VOLUME = 1  #: metric row: 1 / volume of cell i, n entries
+M_MEAN_AREA = 2  #: metric row: (A_{i-1/2} + A_{i+1/2}) / (2 V_i) [1/m]
+M_AREA_CHANGE = 3  #: metric row: (A_{i+1/2} - A_{i-1/2}) / V_i [1/m]
+N_METRIC = 4

@@ -25,6 +25,8 @@ import math
 import numpy as np
 
 from . import layout as L
+from . import layout_single_layer as S
+from . import layout_two_layer as T
 from .compiled import FIELDS, PARAMS, STATE, kernel
 from .sources import closure_rate, relaxed_rate
 from .state import velocity
@@ -33,12 +35,13 @@ from .state import velocity
 @kernel(STATE, FIELDS, PARAMS)
 def source_rate_two_layer(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> None:
     """Add the regularised source rate of (26)-(27) to ``rate`` (two layers)."""
-    r = P[L.R]
-    g = P[L.G_Z]
-    gx = P[L.G_X]
-    dry = P[L.DRY]
-    eps = P[L.MOL_EPS]
-    du_reg = max(P[L.DU_REG], eps)
+    r = P[T.R]
+    g = P[T.G_Z]
+    gx = P[T.G_X]
+    dry = P[T.DRY]
+    eps = P[T.MOL_EPS]
+    du_reg = max(P[T.DU_REG], eps)
+    closure = int(P[T.CLOSURE])
     for i in range(q.shape[1]):
         h1 = max(q[0, i], 0.0)
         h2 = max(q[2, i], 0.0)
@@ -50,19 +53,19 @@ def source_rate_two_layer(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> Non
         t1 = 0.0
         if wet1:
             du = u1 - u2
-            m = closure_rate(h1, du, r, g, P[L.TAN_INT], P[L.K], P[L.C], du_reg)
-            if (m > 0.0 and not wet2) or P[L.TAU_STAR] < 0.0:
+            m = closure_rate(h1, du, r, g, P[T.TAN_INT], P[T.K], P[T.C], du_reg)
+            if (m > 0.0 and not wet2) or closure == L.CLOSURE_NONE:
                 m = 0.0
-            elif P[L.TAU_STAR] > 0.0:
-                tau = P[L.TAU_STAR] * math.sqrt((h1 + h2) / g)
-                m = relaxed_rate(m, h1, h2, du, r, g, P[L.TAN_INT], P[L.K], P[L.C], tau)
-            t1 = (P[L.K] * r * g * h1 * P[L.TAN_INT] + P[L.C] * du * du) * du / max(
+            elif closure == L.CLOSURE_RELAXED:
+                tau = P[T.TAU_STAR] * math.sqrt((h1 + h2) / g)
+                m = relaxed_rate(m, h1, h2, du, r, g, P[T.TAN_INT], P[T.K], P[T.C], tau)
+            t1 = (P[T.K] * r * g * h1 * P[T.TAN_INT] + P[T.C] * du * du) * du / max(
                 abs(du), eps)
             rate[0, i] += m / r
             rate[1, i] += gx * h1 + u1 * m / r - t1 / r
         rate[2, i] -= m
         if wet2:
-            bf = g * (r * h1 + h2) * P[L.TAN_B] * u2 / max(abs(u2), eps)
+            bf = g * (r * h1 + h2) * P[T.TAN_B] * u2 / max(abs(u2), eps)
             rate[3, i] += gx * h2 - u1 * m + t1 - bf
         else:
             rate[3, i] -= u1 * m
@@ -73,7 +76,7 @@ def source_rate_single(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> None:
     """Add gravity along the bed and regularised Coulomb friction (single layer)."""
     for i in range(q.shape[1]):
         h = max(q[0, i], 0.0)
-        if h > P[L.S_DRY]:
+        if h > P[S.DRY]:
             u = q[1, i] / h
-            rate[1, i] += P[L.S_G_X] * h - P[L.S_G_Z] * h * P[L.S_TAN_B] * u / max(
-                abs(u), P[L.S_MOL_EPS])
+            rate[1, i] += P[S.G_X] * h - P[S.G_Z] * h * P[S.TAN_B] * u / max(
+                abs(u), P[S.MOL_EPS])

@@ -15,9 +15,9 @@ Layers at rest on both sides of a face (zero momentum) get no mass fluctuation a
 hydrostatic jump split by each side's own depth, whatever the flux (this is what keeps a
 Coulomb heap below its friction angle exactly at rest).
 
-:func:`fluctuation_kernel` builds the fluctuations of one model and one flux (the others
-are not compiled); a face's states come as tuples ``(h, hu)`` or ``(h1, h1u1, h2, h2u2)``,
-see :func:`face_single` and :func:`face_two_layer`.
+:func:`fluctuations_single` and :func:`fluctuations_two_layer` build the fluctuations of
+one model and one flux (the others are not compiled); a face's states come as tuples
+``(h, hu)`` or ``(h1, h1u1, h2, h2u2)``, see :func:`face_single` and :func:`face_two_layer`.
 """
 
 from __future__ import annotations
@@ -123,17 +123,22 @@ def face_two_layer(q, i, sign):
 
 
 @functools.cache
-def fluctuation_kernel(two_layer: bool, flux: int) -> Any:
-    """``fluct(left, right, g, r, dry) -> (D^-, D^+, smax)`` of one model and one flux
-    (layout.FLUX_*): the fluctuations as tuples of the face states' length and the
-    largest wave speed [m/s]; ``g`` = g_z [m/s^2], ``r`` = rho1/rho2 (two layers)."""
-    rusanov = flux == L.FLUX_RUSANOV
-    ifcp = flux == L.FLUX_IFCP
-    if two_layer:
-        return specialise(_two_layer(rusanov, ifcp), types.UniTuple(f8, 4),
-                          types.UniTuple(f8, 4), f8, f8, f8, helper=True)
-    return specialise(_single(rusanov, ifcp), types.UniTuple(f8, 2),
-                      types.UniTuple(f8, 2), f8, f8, f8, helper=True)
+def fluctuations_single(flux: int) -> Any:
+    """``fluct(left, right, g, r, dry) -> (D^-, D^+, smax)`` of the single layer for one
+    flux (layout.FLUX_*): the fluctuations as (h, hu) tuples and the largest wave speed
+    [m/s]; ``g`` = g_z [m/s^2], ``r`` unused."""
+    return specialise(_single(flux == L.FLUX_RUSANOV, flux == L.FLUX_IFCP),
+                      types.UniTuple(f8, 2), types.UniTuple(f8, 2), f8, f8, f8,
+                      helper=True)
+
+
+@functools.cache
+def fluctuations_two_layer(flux: int) -> Any:
+    """:func:`fluctuations_single` of the two-layer system (24): (h1, h1u1, h2, h2u2)
+    tuples; ``r`` = rho1/rho2."""
+    return specialise(_two_layer(flux == L.FLUX_RUSANOV, flux == L.FLUX_IFCP),
+                      types.UniTuple(f8, 4), types.UniTuple(f8, 4), f8, f8, f8,
+                      helper=True)
 
 
 def _single(rusanov: bool, ifcp: bool):

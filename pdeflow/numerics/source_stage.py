@@ -25,6 +25,8 @@ import math
 import numpy as np
 
 from . import layout as L
+from . import layout_single_layer as S
+from . import layout_two_layer as T
 from .compiled import PARAMS, STATE, VECTOR, cached, f8, i8, kernel
 from .friction import implicit_friction, restore_hyperbolicity
 from .hyperbolicity import is_hyperbolic
@@ -49,13 +51,14 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
                       diag: np.ndarray, lo: int, hi: int) -> None:
     """:func:`source_stage_two_layer` on the cells ``lo..hi`` only (the others must be
     dry and at rest, where the stage changes nothing)."""
-    r = P[L.R]
-    g = P[L.G_Z]
-    gx = P[L.G_X]
-    dry = P[L.DRY]
-    slow_u = P[L.SLOW_U]
-    slow_h = P[L.SLOW_H]
-    mode = int(P[L.HYPERBOLICITY])
+    r = P[T.R]
+    g = P[T.G_Z]
+    gx = P[T.G_X]
+    dry = P[T.DRY]
+    slow_u = P[T.SLOW_U]
+    slow_h = P[T.SLOW_H]
+    mode = int(P[T.HYPERBOLICITY])
+    closure = int(P[T.CLOSURE])
     moving1 = False
     moving2 = False
     fast1 = False
@@ -77,16 +80,17 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
         u2 = velocity(h2, m2, dry)
         if dt > 0.0:
             # interface stress of (32): the paper's t1 (22) unless erosion rewrites it
-            k_eff = P[L.K]
-            c_eff = P[L.C]
+            k_eff = P[T.K]
+            c_eff = P[T.C]
             # --- (31) mass exchange; the exchanged mass carries the velocity of the layer
             # it leaves (upwind): u1 when depositing, u2 when eroding ------------------
-            if h1 > 0.0 and P[L.TAU_STAR] >= 0.0:
-                tau = P[L.TAU_STAR] * math.sqrt((h1 + h2) / g) if P[L.TAU_STAR] > 0.0 \
-                    else 0.0
+            if h1 > 0.0 and closure != L.CLOSURE_NONE:
+                # exchange_step takes the relaxation time; 0 selects the paper's closure
+                tau = P[T.TAU_STAR] * math.sqrt((h1 + h2) / g) \
+                    if closure == L.CLOSURE_RELAXED else 0.0
                 du = u1 - u2
-                dh1, full = exchange_step(h1, h2, du, dt, r, g, P[L.TAN_INT], P[L.K],
-                                          P[L.C], P[L.DU_REG], P[L.FILM], tau)
+                dh1, full = exchange_step(h1, h2, du, dt, r, g, P[T.TAN_INT], P[T.K],
+                                          P[T.C], P[T.DU_REG], P[T.FILM], tau)
                 if dh1 != 0.0:
                     mom = h2 * u2 + r * h1 * u1  # rho-weighted momentum / rho2
                     phi = 0.0
@@ -103,8 +107,8 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
                         u2 = (mom - r * h1 * u1) / h2
                         if phi > 0.0:
                             # t1 - M du = phi t2 + (1 - phi) t1 (see the module docstring)
-                            k_eff = P[L.K] + phi * (1.0 - P[L.K])
-                            c_eff = (1.0 - phi) * P[L.C]
+                            k_eff = P[T.K] + phi * (1.0 - P[T.K])
+                            c_eff = (1.0 - phi) * P[T.C]
                     else:
                         u2 = 0.0
                         if h1 > dry:
@@ -119,7 +123,7 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
             b2 = u2 + dt * gx if h2 > dry else 0.0
             v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, 0.0, k_eff, c_eff)
             # --- (33)-(34) hyperbolicity --------------------------------------------------
-            if mode > 0 and h1 > dry and h2 > dry:
+            if mode != L.HYPERBOLICITY_NONE and h1 > dry and h2 > dry:
                 if not is_hyperbolic(h1, h2, v1, v2, g, r, mode):
                     f, v1, v2, bisected = restore_hyperbolicity(b1, b2, h1, h2, v1, v2,
                                                                  dt, P, k_eff, c_eff)
@@ -161,10 +165,10 @@ def source_stage_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
 def sources_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
                    diag: np.ndarray, lo: int, hi: int) -> None:
     """:func:`source_stage_single` on the cells ``lo..hi`` only."""
-    g = P[L.S_G_Z]
-    gx = P[L.S_G_X]
-    dry = P[L.S_DRY]
-    mu_dt = dt * g * P[L.S_TAN_B]
+    g = P[S.G_Z]
+    gx = P[S.G_X]
+    dry = P[S.DRY]
+    mu_dt = dt * g * P[S.TAN_B]
     moving = False
     fast = False
     for i in range(lo, hi + 1):
@@ -179,7 +183,7 @@ def sources_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
         m = h * u if h > dry else 0.0
         if m != 0.0:
             moving = True
-            if h > P[L.S_SLOW_H] and abs(u) >= P[L.S_SLOW_U]:
+            if h > P[S.SLOW_H] and abs(u) >= P[S.SLOW_U]:
                 fast = True
         q[0, i] = h
         q[1, i] = m

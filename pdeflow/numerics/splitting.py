@@ -32,6 +32,7 @@ from . import layout as L
 from .advection import ADVECT_SIGNATURE, advection_kernel, wet_cells
 from .compiled import (
     FIELDS,
+    METRIC,
     PARAMS,
     STATE,
     VECTOR,
@@ -45,8 +46,7 @@ from .compiled import (
     ready,
     specialise,
 )
-from .friction import predictor_single, predictor_two_layer
-from .source_stage import sources_single, sources_two_layer
+from .model_kernels import ModelKernels
 
 STATUS_END = 0  #: reached t_end
 STATUS_REST = 1  #: everything at rest: nothing will change any more
@@ -97,8 +97,8 @@ def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
     source step before it, as a Python closure (compiled inside :func:`stepping_kernel`;
     the blow-up diagnosis runs it in Python with an instrumented ``update``):
 
-    ``advect_step(advect, sources, predictor, q, t, t_end, dx, bc_left, bc_right, P, g,
-    r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, lo, hi, b_lo,
+    ``advect_step(advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
+    P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, lo, hi, b_lo,
     b_hi)`` advances from the wet cells ``lo..hi`` with the model's kernels (see
     :func:`stepping_kernel`); ``b_lo..b_hi`` are the cells the step may change, saved in
     ``backup`` (and, for Strang, the bookkeeping in ``diag_keep``, ``fex_keep``).
@@ -109,11 +109,11 @@ def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
     """
     muscl = order == 2
 
-    def advect_step(advect, sources, predictor, q, t, t_end, dx, bc_left, bc_right, P, g,
-                    r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first,
-                    lo, hi, b_lo, b_hi):
+    def advect_step(advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
+                    P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep,
+                    first, lo, hi, b_lo, b_hi):
         fex = diag[L.N_DIAG:]
-        smax, a_lo, a_hi = advect(q, rate, rec, dx, bc_left, bc_right, g, r, dry, lo, hi)
+        smax, a_lo, a_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry, lo, hi)
         dt = t_end - t
         if strang:
             # the first half source step may accelerate a layer by up to dt/2 |g_x|
@@ -133,7 +133,7 @@ def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
                 sources(q, 0.5 * dt, t, P, diag, h_lo, h_hi)
                 changed = diag[L.D_CHANGED]
                 # (a deposit can lift a cell of sub-dry layers above dry: search wider)
-                smax2, a_lo, a_hi = advect(q, rate, rec, dx, bc_left, bc_right, g, r, dry,
+                smax2, a_lo, a_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry,
                                            b_lo, b_hi)
                 if smax2 * dt <= cfl * dx * (1.0 + 1e-9) or attempt == 39:
                     break
@@ -150,7 +150,7 @@ def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
         mass_rate, ok = update(q, q0, rate, dt, 0.0, a_lo, a_hi)
         if ok:
             predictor(q, dt, P, a_lo, a_hi)
-            _, c_lo, c_hi = advect(q, rate, rec, dx, bc_left, bc_right, g, r, dry, b_lo,
+            _, c_lo, c_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry, b_lo,
                                    b_hi)
             # cells of the first stage that the second does not reach get rate 0
             for i in range(a_lo, a_hi + 1):
@@ -173,9 +173,9 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any) -> Any:
     """The stepping loop as a Python closure (compiled by :func:`stepping_kernel`, which
     documents it); ``advect_step`` is :func:`advect_step_function`."""
 
-    def advance(q, t, t_end, dx, bc_left, bc_right, P, g, r, dry, cfl, diag, rate, backup,
-                diag_backup, work, max_steps, stop_at_rest, advect, sources, predictor,
-                fallback):
+    def advance(q, t, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag, rate,
+                backup, diag_backup, work, max_steps, stop_at_rest, advect, sources,
+                predictor, fallback):
         n = q.shape[1]
         steps = 0
         rec = work[:2]
@@ -211,9 +211,9 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any) -> Any:
                 _copy_range(diag_keep, diag, 0, L.N_DIAG - 1)
                 _copy_range(fex_keep, fex, b_lo, b_hi)
             dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
-                advect, sources, predictor, q, t, t_end, dx, bc_left, bc_right, P, g, r,
-                dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, lo, hi,
-                b_lo, b_hi)
+                advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right, P,
+                g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, lo,
+                hi, b_lo, b_hi)
             if ifcp and not ok:
                 # IFCP is Roe's linearisation for one layer: not positive where cells
                 # move apart fast. Redo the step with HLL, which is, and count it.
@@ -222,9 +222,9 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any) -> Any:
                 _copy_range(fex, fex_keep, b_lo, b_hi)
                 diag[L.D_FLUX_FALLBACKS] += 1.0
                 dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
-                    fallback, sources, predictor, q, t, t_end, dx, bc_left, bc_right, P, g,
-                    r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first,
-                    lo, hi, b_lo, b_hi)
+                    fallback, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
+                    P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep,
+                    first, lo, hi, b_lo, b_hi)
             t_new = t + dt if dt < t_end - t else t_end
             if not ok:
                 _copy_cells(q, backup, b_lo, b_hi)
@@ -273,9 +273,10 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
     :func:`pdeflow.numerics.compiled.ready`): advance ``q`` from ``t`` to ``t_end`` with
     the CFL-limited splitting scheme,
 
-    ``advance(q, t, t_end, dx, bc_left, bc_right, P, g, r, dry, cfl, diag, rate, backup,
-    diag_backup, work, max_steps, stop_at_rest, advect, sources, predictor, fallback) ->
-    (t, steps, status)``.
+    ``advance(q, t, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag, rate,
+    backup, diag_backup, work, max_steps, stop_at_rest, advect, sources, predictor,
+    fallback) -> (t, steps, status)``; ``metric``: the grid's
+    (:class:`~pdeflow.numerics.geometry.Metric`).
 
     ``rate`` and ``backup`` have the shape of ``q``, ``diag_backup`` that of ``diag``;
     ``work`` has shape (3, *q.shape); ``g`` = g_z [m/s^2], ``r`` = rho1/rho2 (0 for one
@@ -295,28 +296,27 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
     undone; ``q`` holds the last good state).
     """
     step = njit(inline="always")(advect_step_function(order, strang))
-    return specialise(stepping_function(ifcp, strang, step), STATE, f8, f8, f8, i8, i8,
-                      PARAMS, f8, f8, f8, f8, VECTOR, FIELDS, FIELDS, VECTOR, WORK, i8, flag,
+    return specialise(stepping_function(ifcp, strang, step), STATE, f8, f8, f8, METRIC, i8,
+                      i8, PARAMS, f8, f8, f8, f8, VECTOR, FIELDS, FIELDS, VECTOR, WORK, i8, flag,
                       ADVECT, SOURCES, PREDICTOR if order == 2 else types.none,
                       ADVECT if ifcp else types.none, pointer=False)
 
 
 class Stepper:
     """The stepping loop of one scheme with its model's kernels:
-    ``stepper(q, t, t_end, dx, bc_left, bc_right, P, cfl, diag, rate, backup, work,
-    max_steps, stop_at_rest) -> (t, steps, status)`` (see :func:`stepping_kernel`).
+    ``stepper(q, t, t_end, dx, metric, bc_left, bc_right, P, cfl, diag, rate, backup,
+    work, max_steps, stop_at_rest) -> (t, steps, status)`` (see :func:`stepping_kernel`).
     Nothing is compiled before the first call (or :meth:`ready`)."""
 
-    def __init__(self, two_layer: bool, flux: int, order: int, limiter: int,
-                 strang: bool):
-        self.two_layer = two_layer
+    def __init__(self, model: ModelKernels, flux: int, order: int, limiter: int,
+                 strang: bool, geometry: int):
+        self.model = model
         self.ifcp = flux == L.FLUX_IFCP
         self.loop = stepping_kernel(order, strang, self.ifcp)
-        self.advect = advection_kernel(two_layer, flux, order, limiter)
-        self.sources = sources_two_layer if two_layer else sources_single
-        self.predictor = ((predictor_two_layer if two_layer else predictor_single)
-                          if order == 2 else None)
-        self.fallback = advection_kernel(two_layer, L.FLUX_HLL, order, limiter) \
+        self.advect = advection_kernel(model, flux, order, limiter, geometry)
+        self.sources = model.sources
+        self.predictor = model.predictor if order == 2 else None
+        self.fallback = advection_kernel(model, L.FLUX_HLL, order, limiter, geometry) \
             if self.ifcp else None
         self.kernels = [k for k in (self.loop, self.advect, self.sources, self.predictor,
                                     self.fallback) if k is not None]
@@ -332,44 +332,38 @@ class Stepper:
                 self.advect, self.sources, self.predictor, self.fallback))
         return self
 
-    def model_constants(self, P: np.ndarray) -> tuple[float, float, float]:
-        """(g_z [m/s^2], rho1/rho2 (0 for one layer), dry tolerance [m]) from ``P``."""
-        if self.two_layer:
-            return float(P[L.G_Z]), float(P[L.R]), float(P[L.DRY])
-        return float(P[L.S_G_Z]), 0.0, float(P[L.S_DRY])
-
-    def __call__(self, q: np.ndarray, t: float, t_end: float, dx: float, bc_left: int,
-                 bc_right: int, P: np.ndarray, cfl: float, diag: np.ndarray,
-                 rate: np.ndarray, backup: np.ndarray, work: np.ndarray, max_steps: int,
+    def __call__(self, q: np.ndarray, t: float, t_end: float, dx: float,
+                 metric: np.ndarray, bc_left: int, bc_right: int, P: np.ndarray,
+                 cfl: float, diag: np.ndarray, rate: np.ndarray, backup: np.ndarray,
+                 work: np.ndarray, max_steps: int,
                  stop_at_rest: bool) -> tuple[float, int, int]:
-        return self.run(self.ready().loop, q, t, t_end, dx, bc_left, bc_right, P, cfl,
-                        diag, rate, backup, work, max_steps, stop_at_rest)
+        return self.run(self.ready().loop, q, t, t_end, dx, metric, bc_left, bc_right, P,
+                        cfl, diag, rate, backup, work, max_steps, stop_at_rest)
 
     def run(self, loop: Any, q: np.ndarray, t: float, t_end: float, dx: float,
-            bc_left: int, bc_right: int, P: np.ndarray, cfl: float, diag: np.ndarray,
-            rate: np.ndarray, backup: np.ndarray, work: np.ndarray, max_steps: int,
-            stop_at_rest: bool) -> tuple[float, int, int]:
+            metric: np.ndarray, bc_left: int, bc_right: int, P: np.ndarray, cfl: float,
+            diag: np.ndarray, rate: np.ndarray, backup: np.ndarray, work: np.ndarray,
+            max_steps: int, stop_at_rest: bool) -> tuple[float, int, int]:
         """``loop`` (the compiled loop, or its Python code) with this scheme's kernels
         on the stepper's arguments."""
-        return loop(q, t, t_end, dx, bc_left, bc_right, P, *self.model_constants(P), cfl,
-                    diag, rate, backup, np.empty_like(diag), work, max_steps,
-                    stop_at_rest, *self.ready().arguments)
+        return loop(q, t, t_end, dx, metric, bc_left, bc_right, P,
+                    *self.model.constants(P), cfl, diag, rate, backup, np.empty_like(diag),
+                    work, max_steps, stop_at_rest, *self.ready().arguments)
 
 
 @functools.cache
-def scheme_stepper(two_layer: bool, flux: int, order: int, limiter: int,
-                   strang: bool) -> Stepper:
-    """The :class:`Stepper` of one scheme (one per process)."""
-    return Stepper(two_layer, flux, order, limiter, strang)
+def scheme_stepper(model: ModelKernels, flux: int, order: int, limiter: int,
+                   strang: bool, geometry: int) -> Stepper:
+    """The :class:`Stepper` of one model's scheme on one geometry (one per process)."""
+    return Stepper(model, flux, order, limiter, strang, geometry)
 
 
-def python_stepping(two_layer: bool, flux: int, order: int, limiter: int, strang: bool,
-                    update: Any) -> Any:
+def python_stepping(model: ModelKernels, flux: int, order: int, limiter: int,
+                    strang: bool, geometry: int, update: Any) -> Any:
     """:func:`scheme_stepper` as plain Python around the compiled advection and source
     kernels, with ``update`` for :func:`update` (the blow-up diagnosis replays a step
     with an update that records what it wrote); called as the stepper."""
-    compiled = scheme_stepper(two_layer, flux, order, limiter, strang).ready()
+    compiled = scheme_stepper(model, flux, order, limiter, strang, geometry).ready()
     loop = stepping_function(compiled.ifcp, strang,
                              advect_step_function(order, strang, update))
     return functools.partial(compiled.run, loop)
-

@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from . import layout as L
+from . import layout_single_layer as S
+from . import layout_two_layer as T
 
 
 def _vel(h: np.ndarray, m: np.ndarray, dry: float) -> np.ndarray:
@@ -130,18 +132,24 @@ def advection_rate(q: np.ndarray, dx: float, bc: tuple[int, int], g: float,
     return -(dplus[:, :-1] + dmin[:, 1:]) / dx, smax
 
 
-def source_rate(q: np.ndarray, P: np.ndarray, two_layer: bool) -> np.ndarray:
-    """Regularised source rate of (26)-(27) (see :mod:`pdeflow.numerics.mol`)."""
+def source_rate_single_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """Gravity along the bed and regularised Coulomb friction of the single layer (the
+    numpy twin of :func:`pdeflow.numerics.mol.source_rate_single`)."""
     rate = np.zeros_like(q)
-    if not two_layer:
-        h = np.maximum(q[0], 0.0)
-        u = _vel(h, q[1], P[L.S_DRY])
-        eps = P[L.S_MOL_EPS]
-        wet = h > P[L.S_DRY]
-        fric = P[L.S_G_Z] * h * P[L.S_TAN_B] * u / np.maximum(np.abs(u), eps)
-        rate[1] = np.where(wet, P[L.S_G_X] * h - fric, 0.0)
-        return rate
-    r, g, gx, dry, eps = P[L.R], P[L.G_Z], P[L.G_X], P[L.DRY], P[L.MOL_EPS]
+    h = np.maximum(q[0], 0.0)
+    u = _vel(h, q[1], P[S.DRY])
+    eps = P[S.MOL_EPS]
+    wet = h > P[S.DRY]
+    fric = P[S.G_Z] * h * P[S.TAN_B] * u / np.maximum(np.abs(u), eps)
+    rate[1] = np.where(wet, P[S.G_X] * h - fric, 0.0)
+    return rate
+
+
+def source_rate_two_layer_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """Regularised source rate of (26)-(27) of the two layers (the numpy twin of
+    :func:`pdeflow.numerics.mol.source_rate_two_layer`)."""
+    rate = np.zeros_like(q)
+    r, g, gx, dry, eps = P[T.R], P[T.G_Z], P[T.G_X], P[T.DRY], P[T.MOL_EPS]
     h1 = np.maximum(q[0], 0.0)
     h2 = np.maximum(q[2], 0.0)
     u1 = _vel(h1, q[1], dry)
@@ -149,23 +157,24 @@ def source_rate(q: np.ndarray, P: np.ndarray, two_layer: bool) -> np.ndarray:
     wet1 = h1 > dry
     wet2 = h2 > dry
     du = u1 - u2
-    num = P[L.C] * du * du - (1.0 - P[L.K]) * r * g * h1 * P[L.TAN_INT]
-    m = num / np.maximum(np.abs(du), max(P[L.DU_REG], eps))
-    if P[L.TAU_STAR] > 0:
+    num = P[T.C] * du * du - (1.0 - P[T.K]) * r * g * h1 * P[T.TAN_INT]
+    m = num / np.maximum(np.abs(du), max(P[T.DU_REG], eps))
+    closure = int(P[T.CLOSURE])
+    if closure == L.CLOSURE_RELAXED:
         # relaxed closure: bounded by the relaxation towards h1_eq on tau
-        tau = P[L.TAU_STAR] * np.sqrt(np.maximum(h1 + h2, 1e-300) / g)
-        denom = (1.0 - P[L.K]) * r * g * P[L.TAN_INT]
-        h1_eq = P[L.C] * du * du / denom if denom > 0 else np.full_like(h1, np.inf)
+        tau = P[T.TAU_STAR] * np.sqrt(np.maximum(h1 + h2, 1e-300) / g)
+        denom = (1.0 - P[T.K]) * r * g * P[T.TAN_INT]
+        h1_eq = P[T.C] * du * du / denom if denom > 0 else np.full_like(h1, np.inf)
         dep = r * (np.minimum(h1_eq, h1) - h1) / tau
         ero = np.maximum(r * (np.minimum(h1_eq, h1 + h2 / r) - h1) / tau, 0.0)
         m = np.where(m < 0, np.maximum(m, dep), np.where(m > 0, np.minimum(m, ero), m))
-    m = np.where(wet1 & ((m <= 0) | wet2) & (P[L.TAU_STAR] >= 0), m, 0.0)
+    m = np.where(wet1 & ((m <= 0) | wet2) & (closure != L.CLOSURE_NONE), m, 0.0)
     sgn_du = du / np.maximum(np.abs(du), eps)
-    t1 = np.where(wet1, (P[L.K] * r * g * h1 * P[L.TAN_INT] + P[L.C] * du * du) * sgn_du,
+    t1 = np.where(wet1, (P[T.K] * r * g * h1 * P[T.TAN_INT] + P[T.C] * du * du) * sgn_du,
                   0.0)
     rate[0] = m / r
     rate[1] = np.where(wet1, gx * h1 + u1 * m / r - t1 / r, 0.0)
     rate[2] = -m
-    bf = g * (r * h1 + h2) * P[L.TAN_B] * u2 / np.maximum(np.abs(u2), eps)
+    bf = g * (r * h1 + h2) * P[T.TAN_B] * u2 / np.maximum(np.abs(u2), eps)
     rate[3] = np.where(wet2, gx * h2 - u1 * m + t1 - bf, -u1 * m)
     return rate

@@ -51,16 +51,18 @@ class _RestProfilerFilter(logging.Filter):
 logging.getLogger("pde.solvers.controller").addFilter(_RestProfilerFilter())
 
 
-def scheme_codes(pde: GranularPDE, splitting: str = "lie") -> tuple[bool, int, int, int,
-                                                                     bool]:
-    """(two_layer, flux, order, limiter, strang): the scheme of ``pde`` with
-    ``splitting``, as :func:`pdeflow.numerics.splitting.scheme_stepper` takes it."""
-    return (bool(pde.two_layer), *pde.scheme_codes, splitting == "strang")
+def scheme_codes(pde: GranularPDE, splitting: str = "lie",
+                 geometry: int = L.GEOMETRY_PLANAR) -> tuple[Any, int, int, int, bool, int]:
+    """(model kernels, flux, order, limiter, strang, geometry): the scheme of ``pde`` with
+    ``splitting`` on a grid of ``geometry`` (layout.GEOMETRY_*), as
+    :func:`pdeflow.numerics.splitting.scheme_stepper` takes it."""
+    return (pde.kernels, *pde.scheme_codes, splitting == "strang", geometry)
 
 
 def load_kernels(log: Any = None, pdes: Sequence[GranularPDE] = (),
                  splitting: str = "lie", parallel: bool = True,
-                 meanwhile: Callable[[], Any] | None = None) -> float:
+                 meanwhile: Callable[[], Any] | None = None,
+                 geometry: int = L.GEOMETRY_PLANAR) -> float:
     """Compile the ``fv-split`` kernels of the models ``pdes`` (their schemes, with
     ``splitting``) or load them from numba's disk cache, now, so that this time is not
     booked on a real run's wall time or progress bar. Only what these schemes call is
@@ -76,8 +78,9 @@ def load_kernels(log: Any = None, pdes: Sequence[GranularPDE] = (),
             part of the kernels, see :func:`pdeflow.numerics.compile_parallel.ready_all`).
         meanwhile: work of the caller's for this process while the helper compiles
             (called once in any case; see ``ready_all``).
+        geometry: the runs' grid geometry (layout.GEOMETRY_*).
     """
-    steppers = [scheme_stepper(*scheme_codes(pde, splitting)) for pde in pdes]
+    steppers = [scheme_stepper(*scheme_codes(pde, splitting, geometry)) for pde in pdes]
     if kernels_ready():
         if meanwhile is not None:
             meanwhile()
@@ -253,6 +256,8 @@ class FVSplitSolver(SolverBase):
         """Return ``stepper(state, t_start, t_end) -> t`` advancing with CFL steps."""
         pde: GranularPDE = self.pde
         dx = pde.check_state(state)
+        metric = pde.metric(state.grid)
+        M = metric.array()
         self._select_backend(state)
         if self.backend_name == "numba":
             # the compiled loop calls the source stage itself: no hook to compile (the
@@ -269,14 +274,14 @@ class FVSplitSolver(SolverBase):
         rate = np.empty_like(state.data)
         backup = np.empty_like(state.data)
         work = np.empty((3, *state.data.shape))
-        scheme = scheme_codes(pde, self.splitting)
+        scheme = scheme_codes(pde, self.splitting, metric.code)
         cfl = self.cfl
         stop = self.stop_at_rest
 
         def run_kernel(kernel: Any, q: np.ndarray, t0: float, t1: float, diag_: np.ndarray,
                        rate_: np.ndarray, backup_: np.ndarray, work_: np.ndarray,
                        max_steps: int):
-            return kernel(q, t0, t1, dx, bcl, bcr, P, cfl, diag_, rate_, backup_, work_,
+            return kernel(q, t0, t1, dx, M, bcl, bcr, P, cfl, diag_, rate_, backup_, work_,
                           max_steps, stop)
 
         if self.backend_name == "numba":
@@ -357,20 +362,15 @@ class FVSplitSolver(SolverBase):
                     diag: np.ndarray):
         """Pure numpy/Python version of the stepping loop (same stages, slow)."""
         from ..numerics.splitting import STATUS_END
-        from ..numerics.vectorized import advection_rate
 
         pde: GranularPDE = self.pde
-        pde._require_numpy_variant()
+        pde._require_numpy_variant(state.grid)
         if self.splitting != "lie":
             raise NotImplementedError("the numpy loop implements Lie splitting only")
-        g = P[L.G_Z]
-        dry = pde._dry(P)
-        r = P[L.R] if pde.two_layer else None
-
         def advance(q: np.ndarray, t: float, t_end: float):
             steps = 0
             while t < t_end and steps < self.max_steps:
-                rate, smax = advection_rate(q, dx, pde.bc_codes, g, dry, r)
+                rate, smax = pde.kernels.numpy_advection(q, dx, pde.bc_codes, P)
                 dt = t_end - t if smax <= 0 else min(t_end - t, self.cfl * dx / smax)
                 new = q + dt * rate
                 if not np.all(np.isfinite(new)) or np.any(new[::2] < -1e-12):

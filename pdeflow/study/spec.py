@@ -43,8 +43,9 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
+from .. import systems
 from ..cases import Case, CaseError, load_case
-from ..simulate import SUMMARY_KEYS
+from ..simulate import summary_keys
 from .expressions import Expression, StudyError
 
 DESIGNS = ("grid", "lhs", "sobol", "optimize")
@@ -175,12 +176,12 @@ class StudySpec:
 
     def models(self) -> list[str]:
         """Models whose summaries a point needs (only those are run)."""
-        return [m for m in SUMMARY_KEYS if any(q.startswith(m + ".")
-                                                for q in self.quantities)]
+        return [m for m in systems.names() if any(q.startswith(m + ".")
+                                                  for q in self.quantities)]
 
     def sweep_models(self) -> list[str]:
-        return [m for m in SUMMARY_KEYS if any(q.startswith(f"sweep.{m}.")
-                                                for q in self.quantities)]
+        return [m for m in systems.names() if any(q.startswith(f"sweep.{m}.")
+                                                  for q in self.quantities)]
 
     def columns(self) -> list[str]:
         """Quantity columns of the results table: measured, derived, objectives."""
@@ -216,17 +217,17 @@ def _check_quantity(q: str, function: str | None) -> None:
         return
     parts = q.split(".")
     if parts[0] == "sweep":
-        if len(parts) == 3 and parts[1] in SUMMARY_KEYS and parts[2] in SWEEP_KEYS:
+        if len(parts) == 3 and parts[1] in systems.names() and parts[2] in SWEEP_KEYS:
             return
         raise StudyError(f"unknown quantity {q!r}: a sweep quantity is "
-                         f"sweep.<{'|'.join(SUMMARY_KEYS)}>.<{'|'.join(SWEEP_KEYS)}>")
-    if len(parts) == 2 and parts[0] in SUMMARY_KEYS:
-        if parts[1] in SUMMARY_KEYS[parts[0]]:
+                         f"sweep.<{'|'.join(systems.names())}>.<{'|'.join(SWEEP_KEYS)}>")
+    if len(parts) == 2 and parts[0] in systems.names():
+        if parts[1] in summary_keys(parts[0]):
             return
         raise StudyError(f"unknown quantity {q!r}: {parts[0]}'s run summary has "
-                         f"{', '.join(SUMMARY_KEYS[parts[0]])}")
+                         f"{', '.join(summary_keys(parts[0]))}")
     raise StudyError(f"unknown quantity {q!r}: use <model>.<summary key> with model "
-                     f"{' or '.join(SUMMARY_KEYS)}, or sweep.<model>.exponent")
+                     f"{' or '.join(systems.names())}, or sweep.<model>.exponent")
 
 
 def load_study(path: str | Path) -> StudySpec:

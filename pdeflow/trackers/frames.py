@@ -28,8 +28,6 @@ from ..numerics import layout as L
 
 FEXTRA_LABEL = "fextra_over_rho1"
 """Label of the F_extra/rho1 field [m^2/s^2] that follows the state in every frame."""
-STATE_LABELS = {"two_layer": ("h1", "h1u1", "h2", "h2u2"), "single_layer": ("h", "hu")}
-"""Labels of the state fields per model (depths in m, discharges in m^2/s)."""
 
 
 def fextra_over_rho1(info: InfoDict | None, n: int) -> np.ndarray:
@@ -42,14 +40,10 @@ def fextra_over_rho1(info: InfoDict | None, n: int) -> np.ndarray:
     return np.zeros(n)
 
 
-def model_of(field_or_rows: Any) -> str:
-    """'two_layer' for 4 state rows, 'single_layer' for 2."""
-    rows = getattr(field_or_rows, "data", field_or_rows).shape[0]
-    if rows == 4:
-        return "two_layer"
-    if rows == 2:
-        return "single_layer"
-    raise ValueError(f"a granular state has 2 or 4 fields, got {rows}")
+def state_labels(field: FieldCollection) -> tuple[str, ...]:
+    """Labels of the fields of a granular state (depths in m, discharges in m^2/s; the
+    model's :attr:`~pdeflow.systems.EquationSystem.field_names`)."""
+    return tuple(f.label for f in field)
 
 
 def final_time(info: InfoDict | None) -> float | None:
@@ -101,12 +95,12 @@ class FextraStorageTracker(StorageTracker):
         self._info = info
         self._field = field
         grid = field.grid
-        labels = (*STATE_LABELS[model_of(field)], FEXTRA_LABEL)
+        labels = (*state_labels(field), FEXTRA_LABEL)
         self._frame = FieldCollection([ScalarField(grid, label=name) for name in labels])
         return super().initialize(field, info)
 
     def _transform(self, field: Any, t: float) -> FieldCollection:
-        """The frame: the state's fields (labelled as :data:`STATE_LABELS`), then
+        """The frame: the state's fields (labelled as :func:`state_labels`), then
         F_extra/rho1 of the last step. One collection is refilled for every frame (the
         storage copies its data when appending): building one per frame would cost
         more than the run between two frames of the app's animation."""
@@ -128,5 +122,5 @@ class FextraStorageTracker(StorageTracker):
                 for t, d in zip(self.storage.times, self.storage.data, strict=True)}
 
 
-__all__ = ["FEXTRA_LABEL", "STATE_LABELS", "FextraStorageTracker", "fextra_over_rho1",
-           "final_time", "model_of", "show_final_state"]
+__all__ = ["FEXTRA_LABEL", "FextraStorageTracker", "fextra_over_rho1", "final_time",
+           "show_final_state", "state_labels"]

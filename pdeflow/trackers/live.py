@@ -41,7 +41,8 @@ from pde.trackers.base import InfoDict, TrackerBase
 
 from ..io import PendingFile
 from ..plotting import RunFigure, Series
-from .frames import fextra_over_rho1, model_of, show_final_state
+from ..systems import of_fields
+from .frames import fextra_over_rho1, show_final_state, state_labels
 
 #: movie containers written with H.264 through ffmpeg (WebM cannot hold H.264)
 FFMPEG_SUFFIXES = (".mp4", ".m4v", ".mov", ".mkv", ".avi")
@@ -158,13 +159,17 @@ class LayersPlotTracker(TrackerBase):
         dpi: resolution of movie frames and PNG frames.
         depth_max: upper depth limit of the plot [m] (default: from the initial state).
         pause: seconds the window's event loop runs per frame (window display only).
+        model: the registered name of the run's model (default: the first model whose
+            state has the run's field labels, see :func:`pdeflow.systems.of_fields`).
     """
 
     def __init__(self, interrupts: Any = 0.05, *, title: str = "",
                  display: str = "auto", movie: str | Path | None = None,
                  frames: str | Path | None = None, fps: float = 10, dpi: int = 100,
-                 depth_max: float | None = None, pause: float = 1e-3):
+                 depth_max: float | None = None, pause: float = 1e-3,
+                 model: str | None = None):
         super().__init__(interrupts=interrupts)
+        self.model = model
         self.title = title
         self.display = display_mode(display)
         self.movie_path = None if movie is None else Path(movie)
@@ -188,7 +193,8 @@ class LayersPlotTracker(TrackerBase):
     def initialize(self, field: Any, info: InfoDict | None = None) -> float:
         self._info = info
         self._field = field
-        series = [Series(np.asarray(field.grid.axes_coords[0]), model_of(field))]
+        model = self.model or of_fields(state_labels(field)).name
+        series = [Series(np.asarray(field.grid.axes_coords[0]), model)]
         self.figure = RunFigure(series, title=self.title, depth_max=self.depth_max,
                                 pyplot=self.display == "window")
         if self.frames_dir is not None:

@@ -1,0 +1,96 @@
+r"""The finite-volume metric of a grid: face areas and cell volumes.
+
+A cell's average q_i changes by the fluxes through its faces weighted by their areas,
+
+.. math:: V_i \frac{dq_i}{dt} = -(A_{i+1/2} F_{i+1/2} - A_{i-1/2} F_{i-1/2}) + \dots
+
+On the planar slope (a 1D ``CartesianGrid``, per unit width) A = 1 and V = dx, and the
+update is the one of a uniform grid. On py-pde's ``PolarSymGrid`` (radial flow of an
+axisymmetric collapse on [0, R]) A_{i+1/2} = 2 pi r_{i+1/2} and
+V_i = pi (r_{i+1/2}^2 - r_{i-1/2}^2); the axis r = 0 is a face of area 0.
+:class:`Metric` holds these as the array the advection kernels read (rows
+``layout.M_*``); the kernels are specialised to the geometry's code (``layout.GEOMETRY_*``),
+so that the planar update is exactly the uniform-grid one.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from . import layout as L
+
+
+@dataclass(frozen=True, eq=False)
+class Metric:
+    """Face areas and cell volumes of a 1D finite-volume grid (see the module docstring)."""
+
+    geometry: str
+    """'planar' or 'axisymmetric'"""
+    coordinate: str
+    """name of the grid's coordinate: 'x' [m] (planar) or 'r' [m] (axisymmetric)"""
+    dx: float
+    """cell width dx or dr [m]"""
+    faces: np.ndarray
+    """face positions [m], n + 1"""
+    areas: np.ndarray
+    """face areas: 1 (planar, per unit width) or 2 pi r [m], n + 1"""
+    volumes: np.ndarray
+    """cell volumes: dx [m] (planar) or pi (r+^2 - r-^2) [m^2], n"""
+
+    @property
+    def code(self) -> int:
+        """The geometry's code for the kernels (layout.GEOMETRY_*)."""
+        return L.GEOMETRIES[self.geometry]
+
+    def array(self) -> np.ndarray:
+        """The rows layout.M_* as one C-contiguous array of shape (N_METRIC, n + 1)."""
+        n = self.volumes.size
+        out = np.zeros((L.N_METRIC, n + 1))
+        out[L.M_AREA] = self.areas
+        out[L.M_INV_VOLUME, :n] = 1.0 / self.volumes
+        out[L.M_MEAN_AREA, :n] = 0.5 * (self.areas[:-1] + self.areas[1:]) / self.volumes
+        out[L.M_AREA_CHANGE, :n] = (self.areas[1:] - self.areas[:-1]) / self.volumes
+        return out
+
+    @property
+    def cells(self) -> float | np.ndarray:
+        """What :func:`pdeflow.metrics.mass` weights cells with: dx [m] on the planar
+        grid (uniform cells, per unit width), else the cell volumes [m^3]."""
+        return self.dx if self.geometry == "planar" else self.volumes
+
+    def integral(self, values: np.ndarray) -> float:
+        """sum_i V_i values_i: the volume integral of a cell field (planar: per unit width,
+        sum(values) dx, computed so)."""
+        if self.geometry == "planar":
+            return float(np.sum(values) * self.dx)
+        return float(np.sum(values * self.volumes))
+
+
+def metric_of(grid: Any) -> Metric:
+    """The metric of a non-periodic 1D ``CartesianGrid`` or a ``PolarSymGrid`` starting at
+    the axis; ValueError for any other grid."""
+    from pde import CartesianGrid, PolarSymGrid
+
+    if isinstance(grid, PolarSymGrid):
+        r0, r1 = grid.axes_bounds[0]
+        if r0 != 0.0:
+            raise ValueError("an axisymmetric grid must start at the axis: PolarSymGrid "
+                             f"on [0, R], got [{r0:g}, {r1:g}] m")
+        n = grid.shape[0]
+        dr = float(grid.discretization[0])
+        faces = np.linspace(0.0, float(r1), n + 1)
+        return Metric("axisymmetric", "r", dr, faces, 2 * math.pi * faces,
+                      math.pi * (faces[1:] ** 2 - faces[:-1] ** 2))
+    if not isinstance(grid, CartesianGrid) or grid.num_axes != 1:
+        raise ValueError(f"grid must be a 1D CartesianGrid or a PolarSymGrid, got {grid!r}")
+    if grid.periodic[0]:
+        raise ValueError("grid must not be periodic: use wall or open boundaries")
+    n = grid.shape[0]
+    dx = float(grid.discretization[0])
+    x0, x1 = grid.axes_bounds[0]
+    return Metric("planar", "x", dx, np.linspace(x0, x1, n + 1), np.ones(n + 1),
+                  np.full(n, dx))

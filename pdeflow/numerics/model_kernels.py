@@ -1,0 +1,52 @@
+"""What the model-independent numerics need of an equation system: its kernels.
+
+The stepping loop (:mod:`.splitting`), the advection stage and the method-of-lines rate
+(:mod:`.advection`) are written once for every model; a :class:`ModelKernels` hands them
+one model's pieces. An equation system (:mod:`pdeflow.models.system`) owns one; the two
+of the paper's models are in :mod:`.bundles`. Nothing in :mod:`pdeflow.numerics`
+branches on which model it runs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+
+@dataclass(frozen=True, eq=False)
+class ModelKernels:
+    """The kernels of one equation system (compared and hashed by identity, so that the
+    kernel factories cache one build per bundle).
+
+    State ``q[field, cell]`` holds (depth, discharge) pairs of each layer, depths in
+    rows 0, 2, ... [m], discharges in rows 1, 3, ... [m^2/s].
+    """
+
+    fields: int
+    """rows of the state"""
+    face: Any
+    """``face(q, i, sign) -> tuple``: the state of cell (or face value) i, momenta times
+    ``sign`` (-1: a wall's mirror image)"""
+    fluctuations: Callable[[int], Any]
+    """flux code (layout.FLUX_*) -> ``fluct(left, right, g, r, dry) -> (D^-, D^+, smax)``"""
+    cell_jump: Any
+    """MUSCL: ``cell_jump(qm, qp, rate, lo, hi, inv_dx, g, r, dry)`` subtracts the flux
+    difference across the reconstruction inside cells lo..hi"""
+    sources: Any
+    """source stage on cells lo..hi: ``sources(q, dt, t, P, diag, lo, hi)``"""
+    source_stage: Any
+    """the same on every cell, ``(q, dt, t, P, diag)``: the post-step hook's kernel"""
+    predictor: Any
+    """MUSCL's friction predictor ``(q, dt, P, lo, hi)`` (see :mod:`.friction`)"""
+    mol_sources: Any
+    """method of lines: ``mol_sources(q, rate, P)`` adds the regularised source rate"""
+    numpy_advection: Callable[..., tuple[np.ndarray, float]]
+    """numpy twin of the HLL first-order advection: ``(q, dx, bc, P) -> (rate, smax)``"""
+    numpy_sources: Callable[[np.ndarray, np.ndarray], np.ndarray]
+    """numpy twin of ``mol_sources``: ``(q, P) -> rate``"""
+    constants: Callable[[np.ndarray], tuple[float, float, float]]
+    """``P -> (g_z [m/s^2], coupling r [-] (0 without), dry tolerance [m])``: the
+    scalars the advection kernels take"""
