@@ -33,7 +33,8 @@ from typing import Any
 import numpy as np
 
 from ..cases import Case, CaseError, load_case
-from ..simulate import load_case_kernels
+from ..numerics.warmup import prepare
+from ..simulate import case_steppers
 from .study import Executor, Point, Study, refined, serial
 
 QOI_KEYS = ("lower_stop_time", "upper_stop_time", "lower_slow_time", "upper_slow_time",
@@ -203,7 +204,7 @@ def cmd_converge(args: argparse.Namespace) -> int:
                         f"{args.levels}")
     check_output(args.summary, "--summary")
     case = load_case(args.case, args.set)
-    load_case_kernels(case, sys.stderr)
+    prepare(case_steppers(case), log=sys.stderr)
     if case.data.get("sweep"):
         res = converge_sweep(case, args.levels, args.model)
         print(table(res, SWEEP_VIEW))

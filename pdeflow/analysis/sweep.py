@@ -23,7 +23,8 @@ from typing import Any
 import numpy as np
 
 from ..cases import Case, CaseError, load_case
-from ..simulate import load_case_kernels
+from ..numerics.warmup import prepare
+from ..simulate import case_steppers
 from .study import Executor, Point, Study, serial, with_sets
 
 PAPER_FITS = {"single_layer": (2.25, 1.06), "two_layer": (1.61, 0.84)}
@@ -184,7 +185,7 @@ def cmd_sweep(args: Any) -> int:
     io.check_output(args.plot, "--plot")
     case = load_case(args.case, args.set)
     sweep_ratios(case)  # before any run
-    load_case_kernels(case, None if args.quiet else sys.stderr)
+    prepare(case_steppers(case), log=None if args.quiet else sys.stderr)
     summary = run_sweep(case)
     if args.summary:
         io.write_json(args.summary, summary)
