@@ -304,6 +304,36 @@ def test_prepare_binds_a_stepper_and_reports_what_is_left():
     assert fresh(1.5) == 3.0 and len(fresh.signatures) == 1
 
 
+def test_prepare_refuses_what_is_no_kernel_or_stepper():
+    from pdeflow.cases import load_case
+
+    case = load_case(ROOT / "cases" / "ritter_dam_break.toml")
+    with pytest.raises(TypeError, match="case_steppers"):
+        warmup.prepare([case])
+
+
+def test_the_rest_of_the_package_warms_kernels_up_through_prepare_only():
+    """Outside pdeflow/numerics nothing calls the compile machinery behind
+    warmup.prepare: of compile_parallel only the fork helpers the figures use, of
+    compiled only ready (the py-pde solvers' rates and hooks compile on demand)."""
+    import ast
+
+    allowed = {"pdeflow.numerics.compile_parallel": {"can_fork", "fork_context"},
+               "pdeflow.numerics.compiled": {"ready"}}
+    for path in sorted((ROOT / "pdeflow").rglob("*.py")):
+        if path.parent.name == "numerics":
+            continue
+        pkg = path.relative_to(ROOT).with_suffix("").parts[:-1]
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.module:
+                base = list(pkg[:len(pkg) - node.level + 1]) if node.level else []
+                name = ".".join([*base, node.module])
+                names = {a.name for a in node.names}
+                assert names <= allowed.get(name, names), (path.name, name, names)
+                if name == "pdeflow.numerics":  # no way round the names above
+                    assert not names & {"compiled", "compile_parallel"}, path.name
+
+
 def test_garbage_collector_walks_less_while_compiling_and_is_restored():
     """While kernels compile, the objects that existed before are frozen and the first
     collection threshold raised; afterwards (also after a failure) both are as before."""

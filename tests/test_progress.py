@@ -75,7 +75,7 @@ def test_progress_bar_says_it_compiles_and_restarts_its_clock(monkeypatch, capsy
     assert "at rest" in capsys.readouterr().err
 
 
-def test_cli_says_when_it_compiles(monkeypatch):
+def test_prepare_says_when_it_compiles(monkeypatch):
     """``pdeflow run`` compiles (or loads) the kernels before its runs and, when it has
     to compile them, says so with the time it took."""
     log = io.StringIO()

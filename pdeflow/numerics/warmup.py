@@ -121,7 +121,12 @@ def _flatten(work: Any) -> Iterator[Any]:
     if isinstance(work, Dispatcher) or hasattr(work, "kernels") or callable(work):
         yield work
         return
-    for item in work:
+    try:
+        items = iter(work)
+    except TypeError:
+        raise TypeError(f"prepare takes kernels and steppers (e.g. "
+                        f"pdeflow.simulate.case_steppers(case)), got {work!r}") from None
+    for item in items:
         yield from _flatten(item)
 
 
