@@ -184,7 +184,8 @@ class FunctionPointer(CompileResultWAP):
     """A compiled kernel as a first-class function argument, with its address and numba
     type looked up once. (Passed a dispatcher, numba looks up its address on every call
     of the kernel it is passed to; passed numba's own wrapper, it builds the function
-    type again on every call: both cost more than a short stepping call.)"""
+    type again on every call. The stepping loop is called once per tracker interval
+    with four such arguments.)"""
 
     def __init__(self, cres: Any):
         super().__init__(cres)
