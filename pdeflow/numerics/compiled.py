@@ -185,7 +185,7 @@ class FunctionPointer(CompileResultWAP):
     type looked up once. (Passed a dispatcher, numba looks up its address on every call
     of the kernel it is passed to; passed numba's own wrapper, it builds the function
     type again on every call. The stepping loop is called once per tracker interval
-    with four such arguments.)"""
+    with up to four such arguments.)"""
 
     def __init__(self, cres: Any):
         super().__init__(cres)
