@@ -308,8 +308,9 @@ def test_prepare_refuses_what_is_no_kernel_or_stepper():
     from pdeflow.cases import load_case
 
     case = load_case(ROOT / "cases" / "ritter_dam_break.toml")
-    with pytest.raises(TypeError, match="case_steppers"):
-        warmup.prepare([case])
+    for wrong in ([case], "two_layer"):
+        with pytest.raises(TypeError, match="case_steppers"):
+            warmup.prepare(wrong)
 
 
 def test_the_rest_of_the_package_warms_kernels_up_through_prepare_only():

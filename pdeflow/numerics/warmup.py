@@ -122,10 +122,12 @@ def _flatten(work: Any) -> Iterator[Any]:
         yield work
         return
     try:
-        items = iter(work)
+        items = iter(work) if not isinstance(work, (str, bytes)) else None
     except TypeError:
+        items = None
+    if items is None:
         raise TypeError(f"prepare takes kernels and steppers (e.g. "
-                        f"pdeflow.simulate.case_steppers(case)), got {work!r}") from None
+                        f"pdeflow.simulate.case_steppers(case)), got {work!r}")
     for item in items:
         yield from _flatten(item)
 
