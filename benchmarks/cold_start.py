@@ -86,12 +86,22 @@ class _Compiles(event.Listener):
 
 event.register("numba:compile", _Compiles())
 import pdeflow.plotting as _plotting
-import pdeflow.solvers.fv_split as _fv_split
 # compiling on two cores: this process's own compilations, then waiting for the helper
-_fv_split.ready_all = _timed("compile", _fv_split.ready_all)
-for _name, _f in list(vars(_plotting).items()):
-    if inspect.isfunction(_f) and _f.__module__ == _plotting.__name__:
-        setattr(_plotting, _name, _timed("figures", _f))
+try:
+    import pdeflow.numerics.warmup as _warmup
+    _warmup._compile = _timed("compile", _warmup._compile)
+except ImportError:  # a checkout (--tree) from before pdeflow.numerics.warmup
+    import pdeflow.solvers.fv_split as _fv_split
+    _fv_split.ready_all = _timed("compile", _fv_split.ready_all)
+try:
+    import pdeflow.case_figures as _case_figures
+    _figure_modules = [_plotting, _case_figures]
+except ImportError:  # a checkout (--tree) from before pdeflow.case_figures
+    _figure_modules = [_plotting]
+for _module in _figure_modules:
+    for _name, _f in list(vars(_module).items()):
+        if inspect.isfunction(_f) and _f.__module__ == _module.__name__:
+            setattr(_module, _name, _timed("figures", _f))
 import runpy
 sys.argv = ["pdeflow", *sys.argv[1:]]
 try:
@@ -209,7 +219,7 @@ system time of the process and of its helper processes, less sensitive than wall
 to the other jobs on this shared machine. *imports*, *compile*, *figures* and *rest*
 split the same command run through a wrapper that times top-level imports, numba's
 compilations (since *session4* with the wait for the helper process that compiles part
-of the kernels on the second core, `pdeflow.numerics.compile_parallel.ready_all`) and
+of the kernels on the second core, `pdeflow.numerics.warmup.prepare`) and
 `pdeflow.plotting` (since *session4* drawn on two cores; the rest: interpreter start,
 reading the case, both runs, the summary). *warm*: the command again with the cache
 the cold run left. *load*: 1-minute load average of the machine at the start (2 cores).
@@ -231,6 +241,40 @@ CHANGES = {
                        "within a day: its CPU time moves with it)",
 }
 """what the code of each measured label changed (rendered under the table)"""
+MECHANISMS = """
+### What each cold-start mechanism is for, and what it was measured to save
+
+`pdeflow.numerics.warmup.prepare` is the one call that compiles a run's kernels before
+the run; the mechanisms behind it, with the measurements and incidents that put them
+there (test 5.1 cold, on this 2-core machine; numbers from the sessions in the table
+above, not re-measured since the code moved behind `prepare`):
+
+* **Helper process on the second core** (`compile_parallel`): test 5.1 compiled ~11 s
+  in one process, one core busy (*session3*); with a forked helper 5.5 s (*session4*).
+  The two-layer source stage is 41 % of the bytecode of the call trees and about half
+  of the compile time, so the helper takes it alone (`HELPER_SHARE` = 0.42). Where
+  no fork is safe (threads: a server, Jupyter, Dask) the helper is a new interpreter,
+  which first spends ~1 s importing pdeflow.
+* **Helpers without entry points** (`compiled.HelperKernel`): the two-layer source stage
+  is a tree of 20 helper kernels; with the Python and function-pointer entry points
+  every caller linked in and compiled again at every level (*session5*, together with
+  the fewer collections below: 4.2 s of compilation against 5.5 s in *session4*).
+* **Fewer garbage collections while compiling** (`compile_parallel.fewer_collections`):
+  0.7-0.8 s of collecting in 8.5-10.4 s of compiling in one process, 0.2 s with it;
+  **none at exit** (`pdeflow.__main__`, `gc.freeze()`): 0.4-0.8 s of a first run.
+* **Function pointers looked up once** (`compiled.FunctionPointer`): passed a
+  dispatcher, numba looks up its address on every call of the stepping loop, about
+  0.3 ms; passed numba's own wrapper it builds the function type again, 10-30 us.
+* **Closures named after their constants** (`compiled.specialise`, numba issue #10486):
+  a rate test once failed with a cache that many test processes had filled, one
+  closure's code loaded for another's.
+* **Cache keys following every callee's code** (`compiled._CodeKeyedCache`): numba's own
+  key, the source file's time stamp, once loaded a kernel with an old callee compiled
+  in and gave a wrong test 5.1 result.
+* **The app** loads its kernels in a background thread (`app/kernels.py`) and says so:
+  its first picture came 13 s after a start with an empty cache (docs/teaching.md).
+"""
+"""why each mechanism is there (rendered under the kernel lists)"""
 COLUMNS = ("code", "runs", "load", "`python -m pdeflow run` wall [s]", "CPU [s]",
            "`pdeflow` script wall [s]", "imports [s]", "compile [s]", "figures [s]",
            "rest [s]", "warm wall [s]", "kernels compiled (signatures)")
@@ -274,6 +318,7 @@ def render(data: dict[str, Any]) -> str:
         L.append(f"\nKernels compiled by the cold run, *{label}*: {names(d['kernels'])}.")
         if d.get("helper_kernels"):
             L.append(f"Of these, the helper process compiled {names(d['helper_kernels'])}.")
+    L.append(MECHANISMS)
     return "\n".join(L) + "\n"
 
 

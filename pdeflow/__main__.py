@@ -10,7 +10,8 @@ def program() -> None:
     """:func:`pdeflow.cli.main` on the command line's arguments, then exit."""
     code = main()
     # frozen, the objects of numba's compiler and of matplotlib are not walked by the
-    # garbage collection at exit (0.4-0.8 s of a first run of test 5.1)
+    # garbage collection at exit, which would otherwise walk them all once more
+    # (docs/performance.md, "Cold first run")
     gc.freeze()
     sys.exit(code)
 

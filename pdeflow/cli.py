@@ -102,7 +102,8 @@ def _import_plotting() -> None:
 def cmd_run(args: argparse.Namespace) -> int:
     from .cases import load_case
     from .io import check_output, write_json, write_npz
-    from .simulate import load_case_kernels, print_summary, run_model
+    from .numerics.warmup import prepare
+    from .simulate import case_steppers, print_summary, run_model
 
     case = load_case(args.case, args.set)
     for name in ("live_every", "store_every", "fps"):
@@ -131,8 +132,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     outdir = Path(args.outdir) if args.outdir else (
         Path("results") / case.name if default_out else None)
     # matplotlib's import (~0.5 s) fills the wait for the kernels a helper compiles
-    load_case_kernels(case, None if args.quiet else sys.stderr,
-                      meanwhile=_import_plotting if args.plot or outdir else None)
+    prepare(case_steppers(case), log=None if args.quiet else sys.stderr,
+            meanwhile=_import_plotting if args.plot or outdir else None)
     results = {}
     stores: dict[str, Any] = {}
     all_trackers: list[Any] = []

@@ -12,7 +12,6 @@ from __future__ import annotations
 import sys
 import time
 import warnings
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -26,9 +25,11 @@ from .metrics import front_position, mass
 from .models.base import GranularPDE
 from .numerics import layout as L
 from .numerics.layout import GEOMETRIES
+from .numerics.splitting import Stepper, scheme_stepper
 from .numerics.state import velocity_profile
+from .numerics.warmup import prepare
 from .solvers.diagnostics import SplitDiagnostics
-from .solvers.fv_split import SimulationBlowUp, load_kernels
+from .solvers.fv_split import SimulationBlowUp, scheme_codes
 from .trackers import FextraStorageTracker
 from .variant import Variant
 
@@ -72,19 +73,15 @@ class RunResult:
         return out
 
 
-def load_case_kernels(case: Case, log: Any = None,
-                      meanwhile: Callable[[], Any] | None = None) -> float:
-    """Compile or load the compiled kernels that ``case`` needs, before its runs, so
-    that neither its wall times nor its progress bars include it; ``log`` (a stream) is
-    told when they are compiled (the first run on a machine); ``meanwhile``: work to do
-    while a helper process compiles (see :func:`~pdeflow.solvers.fv_split.load_kernels`),
-    called once in any case. Returns seconds spent."""
+def case_steppers(case: Case) -> list[Stepper]:
+    """The compiled steppers that the ``fv-split`` runs of ``case`` call, one per model
+    (none for another solver): what :func:`pdeflow.numerics.warmup.prepare` compiles
+    before the runs, all at once."""
     if case.solver != "fv-split":
-        if meanwhile is not None:
-            meanwhile()
-        return 0.0
-    return load_kernels(log, [case.make_pde(m) for m in case.models], case.splitting,
-                        meanwhile=meanwhile, geometry=GEOMETRIES[case.geometry])
+        return []
+    geometry = GEOMETRIES[case.geometry]
+    return [scheme_stepper(*scheme_codes(case.make_pde(m), case.splitting, geometry))
+            for m in case.models]
 
 
 class Run:
@@ -150,8 +147,8 @@ class Run:
         if not self.variant.is_mol and self.backend == "numba":
             # compiling (first run on a machine) or loading the kernels is not the run's
             # wall time, nor should it hold up its progress bar
-            load_kernels(pdes=[self.pde], splitting=self.variant.splitting,
-                         geometry=self.pde.metric(self.state.grid).code)
+            prepare(scheme_stepper(*scheme_codes(self.pde, self.variant.splitting,
+                                                 self.pde.metric(self.state.grid).code)))
         wall0 = time.perf_counter()
         final, info = self.pde.solve(self.state, t_range=case.t_end, tracker=trackers,
                                      ret_info=True, **self.solver_arguments())

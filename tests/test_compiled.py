@@ -12,7 +12,7 @@ import pytest
 from numba.core import config
 
 from pdeflow.numerics import compile_parallel as parallel
-from pdeflow.numerics import compiled
+from pdeflow.numerics import compiled, warmup
 from pdeflow.numerics import layout as L
 from pdeflow.numerics.bundles import SINGLE_LAYER, TWO_LAYER
 from pdeflow.numerics.splitting import scheme_stepper
@@ -207,17 +207,17 @@ def large(x):
     return s * s + x
 """
 
-READY_ALL = r"""
+PREPARE = r"""
 import json, sys, threading
 import toy_kernels as toy
 from pdeflow.numerics import compile_parallel as parallel
-from pdeflow.numerics import compiled
+from pdeflow.numerics import warmup
 if sys.argv[1] == "threads":  # a server's process: the helper is a new interpreter
     stop = threading.Event()
     threading.Thread(target=stop.wait, daemon=True).start()
 ks = [toy.small, toy.medium, toy.large]
 helper = [k.py_func.__name__ for k in parallel.split_work(ks)]
-parallel.ready_all(ks, meanwhile=lambda: print("MEANWHILE", flush=True))
+warmup.prepare(ks, meanwhile=lambda: print("MEANWHILE", flush=True))
 print("STATS" + json.dumps({"helper": helper, "results": [k(2.0) for k in ks],
     "hits": {k.py_func.__name__: sum(k.stats.cache_hits.values()) for k in ks},
     "misses": {k.py_func.__name__: sum(k.stats.cache_misses.values()) for k in ks}}))
@@ -225,7 +225,7 @@ print("STATS" + json.dumps({"helper": helper, "results": [k(2.0) for k in ks],
 
 
 @pytest.mark.parametrize("threads", ["none", "threads"])
-def test_ready_all_compiles_part_of_the_kernels_in_a_helper_process(tmp_path, threads):
+def test_prepare_compiles_part_of_the_kernels_in_a_helper_process(tmp_path, threads):
     """On two cores and a cold cache, a helper process (a fork; with another thread
     running, a new interpreter) compiles some of the kernels (this process then loads
     them from the disk cache: cache hits) and this process compiles the others (cache
@@ -236,7 +236,7 @@ def test_ready_all_compiles_part_of_the_kernels_in_a_helper_process(tmp_path, th
     (tmp_path / "toy_kernels.py").write_text(TOY_KERNELS)
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
            "PYTHONPATH": os.pathsep.join([str(ROOT), str(tmp_path)])}
-    proc = subprocess.run([sys.executable, "-c", READY_ALL, threads], env=env,
+    proc = subprocess.run([sys.executable, "-c", PREPARE, threads], env=env,
                           cwd=ROOT, capture_output=True, text=True, timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
     line = [x for x in proc.stdout.splitlines() if x.startswith("STATS")][0]
@@ -285,16 +285,64 @@ def test_split_work_keeps_this_process_busy_and_no_fork_beside_threads():
 def test_meanwhile_is_called_once_whatever_there_is_to_compile():
     """The caller's work for the wait runs once, also with nothing to compile or wait
     for (kernels already loaded, no kernels)."""
-    import pdeflow
-    from pdeflow.solvers import fv_split
-
     calls: list[int] = []
-    parallel.ready_all([], meanwhile=lambda: calls.append(1))
-    stepper = scheme_stepper(*PLANAR_HLL_SINGLE).ready()
-    parallel.ready_all(stepper.kernels, meanwhile=lambda: calls.append(2))
-    fv_split.load_kernels(None, [pdeflow.SingleLayerGranular()],
-                          meanwhile=lambda: calls.append(3))
-    assert calls == [1, 2, 3]
+    assert warmup.prepare([], meanwhile=lambda: calls.append(1)) == 0.0
+    assert warmup.prepare(None, meanwhile=lambda: calls.append(2)) == 0.0
+    stepper = scheme_stepper(*PLANAR_HLL_SINGLE)
+    warmup.prepare([[stepper], stepper.kernels], meanwhile=lambda: calls.append(3))
+    assert warmup.prepare(stepper, meanwhile=lambda: calls.append(4)) == 0.0
+    assert calls == [1, 2, 3, 4]
+
+
+def test_prepare_binds_a_stepper_and_reports_what_is_left():
+    """After prepare a stepper's kernels are compiled (status READY) and bound as
+    function pointers; a kernel nobody compiled yet is COLD or CACHED, never READY."""
+    from pdeflow.numerics.compiled import f8, kernel
+
+    stepper = scheme_stepper(SINGLE_LAYER, L.FLUX_RUSANOV, 1, L.LIMITER_MINMOD, False,
+                             L.GEOMETRY_PLANAR)
+    warmup.prepare([stepper])
+    assert warmup.status(stepper) == warmup.READY and stepper.arguments is not None
+    assert all(isinstance(k, compiled.FunctionPointer) for k in stepper.arguments[:2])
+
+    @kernel(f8)
+    def fresh(x):  # pragma: no cover - compiled
+        return 2.0 * x
+
+    assert warmup.status([fresh]) in (warmup.COLD, warmup.CACHED)
+    assert warmup.prepare(fresh) >= 0.0 and warmup.status(fresh) == warmup.READY
+    assert fresh(1.5) == 3.0 and len(fresh.signatures) == 1
+
+
+def test_prepare_refuses_what_is_no_kernel_or_stepper():
+    from pdeflow.cases import load_case
+
+    case = load_case(ROOT / "cases" / "ritter_dam_break.toml")
+    for wrong in ([case], "two_layer"):
+        with pytest.raises(TypeError, match="case_steppers"):
+            warmup.prepare(wrong)
+
+
+def test_the_rest_of_the_package_warms_kernels_up_through_prepare_only():
+    """Outside pdeflow/numerics nothing calls the compile machinery behind
+    warmup.prepare: of compile_parallel only the fork helpers the figures use, of
+    compiled only ready (the py-pde solvers' rates and hooks compile on demand)."""
+    import ast
+
+    allowed = {"pdeflow.numerics.compile_parallel": {"can_fork", "fork_context"},
+               "pdeflow.numerics.compiled": {"ready"}}
+    for path in sorted((ROOT / "pdeflow").rglob("*.py")):
+        if path.parent.name == "numerics":
+            continue
+        pkg = path.relative_to(ROOT).with_suffix("").parts[:-1]
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.module:
+                base = list(pkg[:len(pkg) - node.level + 1]) if node.level else []
+                name = ".".join([*base, node.module])
+                names = {a.name for a in node.names}
+                assert names <= allowed.get(name, names), (path.name, name, names)
+                if name == "pdeflow.numerics":  # no way round the names above
+                    assert not names & {"compiled", "compile_parallel"}, path.name
 
 
 def test_garbage_collector_walks_less_while_compiling_and_is_restored():
@@ -303,16 +351,12 @@ def test_garbage_collector_walks_less_while_compiling_and_is_restored():
     import gc
 
     before = gc.get_threshold(), gc.get_freeze_count()
-    seen: list[tuple] = []
-    parallel.ready_all([], meanwhile=lambda: seen.append(
-        (gc.get_threshold(), gc.get_freeze_count())))
-    assert seen[0][0] == parallel.GC_THRESHOLD and seen[0][1] > before[1]
-
-    def fail() -> None:
+    with parallel.fewer_collections():
+        assert gc.get_threshold() == parallel.GC_THRESHOLD
+        assert gc.get_freeze_count() > before[1]
+    assert (gc.get_threshold(), gc.get_freeze_count()) == before
+    with pytest.raises(KeyboardInterrupt), parallel.fewer_collections():
         raise KeyboardInterrupt
-
-    with pytest.raises(KeyboardInterrupt):
-        parallel.ready_all([], meanwhile=fail)
     assert (gc.get_threshold(), gc.get_freeze_count()) == before
 
 

@@ -16,8 +16,10 @@ from pde.trackers.base import TrackerBase
 import pdeflow
 from pdeflow.cases import load_case
 from pdeflow.cli import build_parser
+from pdeflow.numerics import warmup
+from pdeflow.numerics.splitting import scheme_stepper
 from pdeflow.solvers import fv_split
-from pdeflow.trackers import ProgressBar, progress
+from pdeflow.trackers import ProgressBar
 
 ROOT = Path(__file__).parents[1]
 RITTER = ROOT / "cases" / "ritter_dam_break.toml"
@@ -53,8 +55,7 @@ def test_named_progress_tracker_is_replaced():
 def test_progress_bar_says_it_compiles_and_restarts_its_clock(monkeypatch, capsys):
     """While the kernels are compiled the bar says so; its clock starts after the
     first interval, so the remaining time comes from the run alone."""
-    monkeypatch.setattr(progress, "kernels_ready", lambda: False)
-    monkeypatch.setattr(progress, "kernels_cached", lambda: False)
+    monkeypatch.setattr(warmup, "status", lambda work=None: warmup.COLD)
     eq, state = _readme_state()
     bar = ProgressBar(0.5, label="two_layer")
     seen = []
@@ -74,21 +75,21 @@ def test_progress_bar_says_it_compiles_and_restarts_its_clock(monkeypatch, capsy
     assert "at rest" in capsys.readouterr().err
 
 
-def test_cli_says_when_it_compiles(monkeypatch):
+def test_prepare_says_when_it_compiles(monkeypatch):
     """``pdeflow run`` compiles (or loads) the kernels before its runs and, when it has
     to compile them, says so with the time it took."""
-    monkeypatch.setattr(fv_split, "kernels_ready", lambda: False)
-    monkeypatch.setattr(fv_split, "kernels_cached", lambda: False)
     log = io.StringIO()
     eq, _ = _readme_state()
-    seconds = fv_split.load_kernels(log, [eq])
+    stepper = scheme_stepper(*fv_split.scheme_codes(eq))
+    monkeypatch.setattr(warmup, "status", lambda work=None: warmup.COLD)
+    seconds = warmup.prepare(stepper, log=log)
     assert seconds > 0
     text = log.getvalue()
     assert text.startswith("pdeflow: compiling numba kernels (once per machine) ...")
     assert f"done in {seconds:.1f} s" in text
-    monkeypatch.setattr(fv_split, "kernels_cached", lambda: True)
+    monkeypatch.setattr(warmup, "status", lambda work=None: warmup.CACHED)
     log = io.StringIO()
-    fv_split.load_kernels(log, [eq])
+    warmup.prepare(stepper, log=log)
     assert log.getvalue() == ""  # loading from the disk cache is quick: nothing to say
 
 
@@ -97,7 +98,7 @@ def test_kernels_are_loaded_before_the_wall_time_starts():
 
     run_model(load_case(RITTER, ["grid.cells=20", "output.snapshot_times=[]"]),
               "single_layer")
-    assert fv_split.kernels_ready() and fv_split.kernels_cached()
+    assert warmup.status() == warmup.READY
 
 
 def test_progress_bar_only_on_a_terminal_or_asked(monkeypatch):

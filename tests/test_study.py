@@ -305,26 +305,27 @@ def test_summary_keys_catalogue_matches_the_summaries():
         assert set(run_model(case, model).summary) == set(summary_keys(model))
 
 
-LOAD_STUDY_KERNELS = r"""
+PREPARE_STUDY_KERNELS = r"""
 import json, sys
 from pdeflow.numerics.splitting import scheme_stepper
 from pdeflow.solvers.fv_split import scheme_codes
 from pdeflow.study import load_study
-from pdeflow.study.evaluate import load_study_kernels
+from pdeflow.numerics.warmup import prepare
+from pdeflow.study.evaluate import study_steppers
 spec = load_study(sys.argv[1])
 kernels = [k for m in spec.models() for k in scheme_stepper(
     *scheme_codes(spec.case.make_pde(m), spec.case.splitting)).kernels]
 before = sum(len(k.signatures) for k in kernels)
-load_study_kernels(spec)
+prepare(study_steppers(spec))
 print("SIGNATURES" + json.dumps([before, [len(k.signatures) for k in kernels]]))
 """
 
 
-def test_load_study_kernels_makes_every_model_kernel_ready():
+def test_study_kernels_are_prepared_for_every_model_before_the_workers():
     """Before the local workers start, the study's process compiles (or loads) the
     kernels of every model its evaluations run (a fresh process: none before, one
     signature each after), so that the workers only load them."""
-    proc = subprocess.run([sys.executable, "-c", LOAD_STUDY_KERNELS, str(SMOKE)],
+    proc = subprocess.run([sys.executable, "-c", PREPARE_STUDY_KERNELS, str(SMOKE)],
                           capture_output=True, text=True, timeout=900, cwd=ROOT,
                           env={**os.environ, "PYTHONPATH": str(ROOT)})
     assert proc.returncode == 0, proc.stderr[-3000:]

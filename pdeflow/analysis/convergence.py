@@ -34,7 +34,8 @@ import numpy as np
 
 from .. import systems
 from ..cases import PAPER_MODEL, Case, CaseError, load_case
-from ..simulate import load_case_kernels
+from ..numerics.warmup import prepare
+from ..simulate import case_steppers
 from .study import Executor, Point, Study, refined, serial
 
 QOI_KEYS = ("lower_stop_time", "upper_stop_time", "lower_slow_time", "upper_slow_time",
@@ -206,7 +207,7 @@ def cmd_converge(args: argparse.Namespace) -> int:
                         f"{args.levels}")
     check_output(args.summary, "--summary")
     case = load_case(args.case, args.set)
-    load_case_kernels(case, sys.stderr)
+    prepare(case_steppers(case), log=sys.stderr)
     if case.data.get("sweep"):
         res = converge_sweep(case, args.levels, args.model)
         print(table(res, SWEEP_VIEW))

@@ -24,7 +24,8 @@ import numpy as np
 
 from .. import systems
 from ..cases import PAPER_MODEL, Case, CaseError, load_case
-from ..simulate import load_case_kernels
+from ..numerics.warmup import prepare
+from ..simulate import case_steppers
 from .study import Executor, Point, Study, serial, with_sets
 
 DEM_EXPONENT = 0.83
@@ -189,7 +190,7 @@ def cmd_sweep(args: Any) -> int:
     io.check_output(args.plot, "--plot")
     case = load_case(args.case, args.set)
     sweep_ratios(case)  # before any run
-    load_case_kernels(case, None if args.quiet else sys.stderr)
+    prepare(case_steppers(case), log=None if args.quiet else sys.stderr)
     summary = run_sweep(case)
     if args.summary:
         io.write_json(args.summary, summary)

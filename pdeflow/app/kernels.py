@@ -1,10 +1,10 @@
 """The numba kernels, loaded in the background so that the app can say what it waits for.
 
-pdeflow's kernels are compiled on their first use and cached on disk (the app's first
-picture came 13 s after a start with an empty cache on the two-core development machine,
-docs/teaching.md; they load in a fraction of a second afterwards). The app starts
-:data:`WARMUP` when it is served or displayed; its pages show :meth:`KernelWarmup.message`
-(with the elapsed time) until the kernels are ready, instead of looking frozen.
+pdeflow's kernels are compiled on their first use and cached on disk: after a start with
+an empty cache the app waits seconds for its first picture, later starts load the
+kernels in a fraction of a second. The app starts :data:`WARMUP` when it is served or
+displayed; its pages show :meth:`KernelWarmup.message` (with the elapsed time) until
+the kernels are ready, instead of looking frozen.
 """
 
 from __future__ import annotations
@@ -30,7 +30,8 @@ def warm_kernels() -> None:
     """Run every kernel the app uses once: compiles them, or loads them from the cache."""
     from ..cases import Case
     from ..numerics import hyperbolicity as hyp
-    from ..simulate import load_case_kernels, run_model
+    from ..numerics.warmup import prepare
+    from ..simulate import case_steppers, run_model
 
     def spectrum_functions() -> None:
         # called from Python by the hyperbolicity page: compiled as Python-callable
@@ -44,7 +45,7 @@ def warm_kernels() -> None:
 
     case = Case.from_dict(WARMUP_CASE, source="<kernel warm-up>")
     # both models' kernels at once: compiled on two cores
-    load_case_kernels(case, meanwhile=spectrum_functions)
+    prepare(case_steppers(case), meanwhile=spectrum_functions)
     for model in case.models:
         run_model(case, model)
 

@@ -1,19 +1,19 @@
 """Compiling a run's kernels on two cores: a helper process fills numba's disk cache.
 
-The first run on a machine spends most of its time compiling (test 5.1: ~11 s in one
-process, docs/performance.md "Cold first run"), one core busy. :func:`ready_all`
-splits the kernels a run needs in two (:func:`split_work`): a helper process compiles
-its share into numba's disk cache (the kernels' cache keys are their code, the same in
-every process, :mod:`pdeflow.numerics.compiled`) while this process compiles the rest;
-then this process loads the helper's kernels from the cache. The helper is
+Called by :func:`pdeflow.numerics.warmup.prepare` only. :func:`start_helper` splits the
+kernels to compile in two (:func:`split_work`): a helper process compiles its share into
+numba's disk cache (the kernels' cache keys are their code, the same in every process,
+:mod:`pdeflow.numerics.compiled`) while the calling process compiles the rest, then
+loads the helper's kernels from the cache. The helper is
 
 * a **fork** of this process where that is safe (:func:`can_fork`: Linux, no other
   thread): it starts at once and takes any kernel, closures included;
 * else a **new interpreter** (a server, a Jupyter kernel, a Dask worker: processes with
-  threads), which imports pdeflow (~1 s) and takes the kernels it can find by name
-  (module-level ones, such as the source stages).
+  threads), which has to import pdeflow first and takes only the kernels it can find by
+  name (module-level ones, such as the source stages).
 
-Nothing depends on the helper: if it fails, this process compiles its kernels itself.
+Nothing depends on the helper: if it fails, the calling process compiles its kernels
+itself. Measurements of what this saves: docs/performance.md, "Cold first run".
 """
 
 from __future__ import annotations
@@ -25,19 +25,17 @@ import os
 import subprocess
 import sys
 import threading
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
-from .compiled import in_disk_cache, needs_compiling, ready, referenced_kernels
+from .compiled import in_disk_cache, ready, referenced_kernels
 
 HELPER_SHARE = 0.42
 """The helper process's share of the compile work (bytecode of the call trees) that
 :func:`split_work` aims at. Below one half because the bytecode of a closure's tree
 overcounts: it includes the kernels of the branches that its constants drop (the
-fluxes a scheme does not use). On the paper's test 5.1 the two-layer source stage is
-41 % of the bytecode and about half of the compile time: the helper takes it alone
-(docs/performance.md, "Cold first run", lists what each process compiled)."""
+fluxes a scheme does not use)."""
 
 
 GC_THRESHOLD = (10000, 10, 10)
@@ -45,45 +43,30 @@ GC_THRESHOLD = (10000, 10, 10)
 10): a collection of the youngest objects every 10000 new ones instead of every 700."""
 
 
-def ready_all(kernels: Sequence[Any], parallel: bool = True,
-              meanwhile: Callable[[], Any] | None = None) -> None:
-    """:func:`~pdeflow.numerics.compiled.ready` every kernel of ``kernels``; with
-    ``parallel``, two or more kernels to compile (not in the disk cache) and a second
-    core, a helper process compiles part of them meanwhile (module docstring).
-    ``meanwhile`` (if given) is called once, after this process's own compiling and
-    before it waits for the helper: other work of the caller's that can fill that wait
-    (e.g. the imports its figures need)."""
-    with _fewer_collections():
-        todo = [k for k in dict.fromkeys(kernels) if needs_compiling(k)]
-        helper, helper_kernels = None, []
-        if parallel and _cores() > 1 and len(todo) > 1:
-            cold = [k for k in todo if not in_disk_cache(k)]
-            forked = can_fork()
-            helper_kernels = split_work(cold, movable=None if forked else
-                                        [k for k in cold if _importable(k)])
-            if helper_kernels:
-                helper = _Forked(helper_kernels) if forked else _interpreter(helper_kernels)
-        try:
-            _ready_each([k for k in todo if k not in helper_kernels])
-            if meanwhile is not None:
-                meanwhile()
-        except BaseException:
-            if helper is not None:  # e.g. Ctrl-C: no helper outlives this call
-                helper.terminate()
-            raise
-        if helper is not None:
-            helper.wait()
-        _ready_each(todo)
+def start_helper(todo: Sequence[Any]) -> tuple[Any, list[Any]]:
+    """(the helper process, the kernels of ``todo`` it compiles), or (None, []) where
+    there is no second core, fewer than two kernels to compile (not in the disk cache)
+    or nothing to give the helper. The helper is waited for with ``wait()`` and stopped
+    with ``terminate()``."""
+    if _cores() < 2 or len(todo) < 2:
+        return None, []
+    cold = [k for k in todo if not in_disk_cache(k)]
+    forked = can_fork()
+    kernels = split_work(cold, movable=None if forked else
+                         [k for k in cold if _importable(k)])
+    if not kernels:
+        return None, []
+    helper = _Forked(kernels) if forked else _interpreter(kernels)
+    return helper, kernels if helper is not None else []
 
 
 @contextlib.contextmanager
-def _fewer_collections() -> Iterator[None]:
+def fewer_collections() -> Iterator[None]:
     """Python's garbage collector, while numba compiles, walks less: numba's compiler
     makes and drops objects by the million, and a collection started every
-    :data:`GC_THRESHOLD` [0] new objects walked also everything imported so far (numba,
-    py-pde, scipy). Frozen, the objects that exist now are not walked; restored after.
-    (Test 5.1 in one process: 0.7-0.8 s collecting of 8.5-10.4 s compiling, 0.2 s
-    with this.)"""
+    :data:`GC_THRESHOLD` [0] new objects would walk also everything imported so far
+    (numba, py-pde, scipy). Frozen, the objects that exist now are not walked; restored
+    after."""
     thresholds = gc.get_threshold()
     gc.freeze()
     gc.set_threshold(*GC_THRESHOLD)
@@ -140,7 +123,7 @@ def helper_main(names: Sequence[str]) -> None:
     """The new-interpreter helper: ready the kernels named ``module:qualname``."""
     import importlib
 
-    with _fewer_collections():
+    with fewer_collections():
         for name in names:
             module, _, qualname = name.partition(":")
             ready(getattr(importlib.import_module(module), qualname))
@@ -150,7 +133,7 @@ class _Forked:
     """A forked helper process, waited for like a ``subprocess.Popen``."""
 
     def __init__(self, kernels: Sequence[Any]):
-        self.process = fork_context().Process(target=_ready_each, args=(kernels,),
+        self.process = fork_context().Process(target=ready_each, args=(kernels,),
                                               daemon=True)
         self.process.start()
 
@@ -176,7 +159,8 @@ def _interpreter(kernels: Sequence[Any]) -> subprocess.Popen | None:
         return None
 
 
-def _ready_each(kernels: Sequence[Any]) -> None:
+def ready_each(kernels: Sequence[Any]) -> None:
+    """:func:`~pdeflow.numerics.compiled.ready` every kernel of ``kernels``."""
     for k in kernels:
         ready(k)
 

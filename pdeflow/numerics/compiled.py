@@ -27,16 +27,20 @@ What the factories and the kernels share is kept here:
   :class:`HelperKernel` s: only other kernels call them, so they are compiled without
   the entry points that Python and C function pointers need, which every caller would
   link in and compile again (a call from Python still works).
-* :func:`kernels`, :func:`kernels_ready`, :func:`kernels_cached`: what is compiled.
+* :func:`kernels`, :func:`pending` and :func:`in_disk_cache`: what is compiled, what is
+  still to compile or load, and what numba's disk cache holds.
 
-Compiling several kernels on two cores: :mod:`pdeflow.numerics.compile_parallel`.
+The rest of the package does not call :func:`ready` to warm kernels up before a run:
+:func:`pdeflow.numerics.warmup.prepare` does, the one entry point of the cold start.
+Every numba internal this module relies on (subclassed classes, private attributes) is
+listed and checked by ``tests/test_numba_internals.py``.
 """
 
 from __future__ import annotations
 
 import hashlib
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from types import CodeType
 from typing import Any
 
@@ -105,9 +109,8 @@ def specialise(func: Callable, *arg_types: Any, helper: bool = False,
     # numba names compiled code after the function's qualified name and a per-process
     # counter: two closures of one factory compiled in two processes (a run and its
     # compile helper, or two runs) can get one name, and a process that loads both
-    # from the disk cache may run one's code for the other (numba issue #10486; a rate
-    # test failed once with a cache that many test processes had filled). Here the name
-    # carries what the closure is made of.
+    # from the disk cache may run one's code for the other (numba issue #10486). Here
+    # the name carries what the closure is made of.
     description = repr(_describe_function(func)).encode()
     func.__qualname__ += "_" + hashlib.sha256(description).hexdigest()[:12]
     compiled = _jit(func, helper=helper, pointer=pointer)
@@ -119,13 +122,13 @@ def specialise(func: Callable, *arg_types: Any, helper: bool = False,
 class HelperKernel(CPUDispatcher):
     """A kernel that other kernels call: compiled without the two entry points numba
     gives every function by default, one for calls from Python (it unboxes the
-    arguments and boxes the result) and one for C function pointers. Their code is
-    linked into every caller with the rest of the helper and compiled again there, at
-    every level of a call tree (test 5.1's two-layer source stage is a tree of 20
-    helpers; docs/performance.md, "Cold first run", session5). A call from
-    Python (a test, the app's spectrum page) goes to a twin with the entry points,
-    compiled on its first such call and cached apart. (numba cannot call a function
-    without its Python entry point from Python: the process would crash.)"""
+    arguments and boxes the result) and one for C function pointers. Their code would
+    be linked into every caller with the rest of the helper and compiled again there,
+    at every level of a call tree, which makes deep trees (the source stages) slow to
+    compile. A call from Python (a test, the app's spectrum page) goes to a twin with
+    the entry points, compiled on its first such call and cached apart. (numba cannot
+    call a function without its Python entry point from Python: the process would
+    crash.)"""
 
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
         twin = self.__dict__.get("_python_twin")
@@ -151,7 +154,8 @@ def _jit(func: Callable, *, helper: bool = False, pointer: bool = True,
 
 def entry(*kernels: Any) -> None:
     """Register kernels that a solver is about to call (e.g. the stepping loop of a
-    scheme and the model's kernels it is given): :func:`kernels_ready` waits for them."""
+    scheme and the model's kernels it is given): :func:`pending` lists them until they
+    are compiled or loaded."""
     for compiled in kernels:
         if isinstance(compiled, Dispatcher) and compiled not in _ENTRIES:
             _ENTRIES.append(compiled)
@@ -181,8 +185,9 @@ def ready(compiled: Any) -> Any:
 class FunctionPointer(CompileResultWAP):
     """A compiled kernel as a first-class function argument, with its address and numba
     type looked up once. (Passed a dispatcher, numba looks up its address on every call
-    of the kernel it is passed to, about 0.3 ms; passed numba's own wrapper, it builds
-    the function type again, 10-30 us.)"""
+    of the kernel it is passed to; passed numba's own wrapper, it builds the function
+    type again on every call. The stepping loop is called once per tracker interval
+    with up to four such arguments.)"""
 
     def __init__(self, cres: Any):
         super().__init__(cres)
@@ -234,29 +239,17 @@ def kernels() -> list[Any]:
     return list(found.values())
 
 
-def _pending() -> list[Any]:
-    """Entry kernels built but not compiled yet, and what they call."""
-    todo = [k for k in _ENTRIES if _SIGNATURES.get(k) not in k.signatures]
+def pending(roots: Iterable[Any] | None = None) -> list[Any]:
+    """The kernels of ``roots`` (default: the entry kernels built in this process, see
+    :func:`entry`) and the kernels they call that are neither compiled nor loaded yet."""
+    todo = [k for k in (_ENTRIES if roots is None else roots) if needs_compiling(k)]
     seen: dict[int, Any] = {}
     while todo:
         k = todo.pop()
-        if id(k) not in seen and k in _SIGNATURES and _SIGNATURES[k] not in k.signatures:
+        if id(k) not in seen and needs_compiling(k):
             seen[id(k)] = k
             todo.extend(_callees(k))
     return list(seen.values())
-
-
-def kernels_ready() -> bool:
-    """True if every entry kernel built in this process (e.g. the stepping loop of a
-    solver's ``make_stepper``) is compiled or loaded (always with NUMBA_DISABLE_JIT=1)."""
-    return config.DISABLE_JIT or not _pending()
-
-
-def kernels_cached() -> bool:
-    """True if numba's disk cache holds every kernel that :func:`kernels_ready` waits
-    for, for this machine's CPU, so that loading them takes a fraction of a second
-    instead of compiling them. Reads numba's cache index; False if it cannot."""
-    return all(in_disk_cache(k) for k in _pending())
 
 
 def in_disk_cache(compiled: Any) -> bool:
@@ -305,8 +298,8 @@ class _CodeKeyedCache(FunctionCache):
     """numba's disk cache for a kernel, keyed by its code, what it closes over (see the
     module docstring) and the code of every kernel it calls. numba's own key is the
     kernel's source file's time stamp: a kernel whose callee in another file changed
-    was loaded with the old callee compiled in (a stale cache once gave a wrong test
-    5.1 result); here it is recompiled."""
+    would be loaded with the old callee compiled in (and give stale results); here it
+    is recompiled."""
 
     def __init__(self, py_func: Callable, python_twin: bool = False):
         super().__init__(py_func)

@@ -18,8 +18,6 @@ that the hook wraps.
 from __future__ import annotations
 
 import logging
-import time
-from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -28,8 +26,6 @@ from pde.trackers.base import FinishedSimulation
 
 from ..models.base import GranularPDE, check_range
 from ..numerics import layout as L
-from ..numerics.compile_parallel import ready_all
-from ..numerics.compiled import kernels_cached, kernels_ready
 from ..numerics.splitting import STATUS_FAIL, STATUS_REST, python_stepping, scheme_stepper
 
 
@@ -57,46 +53,6 @@ def scheme_codes(pde: GranularPDE, splitting: str = "lie",
     ``splitting`` on a grid of ``geometry`` (layout.GEOMETRY_*), as
     :func:`pdeflow.numerics.splitting.scheme_stepper` takes it."""
     return (pde.kernels, *pde.scheme_codes, splitting == "strang", geometry)
-
-
-def load_kernels(log: Any = None, pdes: Sequence[GranularPDE] = (),
-                 splitting: str = "lie", parallel: bool = True,
-                 meanwhile: Callable[[], Any] | None = None,
-                 geometry: int = L.GEOMETRY_PLANAR) -> float:
-    """Compile the ``fv-split`` kernels of the models ``pdes`` (their schemes, with
-    ``splitting``) or load them from numba's disk cache, now, so that this time is not
-    booked on a real run's wall time or progress bar. Only what these schemes call is
-    compiled. Returns the seconds it took, ``meanwhile`` included (0 if the kernels
-    were already loaded).
-
-    Args:
-        log: a stream (e.g. ``sys.stderr``) that is told when the kernels have to be
-            compiled (once per machine and scheme) and how long it took; None: silent.
-        pdes: the models of the runs to come.
-        splitting: 'lie' or 'strang'.
-        parallel: compile on two cores where there are (a helper process compiles
-            part of the kernels, see :func:`pdeflow.numerics.compile_parallel.ready_all`).
-        meanwhile: work of the caller's for this process while the helper compiles
-            (called once in any case; see ``ready_all``).
-        geometry: the runs' grid geometry (layout.GEOMETRY_*).
-    """
-    steppers = [scheme_stepper(*scheme_codes(pde, splitting, geometry)) for pde in pdes]
-    if kernels_ready():
-        if meanwhile is not None:
-            meanwhile()
-        return 0.0
-    compiling = not kernels_cached()
-    if compiling and log is not None:
-        print("pdeflow: compiling numba kernels (once per machine) ...", end="",
-              file=log, flush=True)
-    t0 = time.perf_counter()
-    ready_all([k for scheme in steppers for k in scheme.kernels], parallel, meanwhile)
-    for scheme in steppers:
-        scheme.ready()
-    seconds = time.perf_counter() - t0
-    if compiling and log is not None:
-        print(f" done in {seconds:.1f} s", file=log, flush=True)
-    return seconds
 
 
 class SimulationBlowUp(FloatingPointError):

@@ -94,13 +94,14 @@ def warm(spec: StudySpec) -> float:
     the numba kernels (from the disk cache; compiled if absent), by a run of each needed
     model on a 16-cell grid for a few steps. Returns the time it took [s]. Run once per
     worker when the cluster starts, so that the loop's timing holds only evaluations."""
+    from ..numerics.warmup import prepare
     from ..simulate import run_model
 
     t0 = time.perf_counter()
     _silence_run_warnings()
     if spec.function is not None:
         importlib.import_module(spec.function.split(":", 1)[0])
-    load_study_kernels(spec)
+    prepare(study_steppers(spec))
     for base, models in _bases(spec):
         tiny = base.copy()
         grid = tiny.data.setdefault("grid", {})
@@ -116,19 +117,20 @@ def warm(spec: StudySpec) -> float:
     return time.perf_counter() - t0
 
 
-def load_study_kernels(spec: StudySpec) -> None:
-    """Compile or load the numba kernels of every model the study's evaluations run,
-    all at once (so that a cold cache is filled on two cores, see
-    :func:`pdeflow.numerics.compile_parallel.ready_all`). The local study engine calls
-    it before it starts its workers, which then load the kernels instead of each
-    compiling them. Warming only: a failure is left to the evaluations to report."""
-    from ..simulate import load_case_kernels
+def study_steppers(spec: StudySpec) -> list[Any]:
+    """The compiled steppers of every model the study's evaluations run, for
+    :func:`pdeflow.numerics.warmup.prepare` to compile or load all at once (a cold cache
+    is filled on two cores). A case that cannot be built is left out: its evaluations
+    report the error."""
+    from ..simulate import case_steppers
 
+    steppers = []
     for base, models in _bases(spec):
         try:
-            load_case_kernels(spec.case_for(base, {}, models))
+            steppers += case_steppers(spec.case_for(base, {}, models))
         except Exception:  # noqa: BLE001, S112 - warming only; evaluations report errors
             continue
+    return steppers
 
 
 def _bases(spec: StudySpec) -> list[tuple[Any, list[str]]]:

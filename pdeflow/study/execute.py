@@ -21,8 +21,9 @@ from collections import deque
 from collections.abc import Callable
 from typing import Any
 
+from ..numerics.warmup import prepare
 from .designs import Optimiser, design_points
-from .evaluate import evaluate_batch, load_study_kernels, warm
+from .evaluate import evaluate_batch, study_steppers, warm
 from .results import ResultsTable
 from .spec import StudySpec
 
@@ -93,7 +94,7 @@ def run_study(spec: StudySpec, out: str, *, workers: int | None = None,
     log(f"{spec.name}: {total} evaluations to run ({len(done)} already in {table.csv})")
     t_start = time.perf_counter()
     if scheduler is None:  # the local workers share this machine's kernel cache
-        load_study_kernels(spec)
+        prepare(study_steppers(spec))
     client, cluster, n_workers = _client(workers, scheduler)
     log(f"Dask: {n_workers} workers, dashboard {client.dashboard_link}")
     walls: deque[float] = deque(maxlen=200)

@@ -17,7 +17,11 @@ from typing import Any
 from pde.trackers import ProgressTracker
 from pde.trackers.base import InfoDict, TrackerBase
 
-from ..numerics.compiled import kernels_cached, kernels_ready
+from ..numerics import warmup
+
+_WAITING = {warmup.COLD: "compiling kernels (once per machine)",
+            warmup.CACHED: "loading compiled kernels"}
+"""what the bar says before the first interval, by :func:`warmup.status`"""
 
 
 class ProgressBar(ProgressTracker):
@@ -45,9 +49,8 @@ class ProgressBar(ProgressTracker):
         self._clock_started = False
         solver = (info or {}).get("solver", {}).get("class")
         waiting = ""
-        if solver == "FVSplitSolver" and not kernels_ready():
-            waiting = ("compiling kernels (once per machine)" if not kernels_cached()
-                       else "loading compiled kernels")
+        if solver == "FVSplitSolver":
+            waiting = _WAITING.get(warmup.status(), "")
         self._waiting = ": ".join(p for p in (self.label, waiting) if p)
         self.progress_bar.set_description(self._waiting)
         return result
