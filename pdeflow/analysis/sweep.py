@@ -24,7 +24,8 @@ import numpy as np
 
 from ..cases import Case, CaseError, load_case
 from ..simulate import load_case_kernels
-from .study import Executor, Point, Study, serial, with_sets
+from ..study.core import Executor, Study, serial
+from .points import Point, with_sets
 
 PAPER_FITS = {"single_layer": (2.25, 1.06), "two_layer": (1.61, 0.84)}
 DEM_EXPONENT = 0.83
@@ -89,7 +90,7 @@ def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
               executor: Executor = serial) -> dict[str, Any]:
     """Run every model at every aspect ratio; return the sweep summary.
 
-    A :class:`~pdeflow.analysis.study.Study`: one point per model and aspect ratio a
+    A :class:`~pdeflow.study.core.Study`: one point per model and aspect ratio a
     (the case with H0 = a L0, no snapshots), measured by :func:`runout_row`.
     """
     ratios = aspect_ratios or sweep_ratios(case)
