@@ -8,7 +8,7 @@ or a direct check:
   Ritter, Mangeney et al. 2000 on a slope with Coulomb friction, Stoker on a wet bed;
   :func:`~pdeflow.analysis.exact.exact_solution_for`) on successive grids, for every
   flux and reconstruction: L1 and Linf errors of h and hu, observed orders;
-* :func:`smooth_study`: a smooth wave against a fine-grid reference;
+* :func:`smooth_study`: a smooth wave against a fine-grid reference (a Study too);
 * :func:`two_layer_checks`: two layers at rest, and two layers against one where the
   models must agree.
 """
@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -103,31 +105,50 @@ def exact_study(case: Case, levels: list[int], label: str | None = None,
     return rows
 
 
-def _solve_smooth(n: int, v: Variant, t: float) -> np.ndarray:
-    grid = CartesianGrid([[-1.0, 1.0]], n)
+@dataclass
+class _Smooth:
+    """A point of :func:`smooth_study`: one variant on a grid of ``cells`` cells."""
+
+    variant: Variant
+    cells: int
+
+    @property
+    def labels(self) -> dict[str, Any]:
+        return {"variant": self.variant.name, "cells": self.cells}
+
+
+def smooth_state(point: _Smooth, t: float) -> dict[str, Any]:
+    """Measure of :func:`smooth_study`: the state at ``t`` [s] of a Gaussian hump on a
+    1 m layer over [-1, 1] m, open ends, CFL 0.45."""
+    grid = CartesianGrid([[-1.0, 1.0]], point.cells)
     x = grid.axes_coords[0]
+    v = point.variant
     eq = SingleLayerGranular({"phi_b_deg": 1e-9}, bc=("open", "open"), flux=v.flux,
                              reconstruction=v.reconstruction, limiter=v.limiter)
     h0 = 1.0 + 0.05 * np.exp(-(x / 0.1) ** 2)
     res = eq.solve(eq.make_state(grid, h=h0, u=0 * x), t_range=t, solver="fv-split",
                    cfl=0.45, tracker=None)
-    return res.data
+    return {"data": res.data}
 
 
 def smooth_study(levels: list[int],
                  variants: tuple[Variant, ...] = VARIANTS) -> list[dict[str, Any]]:
     """A smooth simple wave on a wet bed (a Gaussian hump on a 1 m layer, no shock by
-    t = 0.05 s): L1(h) against a grid 8 times finer than the finest, CFL 0.45."""
+    t = 0.05 s): L1(h) against a grid 8 times finer than the finest, CFL 0.45. A
+    :class:`~pdeflow.study.core.Study` of every variant on the grids and the reference
+    grid, measured by :func:`smooth_state`."""
     t = 0.05
     fine = levels[-1] * 8
+    points = [_Smooth(v, n) for v in variants for n in (fine, *levels)]
+    runs = {(r["variant"], r["cells"]): r["data"]
+            for r in Study(points, partial(smooth_state, t=t)).execute()}
     rows = []
     for v in variants:
-        ref = _solve_smooth(fine, v, t)
+        ref = runs[v.name, fine]
         e1 = []
         for n in levels:
-            data = _solve_smooth(n, v, t)
             coarse = ref.reshape(2, n, fine // n).mean(axis=2)
-            e1.append(float(np.abs(data[0] - coarse[0]).sum() * 2.0 / n))
+            e1.append(float(np.abs(runs[v.name, n][0] - coarse[0]).sum() * 2.0 / n))
         rows.append({"problem": "smooth", "variant": v.name, "L1_h": e1,
                      "order_L1_h": orders(e1)})
     return rows

@@ -82,7 +82,8 @@ serial = Executor(_InProcess(), 1, everywhere=lambda fn: fn())
 
 def pool_executor(pool: cf.Executor, workers: int | None = None) -> Executor:
     """An executor on a ``concurrent.futures`` pool of ``workers`` processes (default:
-    one per core); the set-up then runs in each worker with its first batch."""
+    one per core). A pool cannot run a call on every worker, so a study's set-up is
+    skipped: each worker loads what it needs with its first point."""
     return Executor(pool, workers or os.cpu_count() or 1)
 
 
@@ -193,7 +194,8 @@ class Study:
     points: Sequence[Labelled] | Proposals
     measure: Callable[[Any], Row]
     setup: Callable[[], Any] | None = None
-    """run once on every worker before the clock starts (e.g. load the kernels)"""
+    """warming only, run once on every worker before the clock starts (e.g. load the
+    kernels); skipped by an executor that cannot reach every worker"""
     failed: Callable[[Any, Exception], Row] | None = None
     """the row of each point of a batch that raised (e.g. its worker died): a study of
     thousands of points goes on; None: the error ends the study"""
