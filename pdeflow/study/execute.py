@@ -55,9 +55,11 @@ class _Trials:
     generation: int
 
     def ask(self, n: int) -> list[DesignPoint]:
+        """``n`` new trials of the optimiser."""
         return [DesignPoint(i, p) for i, p in self.optimiser.ask(n)]
 
     def tell(self, rows: list[dict[str, Any]]) -> None:
+        """Report finished trials (their rows carry the objectives)."""
         for row in rows:
             self.optimiser.tell(row)
 
