@@ -122,7 +122,7 @@ def cell_update_rates(variants: Sequence[str] = BENCH_VARIANTS, dx: float = 0.01
                       t_end: float = 0.4, repeats: int = 5) -> list[dict[str, Any]]:
     """Cell updates per second of every model and variant on the 5.1 case (dx [m],
     run to ``t_end`` [s]), with the compiled fv-split stepper."""
-    from pdeflow.analysis.study import case_on_grid, resolve_case
+    from pdeflow.analysis.points import case_on_grid, resolve_case
     from pdeflow.variant import Variant
 
     base = resolve_case(CASE_5_1)

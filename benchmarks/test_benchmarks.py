@@ -26,7 +26,7 @@ VARIANTS = ("hll/first-order", "rusanov/first-order", "ifcp/first-order", "hll/m
 @pytest.mark.parametrize("variant", VARIANTS)
 def test_cell_updates(benchmark, model, variant):
     """5.1 case, dx = 0.0125 m, to t = 0.4 s: one model and variant."""
-    from pdeflow.analysis.study import case_on_grid, resolve_case
+    from pdeflow.analysis.points import case_on_grid, resolve_case
     from pdeflow.variant import Variant
 
     case = case_on_grid(resolve_case(suite.CASE_5_1), 0.0125, Variant.parse(variant))

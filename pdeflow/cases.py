@@ -47,6 +47,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from . import systems
+from .initial_shapes import REQUIRED, SHAPES, profiles_from_file, total_depth
 from .models.base import check_range
 from .numerics.layout import GEOMETRIES
 from .variant import Variant, VariantError, variant_of
@@ -76,7 +77,6 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
     "sweep": {"aspect_ratios": (list,)},
 }
 
-SHAPES = ("column", "dam_break", "heap", "file")
 
 
 class CaseError(ValueError):
@@ -247,9 +247,7 @@ class Case:
     def _check_initial(self) -> None:
         ini = self.initial
         shape = ini["shape"]
-        need = {"column": ("L0", "H0"), "dam_break": ("x_dam", "h_left"),
-                "heap": ("center", "height", "slope_deg"), "file": ("path",)}[shape]
-        for key in need:
+        for key in REQUIRED[shape]:
             if key not in ini:
                 raise self._err(f"initial.{key} is required for shape {shape!r}")
         try:
@@ -405,49 +403,23 @@ class Case:
 
     def initial_profiles(self, model: str, grid=None) -> dict[str, np.ndarray]:
         """Depth and velocity profiles of the initial state for ``model`` (at rest; the
-        model's system splits the total depth into its layers)."""
+        model's system splits the shape's total depth into its layers)."""
         system = systems.get(model)
         grid = grid or self.make_grid()
         x = grid.axes_coords[0] - self.x_start
         ini = self.initial
-        shape = ini["shape"]
-        if shape == "file":
-            return self._profiles_from_file(system, x.size)
-        if shape == "column":
-            h = np.where(x < float(ini["L0"]), float(ini["H0"]), 0.0)
-        elif shape == "dam_break":
-            h = np.where(x < float(ini["x_dam"]), float(ini["h_left"]),
-                         float(ini.get("h_right", 0.0)))
-        else:  # heap
-            slope = math.tan(math.radians(float(ini["slope_deg"])))
-            h = np.maximum(float(ini["height"]) - slope * np.abs(x - float(ini["center"])),
-                           0.0)
+        if ini["shape"] == "file":
+            try:
+                return profiles_from_file(self.base_dir / ini["path"], system.profile_names,
+                                          x.size, system.name)
+            except ValueError as err:
+                raise self._err(str(err)) from None
         params = system.parameters_class.from_dict(self.data.get(model, {}))
-        depths = system.layer_depths(h, x, ini, params)
+        depths = system.layer_depths(total_depth(ini, x), x, ini, params)
         out: dict[str, np.ndarray] = {}
         for layer, depth in zip(system.layers, depths, strict=True):
             out[layer.depth] = depth
             out[layer.velocity] = np.zeros_like(x)
-        return out
-
-    def _profiles_from_file(self, system: Any, n: int) -> dict[str, np.ndarray]:
-        path = self.base_dir / self.initial["path"]
-        keys = system.profile_names
-        try:
-            with np.load(path) as data:
-                missing = [k for k in keys if k not in data]
-                if missing:
-                    raise self._err(f"initial profile {path.name} lacks arrays "
-                                    f"{missing} needed by the {system.name} model")
-                out = {k: np.asarray(data[k], dtype=float) for k in keys}
-        except (OSError, ValueError) as err:
-            if isinstance(err, CaseError):
-                raise
-            raise self._err(f"cannot read initial profile {path}: {err}") from None
-        for k, v in out.items():
-            if v.shape != (n,):
-                raise self._err(f"initial profile {path.name}: array {k} has shape "
-                                f"{v.shape}, the grid has ({n},) cells")
         return out
 
     def make_state(self, model: str):

@@ -37,10 +37,3 @@ def mass(data: np.ndarray, cells: float | np.ndarray,
     if np.ndim(cells) == 0:
         return float(np.sum(total) * cells)
     return float(np.sum(total * cells))
-
-
-def momentum(data: np.ndarray, dx: float, density_ratio: float | None = None) -> float:
-    """Momentum per unit width divided by rho2 [m^3/s]."""
-    if density_ratio is None:
-        return float(np.sum(data[1]) * dx)
-    return float(np.sum(density_ratio * data[1] + data[3]) * dx)

@@ -10,7 +10,6 @@ there a missing kernel means the installation is broken and the notebooks went u
 from __future__ import annotations
 
 import os
-import time
 from pathlib import Path
 
 import pytest
@@ -28,9 +27,11 @@ else:
 
 DOCS = Path(__file__).parents[1] / "docs"
 NOTEBOOKS = sorted(DOCS.glob("*.ipynb"))
-#: each notebook runs in seconds once the numba kernels are cached (a first run compiles
-#: them, which can take a minute or two); this limit only catches run-away cells
-TIME_LIMIT_S = 300
+#: the limit [s] of one cell: generous on purpose, it only stops a cell that hangs. A
+#: notebook runs in seconds once the numba kernels are cached, but a first run compiles
+#: them (minutes on a loaded machine); how fast the notebooks run is not a unit test's
+#: business
+CELL_TIMEOUT_S = 900
 
 
 def _kernel_env() -> dict[str, str]:
@@ -77,12 +78,9 @@ def test_notebook_executes(path, kernel_available):
     assert "assert " in code, "a notebook must check its results"
     assert all(not c.get("outputs") for c in nb.cells if c.cell_type == "code"), \
         "store notebooks without outputs (they are produced when run)"
-    client = nbclient.NotebookClient(nb, timeout=TIME_LIMIT_S, kernel_name="python3",
+    client = nbclient.NotebookClient(nb, timeout=CELL_TIMEOUT_S, kernel_name="python3",
                                      resources={"metadata": {"path": str(DOCS)}})
-    t0 = time.perf_counter()
     client.execute(env=_kernel_env())  # raises CellExecutionError on a failing cell
-    elapsed = time.perf_counter() - t0
-    assert elapsed < TIME_LIMIT_S, f"{path.name} took {elapsed:.0f} s"
     outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.outputs]
     assert not [o for o in outputs if o.output_type == "error"]
     images = [o for o in outputs if "image/png" in o.get("data", {})]

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from pdeflow.analysis import workprecision as wp
-from pdeflow.analysis.study import case_on_grid, resolve_case
+from pdeflow.analysis.points import case_on_grid, resolve_case
 from pdeflow.analysis.timing import mol_time_step
 from pdeflow.cases import load_case
 from pdeflow.simulate import Run

@@ -1,4 +1,4 @@
-"""Analysis: exact solutions, and the studies defined on :class:`~pdeflow.analysis.study.Study`
+"""Analysis: exact solutions, and the studies defined on :class:`~pdeflow.study.core.Study`
 (convergence, work-precision, validation, stability)."""
 
 from .exact import mangeney, ritter, stoker

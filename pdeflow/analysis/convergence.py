@@ -14,7 +14,7 @@ F_extra and wall time; ``--all`` every quantity, ``--summary`` writes all as JSO
 For sweep cases (with a ``[sweep]`` section) it refines the sweep and reports the
 fitted run-out prefactor and exponent per level.
 
-Both are :class:`~pdeflow.analysis.study.Study` definitions: points = the grid levels,
+Both are :class:`~pdeflow.study.core.Study` definitions: points = the grid levels,
 measure = the quantities of one run (:func:`qoi_row`) or the fit of one sweep
 (:func:`fit_row`). ``python docs/generate/convergence.py`` regenerates
 ``docs/convergence.md`` from them.
@@ -36,7 +36,8 @@ from .. import systems
 from ..cases import PAPER_MODEL, Case, CaseError, load_case
 from ..numerics.warmup import prepare
 from ..simulate import case_steppers
-from .study import Executor, Point, Study, refined, serial
+from ..study.core import Executor, Study, serial
+from .points import Point, refined
 
 QOI_KEYS = ("lower_stop_time", "upper_stop_time", "lower_slow_time", "upper_slow_time",
             "stop_time", "runout", "max_fextra_over_rho1")

@@ -10,7 +10,7 @@ from typing import Any
 from ..cases import PAPER_MODEL, Case
 from ..simulate import Run
 from ..variant import Variant
-from .study import case_on_grid, resolve_case
+from .points import case_on_grid, resolve_case
 
 
 def hyperbolicity_study(case_path: str | Path | Case,

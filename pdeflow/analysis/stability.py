@@ -35,11 +35,13 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import numpy as np
 
 from ..numerics import layout as L
+from ..study.core import Executor, Study, serial
 from ..variant import Variant
 from .stability_problems import Problem, reference_speed, shear
 
@@ -167,38 +169,84 @@ def largest_stable(results: dict[float, Outcome]) -> float | None:
     return best
 
 
+@dataclass
+class _Scan:
+    """A point of :func:`cfl_search`: one variant on one problem, over CFL numbers."""
+
+    variant: str
+    problem: Problem
+    cfls: tuple[float, ...]
+
+    @property
+    def labels(self) -> dict[str, Any]:
+        return {"variant": self.variant, "problem": self.problem.name}
+
+
+def scan(point: _Scan) -> dict[str, Any]:
+    """Measure of :func:`cfl_search`: the outcome per CFL number, in increasing order,
+    until two consecutive failures (beyond the first failure nothing more is learnt)."""
+    res: dict[float, Outcome] = {}
+    fails = 0
+    for c in point.cfls:
+        res[c] = run(point.variant, point.problem, c)
+        fails = fails + 1 if res[c].status != "stable" else 0
+        if fails >= 2:
+            break
+    return {"outcomes": res}
+
+
 def cfl_search(variants: Sequence[str], problems: Sequence[Problem],
                cfls: Sequence[float] = DEFAULT_CFLS,
-               log: Callable[[str], None] = print) -> dict[str, dict[str, dict]]:
-    """Outcome per variant, problem and CFL number (stops a problem's scan after two
-    consecutive failures above the first failure, to save time)."""
-    out: dict[str, dict[str, dict]] = {}
-    for name in variants:
-        out[name] = {}
-        for prob in problems:
-            res: dict[float, Outcome] = {}
-            fails = 0
-            for c in (cfls if prob.perturbation else (*SMALL_CFLS, *cfls)):
-                res[c] = run(name, prob, c)
-                fails = fails + 1 if res[c].status != "stable" else 0
-                if fails >= 2:
-                    break
-            out[name][prob.name] = res
-            log(f"  {name:22} {prob.name:28} largest stable CFL "
-                f"{largest_stable(res)}")
+               log: Callable[[str], None] = print,
+               executor: Executor = serial) -> dict[str, dict[str, dict]]:
+    """Outcome per variant, problem and CFL number: a :class:`~pdeflow.study.core.Study`
+    of every variant on every problem, measured by :func:`scan` (the dam break tries
+    :data:`SMALL_CFLS` first)."""
+    points = [_Scan(name, prob, tuple(cfls) if prob.perturbation else (*SMALL_CFLS, *cfls))
+              for name in variants for prob in problems]
+
+    def said(rows: list[dict[str, Any]]) -> None:
+        for r in rows:
+            log(f"  {r['variant']:22} {r['problem']:28} largest stable CFL "
+                f"{largest_stable(r['outcomes'])}")
+
+    out: dict[str, dict[str, dict]] = {name: {} for name in variants}
+    for r in Study(points, scan).run(executor, on_rows=said).rows:
+        out[r["variant"]][r["problem"]] = r["outcomes"]
     return out
+
+
+@dataclass
+class _Shear:
+    """A point of :func:`stability_map`: one variant on the shear problem (r, du)."""
+
+    variant: str
+    r: float
+    du: float
+
+    @property
+    def labels(self) -> dict[str, Any]:
+        return {"r": self.r, "du": self.du}
+
+
+def shear_outcome(point: _Shear, cfl: float, cells: int, t_end: float) -> dict[str, Any]:
+    """Measure of :func:`stability_map`: the outcome of one shear problem at ``cfl``."""
+    return {"outcome": run(point.variant, shear(point.r, point.du, cells, t_end), cfl)}
 
 
 def stability_map(variants: Sequence[str], ratios: Sequence[float] = DEFAULT_RATIOS,
                   dus: Sequence[float] = DEFAULT_DU, cfl: float = 0.3, cells: int = 400,
-                  t_end: float = 4.0,
-                  log: Callable[[str], None] = print) -> dict[str, dict[tuple, Outcome]]:
-    """Outcome of the shear problem per variant over (r, du/sqrt(g H)) at ``cfl``."""
+                  t_end: float = 4.0, log: Callable[[str], None] = print,
+                  executor: Executor = serial) -> dict[str, dict[tuple, Outcome]]:
+    """Outcome of the shear problem per variant over (r, du/sqrt(g H)) at ``cfl``: a
+    :class:`~pdeflow.study.core.Study` per variant over the (r, du) grid."""
     out: dict[str, dict[tuple, Outcome]] = {}
+    measure = partial(shear_outcome, cfl=cfl, cells=cells, t_end=t_end)
     for name in variants:
         t0 = time.perf_counter()
-        out[name] = {(r, d): run(name, shear(r, d, cells, t_end), cfl)
-                     for r in ratios for d in dus}
+        points = [_Shear(name, r, d) for r in ratios for d in dus]
+        out[name] = {(row["r"], row["du"]): row["outcome"]
+                     for row in Study(points, measure).execute(executor)}
         counts = {s: sum(o.status == s for o in out[name].values())
                   for s in ("stable", "growth", "blow-up")}
         log(f"  {name:22} {counts} ({time.perf_counter() - t0:.1f} s)")

@@ -26,7 +26,8 @@ from .. import systems
 from ..cases import PAPER_MODEL, Case, CaseError, load_case
 from ..numerics.warmup import prepare
 from ..simulate import case_steppers
-from .study import Executor, Point, Study, serial, with_sets
+from ..study.core import Executor, Study, serial
+from .points import Point, with_sets
 
 DEM_EXPONENT = 0.83
 
@@ -90,7 +91,7 @@ def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
               executor: Executor = serial) -> dict[str, Any]:
     """Run every model at every aspect ratio; return the sweep summary.
 
-    A :class:`~pdeflow.analysis.study.Study`: one point per model and aspect ratio a
+    A :class:`~pdeflow.study.core.Study`: one point per model and aspect ratio a
     (the case with H0 = a L0, no snapshots), measured by :func:`runout_row`.
     """
     ratios = aspect_ratios or sweep_ratios(case)

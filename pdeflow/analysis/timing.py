@@ -20,7 +20,7 @@ import numpy as np
 from ..cases import Case
 from ..simulate import Run
 from ..variant import Variant
-from .study import Point
+from .points import Point
 
 MIN_TIMING_S = 0.25
 """Short runs are repeated until their timed runs add up to this [s] (noise)."""

@@ -15,7 +15,7 @@ Usage::
 ``CASE`` is a TOML case file (``cases/*.toml``); the dam breaks with exact solutions are
 ``cases/ritter_dam_break.toml``, ``mangeney_dam_break_slope.toml`` and
 ``stoker_dam_break.toml`` (:func:`~pdeflow.analysis.exact.exact_solution_for`). The
-study is a :class:`~pdeflow.analysis.study.Study` over variants x grids: :func:`compare`.
+study is a :class:`~pdeflow.study.core.Study` over variants x grids: :func:`compare`.
 
 Variants
 --------
@@ -59,16 +59,16 @@ import statistics
 import sys
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
-from functools import partial
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..cases import Case, CaseError, load_case
+from ..study.core import Study
 from ..variant import Variant
 from .exact import exact_solution_for
-from .study import Point, Study, case_on_grid, resolve_case
+from .points import Point, case_on_grid, resolve_case
 from .timing import run_variant, timed
 
 DEFAULT_VARIANTS: tuple[str, ...] = (
@@ -158,100 +158,127 @@ def compare(case_path: str | Path | Case, variants: Sequence[str] | None = None,
         against the previous grid of the same variant).
     """
     base = resolve_case(case_path)
-    names = list(variants or DEFAULT_VARIANTS)
-    parsed = [Variant.parse(v) for v in names]
-    grids = list(grids or [base.dx, base.dx / 2, base.dx / 4])
-    t_eval = float(t if t is not None else base.t_end)
-    models = list(models or base.models)
     if reference not in ("auto", "exact", "fine") and not reference.startswith("fine:"):
         raise ValueError(f"reference must be auto, exact, fine or fine:VARIANT, got "
                          f"{reference!r}")
-    common_ref = Variant.parse(reference[5:]) if reference.startswith("fine:") else None
-
-    def dx_of(gr: float | int) -> float:
-        if isinstance(gr, (int, np.integer)) and not isinstance(gr, bool):
-            return base.length / int(gr)
-        return float(gr)
-
-    ref_dx = reference_dx or min(dx_of(gr) for gr in grids) / 4
-    fine_cache: dict[tuple[str, str], tuple[np.ndarray, np.ndarray, str]] = {}
-
-    def say(msg: str) -> None:
-        if log is not None:
-            print(msg, file=log, flush=True)
-
-    def fine_reference(model: str, v: Variant) -> tuple[np.ndarray, np.ndarray, str]:
-        rv = common_ref or (v if not v.is_mol else Variant())
-        key = (model, rv.name)
-        if key not in fine_cache:
-            fc = case_on_grid(base, ref_dx, rv, cfl)
-            say(f"  reference {model} {rv.name} dx={ref_dx:g} ({fc.cells} cells)")
-            run = run_variant(fc, model, rv, t_eval, repeats=0)
-            if run.status != "ok":
-                raise RuntimeError(f"fine reference {rv.name} failed: {run.note}")
-            fine_cache[key] = (run.data, cell_edges(fc), f"fine {rv.name} dx={ref_dx:g} m")
-        return fine_cache[key]
-
-    rows: list[dict[str, Any]] = []
-    for model in models:
-        exact = exact_solution_for(base, model)
-        if reference == "exact" and exact is None:
-            raise ValueError(f"no exact solution for {model} on {base.name}")
-        use_exact = exact is not None and reference in ("auto", "exact")
-        points = [Point(case_on_grid(base, gr, v, cfl), model, v) for v in parsed
-                  for gr in grids]
-        measure = partial(timed, t=t_eval, repeats=repeats, mol_cap=mol_cap)
-
-        def logged(point: Point, measure: Any = measure) -> dict[str, Any]:
-            say(f"{base.name} {point.model} {point.variant} cells={point.case.cells}")
-            return measure(point)
-
-        runs = Study(points, logged).execute()
-        prev: dict[str, Any] | None = None
-        for point, out in zip(points, runs, strict=True):
-            c, v, run = point.case, point.variant, out["run"]
-            assert v is not None
-            if prev is not None and prev["variant"] != v.name:
-                prev = None  # orders compare grids of one variant
-            edges = cell_edges(c)
-            if use_exact:
-                h, hu = exact.cell_averages(edges, t_eval)
-                ref = np.stack([h, hu])
-                ref_name = f"exact {exact.name.capitalize()}"
-            else:
-                fdata, fedges, ref_name = fine_reference(model, v)
-                ref = restrict(fdata, fedges, edges)
-            dx = c.length / c.cells
-            if run.status == "ok":
-                eh, ehu = _errors(run.data, ref, dx)
-            else:
-                eh = ehu = math.nan
-            norm = float(np.abs(ref[::2]).sum() * dx)
-            row = {
-                "case": base.name, "model": model, "variant": v.name,
-                "solver": v.solver, "splitting": None if v.is_mol else v.splitting,
-                "cells": c.cells, "dx": dx, "t": t_eval,
-                "err_h": eh, "err_hu": ehu,
-                "rel_err_h": eh / norm if norm > 0 else math.nan,
-                "wall_s": statistics.median(run.wall_s), "walls": run.wall_s,
-                "compile_s": run.compile_s, "steps": run.steps,
-                "cell_updates": run.steps * c.cells, "status": run.status,
-                "note": run.note, "reference": ref_name, "order_h": None,
-            }
-            if v.is_mol:
-                row["dt"] = run.info.get("dt")
-            if (prev is not None and prev["status"] == "ok" and run.status == "ok"
-                    and eh > 0 and prev["err_h"] > 0):
-                row["order_h"] = math.log(prev["err_h"] / eh) / math.log(
-                    prev["dx"] / dx)
-            say(f"    err_h={eh:.3e} m^2 err_hu={ehu:.3e} m^3/s "
-                f"wall={row['wall_s'] * 1e3:.2f} ms {run.status} {run.note}")
-            rows.append(row)
-            prev = row
-    result = CompareResult(label or base.name, t_eval, rows)
+    grids = list(grids or [base.dx, base.dx / 2, base.dx / 4])
+    harness = _Harness(base, float(t if t is not None else base.t_end), reference,
+                       reference_dx or min(_dx_of(base, gr) for gr in grids) / 4,
+                       repeats, cfl, mol_cap, log)
+    parsed = [Variant.parse(v) for v in variants or DEFAULT_VARIANTS]
+    rows = [row for model in models or base.models
+            for row in harness.model_rows(model, parsed, grids)]
+    result = CompareResult(label or base.name, harness.t, rows)
     if out_dir is not None:
         write_outputs(result, Path(out_dir))
     return result
+
+
+def _dx_of(case: Case, grid: float | int) -> float:
+    """The spacing [m] of a grid given as a number of cells (int) or as dx [m]."""
+    if isinstance(grid, (int, np.integer)) and not isinstance(grid, bool):
+        return case.length / int(grid)
+    return float(grid)
+
+
+@dataclass
+class _Harness:
+    """One :func:`compare`: its case, evaluation time [s], reference and timing options,
+    and the fine references computed so far (one per model and reference variant)."""
+
+    base: Case
+    t: float
+    reference: str
+    ref_dx: float
+    repeats: int
+    cfl: float | None
+    mol_cap: float
+    log: Any
+    fine: dict[tuple[str, str], tuple[np.ndarray, np.ndarray, str]] = field(
+        default_factory=dict)
+
+    def say(self, msg: str) -> None:
+        if self.log is not None:
+            print(msg, file=self.log, flush=True)
+
+    def model_rows(self, model: str, variants: list[Variant],
+                   grids: list[float | int]) -> list[dict[str, Any]]:
+        """The rows of one model: a Study over variants x grids, timed, each compared
+        with the exact solution or a fine reference; orders along each variant's grids."""
+        exact = exact_solution_for(self.base, model)
+        if self.reference == "exact" and exact is None:
+            raise ValueError(f"no exact solution for {model} on {self.base.name}")
+        use_exact = exact if self.reference in ("auto", "exact") else None
+        points = [Point(case_on_grid(self.base, gr, v, self.cfl), model, v)
+                  for v in variants for gr in grids]
+        runs = Study(points, self.timed).execute()
+        rows: list[dict[str, Any]] = []
+        for point, out in zip(points, runs, strict=True):
+            ref, ref_name = self.reference_on(point, use_exact)
+            prev = rows[-1] if rows and rows[-1]["variant"] == point.variant.name else None
+            rows.append(self.row(point, out["run"], ref, ref_name, prev))
+        return rows
+
+    def timed(self, point: Point) -> dict[str, Any]:
+        """Measure: the timing of one point, announced on the log."""
+        self.say(f"{self.base.name} {point.model} {point.variant} "
+                 f"cells={point.case.cells}")
+        return timed(point, self.t, self.repeats, self.mol_cap)
+
+    def reference_on(self, point: Point, exact: Any) -> tuple[np.ndarray, str]:
+        """The reference state on the point's cells, and its name."""
+        edges = cell_edges(point.case)
+        if exact is not None:
+            h, hu = exact.cell_averages(edges, self.t)
+            return np.stack([h, hu]), f"exact {exact.name.capitalize()}"
+        fdata, fedges, ref_name = self.fine_reference(point.model, point.variant)
+        return restrict(fdata, fedges, edges), ref_name
+
+    def fine_reference(self, model: str, v: Variant) -> tuple[np.ndarray, np.ndarray, str]:
+        """A fine-grid run (state, cell faces, name), computed once per model and
+        reference variant: the common one, else the point's (hll/first-order for the
+        method of lines)."""
+        common = self.reference[5:] if self.reference.startswith("fine:") else None
+        rv = Variant.parse(common) if common else (v if not v.is_mol else Variant())
+        key = (model, rv.name)
+        if key not in self.fine:
+            fc = case_on_grid(self.base, self.ref_dx, rv, self.cfl)
+            self.say(f"  reference {model} {rv.name} dx={self.ref_dx:g} ({fc.cells} cells)")
+            run = run_variant(fc, model, rv, self.t, repeats=0)
+            if run.status != "ok":
+                raise RuntimeError(f"fine reference {rv.name} failed: {run.note}")
+            self.fine[key] = (run.data, cell_edges(fc),
+                              f"fine {rv.name} dx={self.ref_dx:g} m")
+        return self.fine[key]
+
+    def row(self, point: Point, run: Any, ref: np.ndarray, ref_name: str,
+            prev: dict[str, Any] | None) -> dict[str, Any]:
+        """The row of one point: errors against ``ref``, timing, and the observed order
+        against ``prev`` (the previous grid of the same variant, or None)."""
+        c, v = point.case, point.variant
+        assert v is not None
+        dx = c.length / c.cells
+        eh, ehu = _errors(run.data, ref, dx) if run.status == "ok" else (math.nan,) * 2
+        norm = float(np.abs(ref[::2]).sum() * dx)
+        row = {
+            "case": self.base.name, "model": point.model, "variant": v.name,
+            "solver": v.solver, "splitting": None if v.is_mol else v.splitting,
+            "cells": c.cells, "dx": dx, "t": self.t,
+            "err_h": eh, "err_hu": ehu,
+            "rel_err_h": eh / norm if norm > 0 else math.nan,
+            "wall_s": statistics.median(run.wall_s), "walls": run.wall_s,
+            "compile_s": run.compile_s, "steps": run.steps,
+            "cell_updates": run.steps * c.cells, "status": run.status,
+            "note": run.note, "reference": ref_name, "order_h": None,
+        }
+        if v.is_mol:
+            row["dt"] = run.info.get("dt")
+        if (prev is not None and prev["status"] == "ok" and run.status == "ok"
+                and eh > 0 and prev["err_h"] > 0):
+            row["order_h"] = math.log(prev["err_h"] / eh) / math.log(prev["dx"] / dx)
+        self.say(f"    err_h={eh:.3e} m^2 err_hu={ehu:.3e} m^3/s "
+                 f"wall={row['wall_s'] * 1e3:.2f} ms {run.status} {run.note}")
+        return row
 
 
 # --- outputs ---------------------------------------------------------------------------

@@ -3,7 +3,7 @@ r"""The source stages (31)-(34) of the split scheme, cell by cell.
 One step of length dt (Lie splitting, as in the paper) advects (29) and then applies,
 in every wet cell:
 
-2. exchange (31): limited closure (25), see :func:`pdeflow.numerics.sources.exchange_depth`;
+2. exchange (31): limited closure (25), see :func:`pdeflow.numerics.sources.exchange_step`;
    the exchanged mass carries the velocity of the layer it leaves;
 3. implicit momentum sources (32): gravity along the bed, Voellmy interface stress
    (t1 - M du where the step eroded, see :mod:`pdeflow.numerics.sources`), Coulomb basal

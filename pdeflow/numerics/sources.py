@@ -155,7 +155,7 @@ def relaxed_rate(m: float, h1: float, h2: float, du: float, r: float, g: float,
                  tan_int: float, k: float, c: float, tau: float) -> float:
     """Rate form of the relaxed closure: the kinematic mass flux ``m`` = M/rho2 [m/s]
     of (25), bounded by the relaxation towards h1_eq on the time scale ``tau`` [s]
-    (the dt -> 0 limit of the relaxed exchange stage of :func:`exchange_depth`):
+    (the dt -> 0 limit of the relaxed exchange stage of :func:`exchange_step`):
     deposition no faster than r (h1 - h1_eq)/tau, erosion no faster than
     r (min(h1_eq, h1 + h2/r) - h1)/tau."""
     denom = (1.0 - k) * r * g * tan_int
@@ -168,26 +168,19 @@ def relaxed_rate(m: float, h1: float, h2: float, du: float, r: float, g: float,
 
 
 @cached
-def exchange_depth(h1: float, h2: float, du: float, dt: float, r: float, g: float,
-                   tan_int: float, k: float, c: float, du_reg: float,
-                   film: float, tau: float) -> float:
-    """Change of the upper-layer depth [m] in the limited exchange stage (31).
+def exchange_step(h1: float, h2: float, du: float, dt: float, r: float, g: float,
+                  tan_int: float, k: float, c: float, du_reg: float, film: float,
+                  tau: float) -> tuple[float, float]:
+    """Change of the upper-layer depth [m] in the limited exchange stage (31), and the
+    unlimited explicit change of the closure, rate dt / r [m] (their ratio is the phi of
+    the erosion stress above).
 
-    Negative values deposit upper-layer material into the lower layer (whose depth
-    changes by -r times the returned value). ``tau`` [s] > 0 selects the *relaxed*
+    Negative changes deposit upper-layer material into the lower layer (whose depth
+    changes by -r times the first value). ``tau`` [s] > 0 selects the *relaxed*
     closure: the change is the smaller of the paper's explicit step and the exactly
     integrated relaxation towards h1_eq with time scale tau,
     (h1_eq - h1)(1 - exp(-dt/tau)); ``tau`` = 0 is the paper's closure.
     """
-    return exchange_step(h1, h2, du, dt, r, g, tan_int, k, c, du_reg, film, tau)[0]
-
-
-@cached
-def exchange_step(h1: float, h2: float, du: float, dt: float, r: float, g: float,
-                  tan_int: float, k: float, c: float, du_reg: float, film: float,
-                  tau: float) -> tuple[float, float]:
-    """:func:`exchange_depth` and the unlimited explicit change of the closure,
-    rate dt / r [m] (their ratio is the phi of the erosion stress above)."""
     if h1 <= 0.0:
         return 0.0, 0.0
     rate = closure_rate(h1, du, r, g, tan_int, k, c, du_reg)

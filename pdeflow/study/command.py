@@ -67,9 +67,3 @@ def cmd_study(args: argparse.Namespace) -> int:
     log(f"report: {write_report(table, command)}")
     return 0
 
-
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pdeflow study", description=__doc__,
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_arguments(ap)
-    return cmd_study(ap.parse_args(argv))

@@ -14,6 +14,7 @@ import json
 import math
 import time
 import warnings
+from dataclasses import dataclass
 from typing import Any
 
 from .spec import StudySpec
@@ -70,16 +71,28 @@ def _number(v: Any) -> Any:
     return float(v)
 
 
-def evaluate(spec: StudySpec, row_id: int, point: dict[str, Any]) -> dict[str, Any]:
-    """The results row of one point: id, status, message, wall time [s], parameters,
-    quantities, derived values and objectives."""
-    row: dict[str, Any] = {"id": row_id, "status": "ok", "message": "", **point}
+@dataclass
+class DesignPoint:
+    """A point of a study file's design: its row id and its parameter values."""
+
+    id: int
+    values: dict[str, Any]
+
+    @property
+    def labels(self) -> dict[str, Any]:
+        """The first columns of its row: the id and the values."""
+        return {"id": self.id, **self.values}
+
+
+def evaluate(spec: StudySpec, point: DesignPoint) -> dict[str, Any]:
+    """The results of one point (its row without the labels): status, message, wall
+    time [s], quantities, derived values and objectives."""
+    row: dict[str, Any] = {"status": "ok", "message": ""}
     wall0 = time.perf_counter()
     try:
-        values = {k: _number(v) for k, v in _quantities(spec, point).items()}
+        values = {k: _number(v) for k, v in _quantities(spec, point.values).items()}
     except Exception as err:  # noqa: BLE001 - recorded in the row, see module docstring
-        first = str(err).strip().splitlines()[0] if str(err).strip() else ""
-        row.update(status="failed", message=f"{type(err).__name__}: {first}"[:300])
+        row.update(status="failed", message=_message(err))
         values = {}
     row["wall_s"] = time.perf_counter() - wall0
     for name, expr in (*spec.derived.items(), *spec.objectives.items()):
@@ -87,6 +100,19 @@ def evaluate(spec: StudySpec, row_id: int, point: dict[str, Any]) -> dict[str, A
         values[name] = None if math.isnan(v) else v
     row.update({k: values.get(k) for k in spec.columns()})
     return row
+
+
+def failed_row(point: DesignPoint, err: Exception) -> dict[str, Any]:
+    """The results of a point whose task failed as a whole (e.g. KilledWorker after
+    Dask's retries): failed, with the error."""
+    return {"status": "failed", "wall_s": 0.0,
+            "message": f"{type(err).__name__}: {err}"[:300]}
+
+
+def _message(err: Exception) -> str:
+    """An error in one line of at most 300 characters: its type and first line."""
+    first = str(err).strip().splitlines()[0] if str(err).strip() else ""
+    return f"{type(err).__name__}: {first}"[:300]
 
 
 def warm(spec: StudySpec) -> float:
@@ -139,8 +165,3 @@ def _bases(spec: StudySpec) -> list[tuple[Any, list[str]]]:
                                                 (spec.sweep_case, spec.sweep_models()))
             if base is not None and models]
 
-
-def evaluate_batch(spec: StudySpec, items: list[tuple[int, dict[str, Any]]]
-                   ) -> list[dict[str, Any]]:
-    """Rows of a batch of (id, point); one Dask task, so scheduling costs once per batch."""
-    return [evaluate(spec, i, p) for i, p in items]

@@ -1,49 +1,29 @@
-"""Execution of a study on Dask: a local cluster or an existing scheduler.
+"""A study file run as a :class:`~.core.Study` on Dask: a local cluster or a scheduler.
 
-Points go to the workers in batches (one Dask task per batch), two batches in flight
-per worker so that none waits for the client. A batch is sized from the median
-evaluation time seen so far to last about ``TARGET_BATCH_S``: Dask's cost per task
-(about a millisecond on one machine, more across a network) then stays a small fraction
-of a 5 ms evaluation, while an interruption loses at most a few batches. Every batch's
-rows are appended to the results table as it arrives (:mod:`.results`), so rerunning the
-same command computes only what is missing.
+The study's points are the points of its design not yet in the results table (or the
+optimiser's trials, :class:`_Trials`), its measure is one evaluation
+(:func:`.evaluate.evaluate`), its set-up loads the kernels on every worker, and every
+batch's rows are appended to the results table as they arrive (:mod:`.results`), so
+rerunning the same command computes only what is missing. The Study sends the points in
+batches sized to the time an evaluation takes (:mod:`.core`).
 """
 
 from __future__ import annotations
 
-import logging
 import math
-import os
-import statistics
 import sys
 import time
-from collections import deque
 from collections.abc import Callable
+from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 from ..numerics.warmup import prepare
+from .core import Execution, Study, dask_cluster
 from .designs import Optimiser, design_points
-from .evaluate import evaluate_batch, study_steppers, warm
+from .evaluate import DesignPoint, evaluate, failed_row, study_steppers, warm
 from .results import ResultsTable
 from .spec import StudySpec
-
-TARGET_BATCH_S = 0.5
-"""wall time a batch should take [s]: scheduling overhead << 1 %, little lost on Ctrl-C"""
-
-
-def _client(workers: int | None, scheduler: str | None) -> tuple[Any, Any, int]:
-    """(client, local cluster or None, number of workers)."""
-    from distributed import Client, LocalCluster
-
-    if scheduler:
-        client = Client(scheduler, timeout="20s")
-        client.wait_for_workers(1, timeout=60)
-        return client, None, len(client.scheduler_info()["workers"])
-    n = workers or os.cpu_count() or 1
-    # processes, one thread each: the kernels hold the GIL between numba calls
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                           dashboard_address=":0", silence_logs=logging.ERROR)
-    return Client(cluster), cluster, n
 
 
 class _Progress:
@@ -67,10 +47,39 @@ class _Progress:
             print(file=sys.stderr)
 
 
-def run_study(spec: StudySpec, out: str, *, workers: int | None = None,
-              scheduler: str | None = None, progress: bool = False,
-              log: Callable[[str], None] = print) -> ResultsTable:
-    """Run (or resume) ``spec`` into directory ``out``; return its results table."""
+@dataclass
+class _Trials:
+    """The optimiser's trials as the study's points, proposed a generation at a time."""
+
+    optimiser: Optimiser
+    total: int
+    generation: int
+
+    def ask(self, n: int) -> list[DesignPoint]:
+        """``n`` new trials of the optimiser."""
+        return [DesignPoint(i, p) for i, p in self.optimiser.ask(n)]
+
+    def tell(self, rows: list[dict[str, Any]]) -> None:
+        """Report finished trials (their rows carry the objectives)."""
+        for row in rows:
+            self.optimiser.tell(row)
+
+
+def _points(spec: StudySpec, finished: list[dict[str, Any]]) -> list[DesignPoint] | _Trials:
+    """What is left to run: the design's points not in the table, or the optimiser's
+    trials (told the finished ones first, so that the search resumes)."""
+    done = {int(r["id"]) for r in finished}
+    if spec.design == "optimize":
+        optimiser = Optimiser(spec)
+        optimiser.replay(sorted(finished, key=lambda r: r["id"]))
+        return _Trials(optimiser, max(spec.samples - len(done), 0), spec.population)
+    return [DesignPoint(i, p) for i, p in enumerate(design_points(spec)) if i not in done]
+
+
+def _open(spec: StudySpec, out: str, log: Callable[[str], None]
+          ) -> tuple[ResultsTable, list[dict[str, Any]]]:
+    """The study's results table in ``out`` and its finished rows (a warning if other
+    models or numerics computed them)."""
     table = ResultsTable(out, spec)
     finished = table.rows()
     if table.other_code and finished:
@@ -78,16 +87,32 @@ def run_study(spec: StudySpec, out: str, *, workers: int | None = None,
             "version of pdeflow's models or numerics (or one that did not record it); "
             "they are kept and only missing evaluations are run: remove the directory "
             "to recompute them all")
+    return table, finished
+
+
+def _record(table: ResultsTable, done: set[int], run: Execution, startup_s: float,
+            workers: int, scheduler: str | None) -> dict[str, Any]:
+    """Record the execution's timing in the table's metadata (the report shows it)."""
+    evals = [r for r in table.rows() if int(r["id"]) not in done]
+    busy = sum(float(r["wall_s"]) for r in evals)
+    info = {"workers": workers, "scheduler": scheduler or "local",
+            "evaluations": len(evals), "startup_s": startup_s, "wall_s": run.wall_s,
+            "evaluation_s": busy,
+            "overhead_per_evaluation_s": ((run.wall_s * workers - busy) / len(evals)
+                                          if evals else None),
+            "complete": run.complete}
+    table.record_execution(info)
+    return info
+
+
+def run_study(spec: StudySpec, out: str, *, workers: int | None = None,
+              scheduler: str | None = None, progress: bool = False,
+              log: Callable[[str], None] = print) -> ResultsTable:
+    """Run (or resume) ``spec`` into directory ``out``; return its results table."""
+    table, finished = _open(spec, out, log)
     done = {int(r["id"]) for r in finished}
-    optimiser = None
-    if spec.design == "optimize":
-        optimiser = Optimiser(spec)
-        optimiser.replay(sorted(finished, key=lambda r: r["id"]))
-        total = max(spec.samples - len(done), 0)
-        queue: deque = deque()
-    else:
-        queue = deque((i, p) for i, p in enumerate(design_points(spec)) if i not in done)
-        total = len(queue)
+    points = _points(spec, finished)
+    total = len(points) if isinstance(points, list) else points.total
     if total == 0:
         log(f"{table.csv}: all {len(done)} evaluations done")
         return table
@@ -95,82 +120,22 @@ def run_study(spec: StudySpec, out: str, *, workers: int | None = None,
     t_start = time.perf_counter()
     if scheduler is None:  # the local workers share this machine's kernel cache
         prepare(study_steppers(spec))
-    client, cluster, n_workers = _client(workers, scheduler)
-    log(f"Dask: {n_workers} workers, dashboard {client.dashboard_link}")
-    walls: deque[float] = deque(maxlen=200)
+    study = Study(points, partial(evaluate, spec), setup=partial(warm, spec),
+                  failed=failed_row)
     bar = _Progress(total, progress)
-    submitted = 0
-    futures: Any = None
-    t_ready = time.perf_counter()
-    try:
-        from distributed import as_completed
+    info: dict[str, Any] = {}
+    with dask_cluster(workers, scheduler) as executor:
+        log(f"Dask: {executor.workers} workers, dashboard {executor.dashboard}")
+        t_cluster = time.perf_counter()
 
-        client.run(warm, spec)  # every worker loads the kernels once, before the clock
-        t_ready = time.perf_counter()
+        def end(run: Execution) -> None:
+            bar.close()
+            info.update(_record(table, done, run, t_cluster - t_start + run.setup_s,
+                                executor.workers, scheduler))
 
-        spec_f = client.scatter(spec, broadcast=True)  # shipped once per worker
-
-        def next_batch() -> list[tuple[int, dict[str, Any]]]:
-            nonlocal submitted
-            left = total - submitted
-            size = 1 if not walls else math.ceil(
-                TARGET_BATCH_S / max(statistics.median(walls), 1e-4))
-            size = max(1, min(size, left // (2 * n_workers) or 1, left))
-            if optimiser is not None:
-                # an optimiser generation should not wait on one worker's long batch
-                size = min(size, max(1, spec.population // n_workers))
-                batch = optimiser.ask(size)
-            else:
-                batch = [queue.popleft() for _ in range(size)]
-            submitted += len(batch)
-            return batch
-
-        batches: dict[str, list[tuple[int, dict[str, Any]]]] = {}
-
-        def submit() -> None:
-            batch = next_batch()
-            fut = client.submit(evaluate_batch, spec_f, batch, pure=False)
-            batches[fut.key] = batch
-            futures.add(fut)
-
-        futures = as_completed()
-        for _ in range(2 * n_workers):
-            if submitted < total:
-                submit()
-        for fut in futures:
-            batch = batches.pop(fut.key)
-            try:
-                rows = fut.result()
-            except Exception as err:  # noqa: BLE001 - e.g. KilledWorker after retries
-                rows = [{"id": i, "status": "failed", "wall_s": 0.0, **p,
-                         "message": f"{type(err).__name__}: {err}"[:300]}
-                        for i, p in batch]
-            table.append(rows)
-            walls.extend(r["wall_s"] for r in rows)
-            if optimiser is not None:
-                for r in rows:
-                    optimiser.tell(r)
-            bar.update(rows)
-            if submitted < total:
-                submit()
-    finally:
-        bar.close()
-        loop_wall = time.perf_counter() - t_ready
-        if futures is not None:
-            client.cancel(list(futures.futures))
-        client.close()
-        if cluster is not None:
-            cluster.close()
-        evals = [r for r in table.rows() if int(r["id"]) not in done]
-        busy = sum(float(r["wall_s"]) for r in evals)
-        info = {"workers": n_workers, "scheduler": scheduler or "local",
-                "evaluations": len(evals), "startup_s": t_ready - t_start,
-                "wall_s": loop_wall, "evaluation_s": busy,
-                "overhead_per_evaluation_s": ((loop_wall * n_workers - busy) / len(evals)
-                                              if evals else None),
-                "complete": bar.done == total}
-        table.record_execution(info)
-    log(f"{len(evals)} evaluations in {loop_wall:.1f} s on {n_workers} workers "
-        f"(cluster start {info['startup_s']:.1f} s; busy {busy:.1f} s, "
-        f"{bar.failed} failed) -> {table.csv}")
+        run = study.run(executor, on_rows=lambda rows: (table.append(rows),
+                                                        bar.update(rows)), on_end=end)
+    log(f"{info['evaluations']} evaluations in {run.wall_s:.1f} s on {executor.workers} "
+        f"workers (cluster start {info['startup_s']:.1f} s; busy "
+        f"{info['evaluation_s']:.1f} s, {bar.failed} failed) -> {table.csv}")
     return table

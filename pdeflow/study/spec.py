@@ -247,6 +247,42 @@ def load_study(path: str | Path) -> StudySpec:
 
 
 def _build(path: Path, text: str, data: dict[str, Any]) -> StudySpec:
+    """The checked study of a parsed study file: its keys, its design, what it runs,
+    its parameters and expressions, its quantities; then every parameter's range is
+    tried on the cases."""
+    st = _study_table(data)
+    design, ints = _design(st)
+    overrides = st.get("set", [])
+    if not isinstance(overrides, list) or not all(isinstance(s, str) for s in overrides):
+        raise StudyError("study.set must be a list of 'section.key=value' strings")
+    case, sweep_case, files = _sources(path, text, data, st, overrides)
+    function = st.get("function")
+    params_raw = data.get("parameters", {})
+    if not params_raw:
+        raise StudyError("[parameters] must name at least one parameter")
+    parameters = [Parameter.parse(k, v) for k, v in params_raw.items()]
+    derived = {k: Expression.parse(f"derived.{k}", v)
+               for k, v in data.get("derived", {}).items()}
+    objectives = {k: Expression.parse(f"objectives.{k}", v)
+                  for k, v in data.get("objectives", {}).items()}
+    if design == "optimize" and not objectives:
+        raise StudyError("the optimize design needs [objectives] (expressions to minimise)")
+    quantities = _quantity_names(st, derived, objectives, function)
+    spec = StudySpec(
+        path=path, text=text, name=str(st.get("name", path.stem)), design=design,
+        parameters=parameters, quantities=tuple(quantities), derived=derived,
+        objectives=objectives, case=case, sweep_case=sweep_case, function=function,
+        case_path=path.parent / st["case"] if "case" in st else None, overrides=overrides,
+        description=str(st.get("description", "")),
+        fingerprint=hashlib.sha256("\0".join(files).encode()).hexdigest(), **ints)
+    if any(q.startswith("sweep.") for q in quantities) and sweep_case is None:
+        raise StudyError("sweep.* quantities need study.sweep_case (a case with [sweep])")
+    _probe_ranges(spec)
+    return spec
+
+
+def _study_table(data: dict[str, Any]) -> dict[str, Any]:
+    """The [study] table, once every section and study key is known."""
     for section in data:
         if section not in SECTIONS:
             raise StudyError(f"unknown section [{section}]; allowed: {sorted(SECTIONS)}")
@@ -254,6 +290,11 @@ def _build(path: Path, text: str, data: dict[str, Any]) -> StudySpec:
     for key in st:
         if key not in STUDY_KEYS:
             raise StudyError(f"unknown key study.{key}; allowed: {sorted(STUDY_KEYS)}")
+    return st
+
+
+def _design(st: dict[str, Any]) -> tuple[str, dict[str, int]]:
+    """study.design and its integers (samples, seed, population, batch), checked."""
     design = st.get("design", "grid")
     if design not in DESIGNS:
         raise StudyError(f"study.design must be one of {', '.join(DESIGNS)}; got "
@@ -270,10 +311,13 @@ def _build(path: Path, text: str, data: dict[str, Any]) -> StudySpec:
     if design == "sobol" and ints["samples"] & (ints["samples"] - 1):
         raise StudyError(f"study.samples must be a power of 2 for the sobol design "
                          f"(Saltelli/Sobol' sequence), got {ints['samples']}")
-    overrides = st.get("set", [])
-    if not isinstance(overrides, list) or not all(isinstance(s, str) for s in overrides):
-        raise StudyError("study.set must be a list of 'section.key=value' strings")
+    return design, ints
 
+
+def _sources(path: Path, text: str, data: dict[str, Any], st: dict[str, Any],
+             overrides: list[str]) -> tuple[Case | None, Case | None, list[str]]:
+    """What the study runs: (base case, sweep case, the texts of the files read); the
+    base case is a file, an inline [base_case] or none (a study.function)."""
     function = st.get("function")
     sources = [k for k in ("case", "function") if k in st] + (
         ["base_case"] if "base_case" in data else [])
@@ -298,18 +342,12 @@ def _build(path: Path, text: str, data: dict[str, Any]) -> StudySpec:
     if "sweep_case" in st:
         sweep_case = _case(path, st["sweep_case"], overrides, "sweep_case")
         files.append((path.parent / st["sweep_case"]).read_text())
+    return case, sweep_case, files
 
-    params_raw = data.get("parameters", {})
-    if not params_raw:
-        raise StudyError("[parameters] must name at least one parameter")
-    parameters = [Parameter.parse(k, v) for k, v in params_raw.items()]
 
-    derived = {k: Expression.parse(f"derived.{k}", v)
-               for k, v in data.get("derived", {}).items()}
-    objectives = {k: Expression.parse(f"objectives.{k}", v)
-                  for k, v in data.get("objectives", {}).items()}
-    if design == "optimize" and not objectives:
-        raise StudyError("the optimize design needs [objectives] (expressions to minimise)")
+def _quantity_names(st: dict[str, Any], derived: dict[str, Expression],
+                    objectives: dict[str, Expression], function: str | None) -> list[str]:
+    """study.quantities and every quantity an expression reads, each checked."""
     listed = st.get("quantities", [])
     if not isinstance(listed, list) or not all(isinstance(q, str) for q in listed):
         raise StudyError("study.quantities must be a list of names")
@@ -330,30 +368,23 @@ def _build(path: Path, text: str, data: dict[str, Any]) -> StudySpec:
             raise StudyError(f"study.quantities: {err}") from None
     if not quantities:
         raise StudyError("study.quantities is empty (and no expression reads a quantity)")
-    spec = StudySpec(
-        path=path, text=text, name=str(st.get("name", path.stem)), design=design,
-        parameters=parameters, quantities=tuple(quantities), derived=derived,
-        objectives=objectives, case=case, sweep_case=sweep_case, function=function,
-        case_path=path.parent / st["case"] if "case" in st else None, overrides=overrides,
-        description=str(st.get("description", "")),
-        fingerprint=hashlib.sha256("\0".join(files).encode()).hexdigest(), **ints)
-    if any(q.startswith("sweep.") for q in quantities) and sweep_case is None:
-        raise StudyError("sweep.* quantities need study.sweep_case (a case with [sweep])")
-    if case is not None or sweep_case is not None:
-        # every key must be a case key that takes every value of its range: try the ends
-        for p in parameters:
-            probes = (p.values if p.kind == "choice" else (p.from_unit(0.0),
-                                                           p.from_unit(1.0)))
-            for value in probes:
-                for base in (case, sweep_case):
-                    if base is None:
-                        continue
-                    if "." not in p.key:
-                        raise StudyError(f"parameters.{p.key!r}: a case key is "
-                                         "'section.key', e.g. 'two_layer.c'")
-                    try:
-                        spec.case_for(base, {p.key: value}, base.models)
-                    except CaseError as err:
-                        raise StudyError(f"parameters.{p.key!r} = {value!r}: {err}") \
-                            from None
-    return spec
+    return quantities
+
+
+def _probe_ranges(spec: StudySpec) -> None:
+    """Every parameter must be a case key that takes every value of its range: try
+    its ends (or each of its values) on the base and the sweep case."""
+    bases = [b for b in (spec.case, spec.sweep_case) if b is not None]
+    if not bases:
+        return
+    for p in spec.parameters:
+        probes = p.values if p.kind == "choice" else (p.from_unit(0.0), p.from_unit(1.0))
+        for value in probes:
+            for base in bases:
+                if "." not in p.key:
+                    raise StudyError(f"parameters.{p.key!r}: a case key is "
+                                     "'section.key', e.g. 'two_layer.c'")
+                try:
+                    spec.case_for(base, {p.key: value}, base.models)
+                except CaseError as err:
+                    raise StudyError(f"parameters.{p.key!r} = {value!r}: {err}") from None

@@ -1,26 +1,16 @@
-"""Studies: runs over a grid of cases, variants and levels, and the table of results.
+"""The points of the analysis studies, and copies of a case on other grids.
 
-Every study of pdeflow is the same three things: a list of :class:`Point` (a case, a
-model, a :class:`~pdeflow.variant.Variant` and the labels that place it in the study:
-level, aspect ratio, ...), a *measure* that turns one point into a row of numbers (it
-builds the point's :class:`~pdeflow.simulate.Run` and executes it, once or repeatedly
-for timings), and an *executor* that maps the measure over the points. Convergence,
-work-precision, validation and aspect-ratio sweeps are thin definitions on it
-(:mod:`pdeflow.analysis.convergence`, :mod:`~pdeflow.analysis.workprecision`,
-:mod:`~pdeflow.analysis.validation`, :mod:`~pdeflow.analysis.sweep`).
-
-Execution is pluggable: an executor is any ``executor(fn, items) -> list`` that returns
-``[fn(item) for item in items]`` in order. :func:`serial` is the default;
-:func:`pool_executor` wraps a ``concurrent.futures`` pool and :func:`dask_executor` a
-Dask client (the study-file engine, :mod:`pdeflow.study`, schedules on Dask the same
-way). A measure must then be a module-level function, so that it pickles.
+A :class:`Point` is one run of a :class:`~pdeflow.study.core.Study`: a case, a model, a
+:class:`~pdeflow.variant.Variant` and the labels that place it in the study (level,
+aspect ratio, ...). Convergence, work-precision, validation and aspect-ratio sweeps
+build their points from a case with the helpers here (:func:`refined`,
+:func:`on_grid`, :func:`case_on_grid`, :func:`with_sets`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -29,23 +19,6 @@ import numpy as np
 from ..cases import Case, load_case
 from ..simulate import Run
 from ..variant import Variant
-
-Executor = Callable[[Callable[[Any], Any], Sequence[Any]], list[Any]]
-
-
-def serial(fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
-    """Run ``fn`` over ``items`` in this process, in order."""
-    return [fn(item) for item in items]
-
-
-def pool_executor(pool: Any) -> Executor:
-    """An executor on a ``concurrent.futures`` pool (results in order)."""
-    return lambda fn, items: list(pool.map(fn, items))
-
-
-def dask_executor(client: Any) -> Executor:
-    """An executor on a Dask ``distributed.Client`` (results in order)."""
-    return lambda fn, items: client.gather(client.map(fn, list(items), pure=False))
 
 
 @dataclass
@@ -117,19 +90,3 @@ def case_on_grid(case: Case, grid: float | int, variant: Variant,
     c.data["grid"].pop("dx", None)
     c.data.get("numerics", {}).pop("dt", None)
     return c.with_variant(variant)  # validates once, with every change made
-
-
-def _row(measure: Callable[[Point], dict[str, Any]], point: Point) -> dict[str, Any]:
-    return {**point.labels, **measure(point)}
-
-
-@dataclass
-class Study:
-    """Points and the measure that turns each into a row of results."""
-
-    points: list[Point]
-    measure: Callable[[Point], dict[str, Any]]
-
-    def execute(self, executor: Executor = serial) -> list[dict[str, Any]]:
-        """The rows ``{**point.labels, **measure(point)}``, in the order of the points."""
-        return executor(partial(_row, self.measure), self.points)

@@ -1,0 +1,66 @@
+"""The initial shapes of case files (``initial.shape``): a total depth on the grid.
+
+Each shape gives the total depth h(x) [m] at the cell centres, x measured from the
+domain's start (on an axisymmetric grid: the radius); the model's system splits it into
+its layers (:attr:`pdeflow.systems.EquationSystem.layer_depths`). ``file`` reads the
+profiles of every layer from an ``.npz`` instead.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+REQUIRED: dict[str, tuple[str, ...]] = {
+    "column": ("L0", "H0"),
+    "dam_break": ("x_dam", "h_left"),
+    "heap": ("center", "height", "slope_deg"),
+    "file": ("path",),
+}
+"""the keys of [initial] each shape needs"""
+SHAPES = tuple(REQUIRED)
+
+
+def total_depth(initial: dict[str, Any], x: np.ndarray) -> np.ndarray:
+    """Total depth [m] of the shape ``initial['shape']`` (not 'file') at ``x`` [m]:
+
+    * ``column``: H0 for x < L0 (a cylinder of radius L0 on an axisymmetric grid);
+    * ``dam_break``: h_left for x < x_dam, h_right (default 0) beyond;
+    * ``heap``: a symmetric triangle of ``height`` with flanks at ``slope_deg`` around
+      ``center`` (a cone about the axis where center = 0 on an axisymmetric grid).
+    """
+    shape = initial["shape"]
+    if shape == "column":
+        return np.where(x < float(initial["L0"]), float(initial["H0"]), 0.0)
+    if shape == "dam_break":
+        return np.where(x < float(initial["x_dam"]), float(initial["h_left"]),
+                        float(initial.get("h_right", 0.0)))
+    if shape == "heap":
+        slope = math.tan(math.radians(float(initial["slope_deg"])))
+        return np.maximum(float(initial["height"])
+                          - slope * np.abs(x - float(initial["center"])), 0.0)
+    raise ValueError(f"initial.shape {shape!r} has no formula; allowed: {list(SHAPES)}")
+
+
+def profiles_from_file(path: Path, keys: tuple[str, ...], n: int,
+                       model: str) -> dict[str, np.ndarray]:
+    """The arrays ``keys`` of the ``.npz`` at ``path``, each of shape (n,); ValueError
+    naming the file and what is wrong."""
+    try:
+        with np.load(path) as data:
+            found = {k: np.asarray(data[k], dtype=float) for k in keys if k in data}
+    except (OSError, ValueError) as err:
+        raise ValueError(f"cannot read initial profile {path}: {err}") from None
+    missing = [k for k in keys if k not in found]
+    if missing:
+        raise ValueError(f"initial profile {path.name} lacks arrays {missing} needed by "
+                         f"the {model} model")
+    out = {k: found[k] for k in keys}
+    for k, v in out.items():
+        if v.shape != (n,):
+            raise ValueError(f"initial profile {path.name}: array {k} has shape "
+                             f"{v.shape}, the grid has ({n},) cells")
+    return out
