@@ -60,7 +60,8 @@ def plot_velocities(ax, x: np.ndarray, runs: Sequence[tuple[str, np.ndarray]]) -
 
 
 def snapshot_figure(x: np.ndarray, t: float, runs: Sequence[tuple[str, np.ndarray]],
-                    fextra: np.ndarray | None, title: str = "") -> Any:
+                    fextra: np.ndarray | None, title: str = "",
+                    coordinate: str = "x") -> Any:
     """Three stacked panels at time t, like the paper's Figs. 3-6: depths and velocities
     of the runs (model name, state data), F_extra/rho1 [m^2/s^2]."""
     fig, axes = plt.subplots(3, 1, figsize=(7, 7.5), sharex=True)
@@ -70,7 +71,7 @@ def snapshot_figure(x: np.ndarray, t: float, runs: Sequence[tuple[str, np.ndarra
     axes[2].set_ylabel(r"$F_{extra}/\rho_1$ [m$^2$/s$^2$]")
     axes[0].legend(loc="upper right", fontsize=8)
     axes[1].legend(loc="upper right", fontsize=8)
-    axes[2].set_xlabel("x [m]")
+    axes[2].set_xlabel(f"{coordinate} [m]")
     for ax in axes:
         ax.grid(alpha=0.3)
     fig.suptitle(f"{title} t = {t:g} s".strip())
@@ -79,12 +80,12 @@ def snapshot_figure(x: np.ndarray, t: float, runs: Sequence[tuple[str, np.ndarra
 
 
 def deposit_figure(x: np.ndarray, runs: Sequence[tuple[str, np.ndarray]],
-                   title: str = "", times: str = "") -> Any:
+                   title: str = "", times: str = "", coordinate: str = "x") -> Any:
     """Final deposits of the runs (model name, state data): the paper's Fig. 7."""
     fig, ax = plt.subplots(figsize=(7, 3.2))
     plot_depths(ax, x, runs)
     ax.legend(loc="upper right", fontsize=8)
-    ax.set_xlabel("x [m]")
+    ax.set_xlabel(f"{coordinate} [m]")
     ax.grid(alpha=0.3)
     ax.set_title(f"{title}: final deposits\n{times}".strip(), fontsize=10)
     fixed_margins(fig, top=0.55)
@@ -99,6 +100,7 @@ def case_figures(results: dict[str, Any], outdir: str | Path, prefix: str = "",
     outdir.mkdir(parents=True, exist_ok=True)
     runs = list(results.values())
     first = runs[0]
+    coordinate = first.pde.metric(first.state.grid).coordinate
     times = sorted(set().union(*(res.snapshots for res in runs)))
     jobs = []
     for t in times:
@@ -107,14 +109,15 @@ def case_figures(results: dict[str, Any], outdir: str | Path, prefix: str = "",
                       None)
         jobs.append((snapshot_figure, (first.x, t, [(res.model, res.snapshots[t][0])
                                                    for res in shown],
-                                       fextra, first.case.name),
+                                       fextra, first.case.name, coordinate),
                      outdir / f"{prefix}snapshot_t{t:g}.png"))
     stop = []
     for res in runs:
         st = res.summary.get("stop_time")
         stop.append(f"{res.model}: t={st:.2f} s" if st else f"{res.model}: moving")
     jobs.append((deposit_figure, (first.x, [(res.model, res.state.data) for res in runs],
-                                  first.case.name, "(" + ", ".join(stop) + ")"),
+                                  first.case.name, "(" + ", ".join(stop) + ")",
+                                  coordinate),
                  outdir / f"{prefix}final_deposits.png"))
     return draw_all(jobs, parallel)
 

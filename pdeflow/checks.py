@@ -209,6 +209,8 @@ def domain_ends(case: Any, initial: np.ndarray, final: np.ndarray,
     lost = -mass_change if mass_change < -1e-9 else 0.0
     sides, reservoirs = [], []
     for (side, i), bc in zip((("left", 0), ("right", -1)), case.bc, strict=True):
+        if side == "left" and case.geometry == "axisymmetric":
+            continue  # the axis is no end of the domain
         if h0[i] > thr:  # material there from the start: a reservoir cut by the end,
             if bc == "open":  # through which mass flows in or out by design
                 reservoirs.append(side)
@@ -220,10 +222,12 @@ def domain_ends(case: Any, initial: np.ndarray, final: np.ndarray,
 
 
 def _end(case: Any, side: str) -> str:
-    """'the open right end (x = 7 m)' or 'the wall at the left end (x = 0 m)'."""
+    """'the open right end (x = 7 m)' or 'the wall at the left end (x = 0 m)' ('r' on an
+    axisymmetric grid)."""
     kind = "open" if case.bc[SIDES.index(side)] == "open" else "wall at the"
     x = case.x_start + (case.length if side == "right" else 0.0)
-    return f"the {kind} {side} end (x = {x:g} m)"
+    coordinate = "r" if case.geometry == "axisymmetric" else "x"
+    return f"the {kind} {side} end ({coordinate} = {x:g} m)"
 
 
 def result_warnings(case: Any, model: str, summary: dict[str, Any]) -> list[str]:

@@ -233,7 +233,7 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
         check_movie_path(args.movie)
     runs = [open_run(p) for p in args.runs]
-    series = [Series(r.x, r.model, lab, r.dry_tolerance)
+    series = [Series(r.x, r.model, lab, r.dry_tolerance, r.coordinate)
               for r, lab in zip(runs, _plot_labels(runs), strict=True)]
     title = args.title if args.title is not None else runs[0].metadata.get(
         "case_name", runs[0].path.stem)

@@ -110,6 +110,8 @@ class Series:
     """legend label (default: the model name)"""
     dry: float = DRY_TOLERANCE
     """the model's dry tolerance [m]: no velocity is drawn where a layer is thinner"""
+    coordinate: str = "x"
+    """name of the grid's coordinate: 'x' (planar) or 'r' (axisymmetric) [m]"""
 
 
 class RunFigure:
@@ -179,12 +181,13 @@ class RunFigure:
         for i, s in enumerate(self.series):
             self._lines.append(self._add_lines(s, filled=i == 0, free=free))
         self.ax_h.set_ylabel("depth normal to bed [m]")
-        self.ax_h.set_xlabel("x [m]")
+        xlabel = f"{self.series[0].coordinate} [m]"
+        self.ax_h.set_xlabel(xlabel)
         if self.ax_u is not None and self.ax_f is not None:
             self.ax_h.set_xlabel("")
             self.ax_u.set_ylabel("velocity [m/s]")
             self.ax_f.set_ylabel(r"$F_{extra}/\rho_1$ [m$^2$/s$^2$]")
-            self.ax_f.set_xlabel("x [m]")
+            self.ax_f.set_xlabel(xlabel)
             if not any(systems.get(s.model).has_fextra for s in self.series):
                 self.ax_f.text(0.5, 0.5, f"{systems.get(self.series[0].model).label}: "
                                "no F_extra", ha="center", va="center",

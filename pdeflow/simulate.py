@@ -192,7 +192,7 @@ def run_model(case: Case, model: str, *, tracker: Any = None,
     return Run(case, model, backend=backend).execute(tracker)
 
 
-_COMMON_KEYS = ("model", "solver", "t_final", "at_rest", "front_position", "runout",
+_COMMON_KEYS = ("model", "solver", "geometry", "t_final", "at_rest", "front_position", "runout",
                 "mass_relative_error", "steps", "wall_time_s", "stop_reason", "stop_time",
                 "max_fextra_over_rho1", "flux_fallback_steps", "mass_change",
                 "runout_lower_bound", "domain_ends", "warnings")
@@ -221,6 +221,7 @@ def summarize(res: RunResult, mass0: float, wall: float,
     out: dict[str, Any] = {
         "model": res.model,
         "solver": case.solver,
+        "geometry": case.geometry,
         "t_final": res.t_final,
         "at_rest": at_rest,
         "front_position": front,
@@ -266,6 +267,10 @@ def print_summary(summary: dict[str, Any], out: Any = None) -> None:
             ("mass error", "mass_relative_error", ""), ("steps", "steps", ""),
             ("wall time", "wall_time_s", " s")]
     models = summary["models"]
+    if any(s.get("geometry") == "axisymmetric" for s in models.values()):
+        # the front and the run-out are radii: R_f and R_f - R0
+        rows = [("front radius" if k == "front_position" else label, k, u)
+                for label, k, u in rows]
     print(f"case {summary['case']}", file=out)
     print(f"{'':18}" + "".join(f"{m:>16}" for m in models), file=out)
     for label, key, unit in rows:

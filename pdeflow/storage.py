@@ -118,6 +118,8 @@ def run_metadata(case: Any, model: str, *, overrides: Sequence[str] = (),
         "cfl": case.cfl,
         "boundaries": list(case.bc),
         "dx": case.dx,
+        "geometry": case.geometry,
+        "coordinate": "r" if case.geometry == "axisymmetric" else "x",
         "pdeflow_version": __version__,
     }
     meta.update(extra)
@@ -303,17 +305,24 @@ class StoredRun:
             cols.append(np.concatenate([p[name] for p in per]))
         return np.column_stack(cols)
 
+    @property
+    def coordinate(self) -> str:
+        """Name of the grid's coordinate: 'x' (planar) or 'r' (axisymmetric) [m]."""
+        return str(self.metadata.get("coordinate", "x"))
+
     def to_csv(self, path: str | Path) -> Path:
-        """Write the long table as CSV (header t,x,...; units in docs/user_guide.md)."""
-        header = ",".join(["t", "x", *self.columns()])
+        """Write the long table as CSV (header t,x,... or t,r,...; units in
+        docs/user_guide.md)."""
+        header = ",".join(["t", self.coordinate, *self.columns()])
         with atomic_path(path) as tmp:
             np.savetxt(tmp, self.table(), delimiter=",", header=header, comments="",
                        fmt="%.10g")
         return Path(path)
 
     def to_npz(self, path: str | Path) -> Path:
-        """Write t, x and each quantity as a (nt, n) array, plus the metadata as JSON."""
-        arrays: dict[str, np.ndarray] = {"t": self.times, "x": self.x}
+        """Write t, the coordinate (x or r) and each quantity as a (nt, n) array, plus the
+        metadata as JSON."""
+        arrays: dict[str, np.ndarray] = {"t": self.times, self.coordinate: self.x}
         per = [self.profiles(i) for i in range(len(self.times))]
         for name in self.columns():
             arrays[name] = np.stack([p[name] for p in per])
@@ -323,14 +332,15 @@ class StoredRun:
         return Path(path)
 
     def to_xarray(self) -> Any:
-        """An ``xarray.Dataset`` with dimensions (t, x); needs xarray."""
+        """An ``xarray.Dataset`` with dimensions (t, x) or (t, r); needs xarray."""
         try:
             import xarray as xr
         except ImportError:
             raise StorageError("exporting to xarray/NetCDF needs xarray: "
                                "pip install 'pdeflow[export]'") from None
         per = [self.profiles(i) for i in range(len(self.times))]
-        data_vars = {name: (("t", "x"), np.stack([p[name] for p in per]),
+        c = self.coordinate
+        data_vars = {name: (("t", c), np.stack([p[name] for p in per]),
                             {"units": units(self.system)[name]}) for name in self.columns()}
         attrs = {"pdeflow_metadata": json.dumps(self.metadata),
                  "model": self.model, "source": str(self.path)}
@@ -339,7 +349,7 @@ class StoredRun:
                 attrs[key] = str(self.metadata[key])
         return xr.Dataset(data_vars,
                           coords={"t": ("t", self.times, {"units": "s"}),
-                                  "x": ("x", self.x, {"units": "m"})},
+                                  c: (c, self.x, {"units": "m"})},
                           attrs=attrs)
 
     def to_netcdf(self, path: str | Path) -> Path:

@@ -139,3 +139,31 @@ def test_axisymmetric_case_files_run_and_check_their_grid(tmp_path):
         load_case(base, [*over, "grid.x_start=1"])
     with pytest.raises(CaseError, match="grid.geometry must be one of"):
         load_case(base, ["grid.geometry='spherical'"])
+
+
+def test_axisymmetric_outputs_name_the_radius(tmp_path):
+    """Through the command line: the table says 'front radius', the stored run exports
+    columns t, r, ..., the figures label r [m], and the axis is no end of the domain
+    (no warning although the column stands on it)."""
+    import subprocess
+    import sys
+
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-m", "pdeflow", "run", str(ROOT / "cases" / "paper_5_1_dam_break.toml"),
+           "--set", "grid.geometry='axisymmetric'", "--set", "grid.length=6",
+           "--set", "grid.dx=0.05", "--set", "boundaries.right='wall'",
+           "--outdir", str(out), "--store", str(tmp_path / "run.h5")]
+    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp_path, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert "front radius" in proc.stdout
+    assert "warning" not in proc.stderr
+    from pdeflow.storage import open_run
+
+    run = open_run(tmp_path / "run.h5")
+    assert run.coordinate == "r" and run.metadata["geometry"] == "axisymmetric"
+    run.to_csv(tmp_path / "run.csv")
+    assert (tmp_path / "run.csv").read_text().splitlines()[0].startswith("t,r,h1,u1")
+    import json
+
+    summary = json.loads((out / "summary.json").read_text())
+    assert {m["geometry"] for m in summary["models"].values()} == {"axisymmetric"}
