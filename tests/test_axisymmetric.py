@@ -167,3 +167,45 @@ def test_axisymmetric_outputs_name_the_radius(tmp_path):
 
     summary = json.loads((out / "summary.json").read_text())
     assert {m["geometry"] for m in summary["models"].values()} == {"axisymmetric"}
+
+
+def _smooth_radial(eq, n: int, t: float = 0.15) -> tuple[np.ndarray, np.ndarray]:
+    """A Gaussian hump of 0.1 m at r = 1 m on a 0.5 m layer (two layers: 0.25 m each,
+    the lower hump half the upper one), frictionless, walls, at t [s]; returns the final
+    state data and the cell volumes."""
+    grid = PolarSymGrid((0, 2.0), n)
+    r = grid.axes_coords[0]
+    hump = 0.1 * np.exp(-((r - 1.0) / 0.2) ** 2)
+    if len(eq.field_names) == 2:
+        state = eq.make_state(grid, h=0.5 + hump)
+    else:
+        state = eq.make_state(grid, h1=0.25 + hump, h2=0.25 + 0.5 * hump)
+    final = eq.solve(state, t_range=t, solver="fv-split", cfl=0.4, tracker=None)
+    return final.data, metric_of(grid).volumes
+
+
+@pytest.mark.parametrize("reconstruction, order", [("first-order", 1.0), ("muscl", 2.0)])
+def test_observed_orders_on_a_smooth_radial_wave(reconstruction, order):
+    """L1 errors of the depths against a 3200-cell reference averaged onto 100, 200 and
+    400 cells (before any shock forms): observed orders within 0.15 of 1 (first order)
+    and 2 (MUSCL, mc limiter) for both models (measured 0.94-1.04 and 2.02)."""
+    frictionless = {"phi_b_deg": 1e-9}
+    models = (pdeflow.SingleLayerGranular(frictionless, bc=("wall", "wall"),
+                                          reconstruction=reconstruction, limiter="mc"),
+              pdeflow.TwoLayerGranular({**frictionless, "phi_int_deg": 1e-9, "k": 0.0,
+                                        "c": 0.0, "exchange_closure": "none"},
+                                       bc=("wall", "wall"), reconstruction=reconstruction,
+                                       limiter="mc"))
+    for eq in models:
+        ref, v_ref = _smooth_radial(eq, 3200)
+        errors = []
+        for n in (100, 200, 400):
+            data, v = _smooth_radial(eq, n)
+            k = 3200 // n
+            err = 0.0
+            for row in range(0, data.shape[0], 2):
+                avg = (ref[row] * v_ref).reshape(n, k).sum(1) / v_ref.reshape(n, k).sum(1)
+                err += float(np.sum(np.abs(data[row] - avg) * v) / np.sum(v))
+            errors.append(err)
+        orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+        assert np.all(np.abs(orders - order) <= 0.15), (type(eq).__name__, orders)
