@@ -202,8 +202,8 @@ def _stop_time(last_moving: float, t_final: float, at_rest: bool) -> float | Non
 
 _COMMON_KEYS = ("model", "solver", "t_final", "at_rest", "front_position", "runout",
                 "mass_relative_error", "steps", "wall_time_s", "stop_reason", "stop_time",
-                "max_fextra_over_rho1", "flux_fallback_steps", "mass_change",
-                "runout_lower_bound", "domain_ends", "warnings")
+                "max_fextra_over_rho1", "flux_fallback_steps", "positivity_retries",
+                "mass_change", "runout_lower_bound", "domain_ends", "warnings")
 SUMMARY_KEYS: dict[str, tuple[str, ...]] = {
     "two_layer": (*_COMMON_KEYS, "lower_stop_time", "upper_stop_time", "lower_slow_time",
                   "upper_slow_time", "max_fextra_x", "max_fextra_time",
@@ -244,6 +244,9 @@ def summarize(res: RunResult, mass0: float, wall: float,
     if diag is not None:
         # steps that IFCP could not keep positive, redone with HLL (0 for other fluxes)
         out["flux_fallback_steps"] = diag.flux_fallbacks
+        # steps rejected by the positivity safety net and redone with dt/2 (see
+        # docs/stability.md): 0 where the scheme kept depths non-negative by itself
+        out["positivity_retries"] = diag.positivity_retries
         tf = res.t_final
         up = _stop_time(diag.last_move_upper, tf, at_rest)
         if res.model == "two_layer":

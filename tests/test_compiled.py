@@ -245,8 +245,9 @@ def test_ready_all_compiles_part_of_the_kernels_in_a_helper_process(tmp_path, th
 
 def test_split_work_keeps_this_process_busy_and_no_fork_beside_threads():
     """The helper gets some kernels, never all, the split nearest HELPER_SHARE of the
-    work: for test 5.1 (both models) the two-layer source stage; with a second thread
-    running nothing is forked."""
+    work (for test 5.1, both models: the two advection stages and the single-layer
+    source stage, which the grown stepping loop made nearer than the two-layer source
+    stage alone); with a second thread running nothing is forked."""
     import itertools
     import threading
 
@@ -256,7 +257,7 @@ def test_split_work_keeps_this_process_busy_and_no_fork_beside_threads():
         scheme_stepper(True, L.FLUX_HLL, 1, L.LIMITER_MINMOD, False).kernels
         + scheme_stepper(False, L.FLUX_HLL, 1, L.LIMITER_MINMOD, False).kernels))
     helper = parallel.split_work(kernels)
-    assert helper == [sources_two_layer]
+    assert 0 < len(helper) < len(kernels) and sources_two_layer not in helper
     total = parallel._work(kernels)
     best = min(abs(parallel._work(side) / total - parallel.HELPER_SHARE)
                for n in range(1, len(kernels))

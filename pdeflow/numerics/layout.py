@@ -58,7 +58,8 @@ D_FLUX_FALLBACKS = 14  #: steps redone with HLL because the IFCP step was not po
 D_HYP_BISECTIONS = 15  #: restorations that needed the bisection fallback (see splitting)
 D_BAD_STEPS = 16  #: steps of a generic py-pde solver that left a non-finite value or a depth
 #: below -1e-12 m, before the post-step hook clipped it (models.base.make_post_step_hook)
-N_DIAG = 17  #: the per-cell F_extra/rho1 of the last step follows at N_DIAG
+D_RETRIES = 17  #: steps rejected (a depth would turn negative) and retried with dt / 2
+N_DIAG = 18  #: the per-cell F_extra/rho1 of the last step follows at N_DIAG
 
 # --- boundary conditions ---------------------------------------------------------------
 BC_WALL = 0
