@@ -158,8 +158,11 @@ class Run:
         if stop.startswith("User interrupted"):
             # py-pde turns Ctrl-C into a normal return; a truncated run must not be
             # written out as if it were complete
-            raise KeyboardInterrupt(f"{model} run of {case.name} interrupted at "
-                                    f"t={info['controller'].get('t_final')}")
+            from .interrupts import RunInterrupted
+
+            t_stop = info["controller"].get("t_final")
+            raise RunInterrupted(f"{model} run of {case.name} interrupted at t={t_stop}",
+                                 t=t_stop)
         sinfo = info.get("solver", {})
         data = sinfo.get("post_step_data")
         if self.variant.is_mol and not np.all(np.isfinite(final.data)):

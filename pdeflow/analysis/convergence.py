@@ -188,6 +188,9 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="override a case value (repeatable)")
     ap.add_argument("--model", default="two_layer", choices=["two_layer", "single_layer"])
     ap.add_argument("--summary", metavar="OUT.json", help="write the results as JSON")
+    ap.add_argument("--force", action="store_true",
+                    help="run even a finest grid estimated beyond a day or half the "
+                    "machine's memory (refused otherwise)")
     ap.add_argument("--all", action="store_true",
                     help="print every quantity (default: stop times, run-out, F_extra, "
                     "wall time)")
@@ -203,6 +206,17 @@ def cmd_converge(args: argparse.Namespace) -> int:
                         f"{args.levels}")
     check_output(args.summary, "--summary")
     case = load_case(args.case, args.set)
+    if not case.data.get("sweep"):
+        from ..sizecheck import check_size
+
+        dx = case.dx / 2 ** (args.levels - 1)
+        remedy = (f"the finest grid (level {args.levels} of --levels {args.levels}, "
+                  f"dx = {dx:.3g} m) is too fine: use fewer --levels")
+        try:
+            finest = refined(case, args.levels - 1)
+        except CaseError as err:  # more memory than the machine has
+            raise CaseError(f"{err}; {remedy}") from None
+        check_size(finest, args.force, remedy)
     load_case_kernels(case, sys.stderr)
     if case.data.get("sweep"):
         res = converge_sweep(case, args.levels, args.model)
@@ -218,3 +232,9 @@ def cmd_converge(args: argparse.Namespace) -> int:
     if args.summary:
         write_json(args.summary, res)
     return 0
+
+
+if __name__ == "__main__":  # python -m: the command's errors and exit codes
+    from pdeflow.cli import module_main
+
+    module_main("converge")

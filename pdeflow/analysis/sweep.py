@@ -199,3 +199,9 @@ def cmd_sweep(args: Any) -> int:
                   f"a^{res['paper_exponent']})   a:r {pts}")
         print(f"wall time {summary['wall_time_s']:.2f} s")
     return 0
+
+
+if __name__ == "__main__":  # python -m: the command's errors and exit codes
+    from pdeflow.cli import module_main
+
+    module_main("sweep")
