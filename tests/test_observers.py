@@ -125,3 +125,37 @@ def test_a_frame_is_the_state_interpolated_between_the_steps_around_its_time():
     r = run.pde.parameters.density_ratio
     m0 = mass(run.state.data, c.dx, r)
     assert abs(mass(frame, c.dx, r) - m0) < 1e-12 * m0
+
+
+def test_a_study_evaluation_and_the_app_give_the_plain_run(plain, tmp_path):
+    """A study point at the case's own parameters, and the app's run with its animation
+    frames (a second run with a frame tracker every t_end/FRAMES_PER_T_END)."""
+    from pdeflow.app.dam_break import simulate
+    from pdeflow.study.evaluate import evaluate
+    from pdeflow.study.spec import load_study
+
+    ref = plain["two_layer"]
+    phi_b = load_case(CASE_51).make_pde("two_layer").parameters.phi_b_deg
+    study = tmp_path / "s.toml"
+    study.write_text(f"""[study]
+name = "observers"
+case = "{CASE_51}"
+set = ["grid.dx=0.1"]
+design = "grid"
+quantities = ["two_layer.stop_time", "two_layer.max_fextra_over_rho1",
+              "two_layer.steps", "two_layer.runout"]
+
+[parameters]
+"two_layer.phi_b_deg" = {{ values = [{phi_b!r}] }}
+""")
+    spec = load_study(study)
+    row = evaluate(spec, 0, {"two_layer.phi_b_deg": phi_b})
+    assert row["status"] == "ok", row
+    for key in ("stop_time", "max_fextra_over_rho1", "steps", "runout"):
+        assert row[f"two_layer.{key}"] == ref[key], key
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        app = simulate(case(), CASE_51, SMALL, frames=True)
+    assert len(app.times) > 10  # the animation was recorded (its own runs)
+    for model, res in app.results.items():
+        assert numbers(res.summary) == plain[model], model

@@ -4,9 +4,9 @@ Every change runs each model of the case twice with :func:`pdeflow.simulate.run_
 once exactly as ``pdeflow run`` does (the summary table, the same numbers as the command
 line printed under it, and the final state: these go to the browser at once), and then
 once with a :class:`~pdeflow.trackers.FextraStorageTracker` that records the frames of the
-animation. The solver lands on every frame time, so those frames come from a run whose
-steps differ a little from the first (by the order of the discretisation error, as any
-tracker's: docs/user_guide.md); the numbers and the last frame never come from it.
+animation. Observers do not change the solver's steps (frames are interpolated between
+them, docs/user_guide.md), so that run takes the same steps as the first; the numbers and
+the last frame still come from the first.
 Depths in m, velocities in m/s, F_extra/rho1 in m^2/s^2, times in s.
 """
 
