@@ -19,13 +19,14 @@ class OutputError(ValueError):
 
 
 def check_output(path: str | Path | None, option: str) -> None:
-    """Raise :class:`OutputError` unless a file can be written at ``path``: the
-    directory it goes into exists (as ``cp`` does: a mistyped path must not create
-    directories anywhere) and takes files, and ``path`` is not a directory (see
-    :func:`pdeflow.outpaths.check_file`, which also checks suffixes)."""
-    from .outpaths import check_file
-
-    check_file(path, option)
+    """Raise :class:`OutputError` unless the directory that ``path`` goes into exists
+    (as ``cp`` does: a mistyped path must not create directories anywhere)."""
+    if path is None:
+        return
+    parent = Path(path).expanduser().parent
+    if not parent.is_dir():
+        raise OutputError(f"{option} {path}: directory {parent} does not exist (create it "
+                          "first)")
 
 
 class PendingFile:

@@ -130,7 +130,7 @@ def test_a_signal_ends_the_run_with_one_line_and_no_files(sig, tmp_path):
     tracker attached): one line, exit 130, and no file at all, hidden or not."""
     out = tmp_path / "out"
     out.mkdir()
-    cmd = [sys.executable, "-m", "pdeflow", "run", str(CASE_51), "--set", "grid.dx=0.0025",
+    cmd = [sys.executable, "-m", "pdeflow", "run", str(CASE_51), "--set", "grid.dx=0.0005",
            "--set", "case.t_end=30", "--store", str(out / "run.h5"), "--summary",
            str(out / "s.json"), "--no-progress"]
     proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,

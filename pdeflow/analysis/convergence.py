@@ -226,14 +226,15 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
 
 
 def cmd_converge(args: argparse.Namespace) -> int:
-    from ..io import check_output, write_json
+    from ..io import write_json
+    from ..outpaths import check_file
 
     if not args.case:
         raise CaseError("pdeflow converge: a case file is required")
     if args.levels < 2:
         raise CaseError(f"--levels must be an integer >= 2 (the number of grids), got "
                         f"{args.levels}")
-    check_output(args.summary, "--summary")
+    check_file(args.summary, "--summary", (".json",))
     case = load_case(args.case, args.set)
     if not case.data.get("sweep"):
         from ..sizecheck import check_size

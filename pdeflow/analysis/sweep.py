@@ -179,9 +179,10 @@ def add_arguments(ap: Any) -> None:
 def cmd_sweep(args: Any) -> int:
     """``pdeflow sweep``: run the sweep described by parsed ``args``; print the fits."""
     from .. import io
+    from ..outpaths import FIGURE_SUFFIXES, check_file
 
-    io.check_output(args.summary, "--summary")
-    io.check_output(args.plot, "--plot")
+    check_file(args.summary, "--summary", (".json",))
+    check_file(args.plot, "--plot", FIGURE_SUFFIXES)
     case = load_case(args.case, args.set)
     sweep_ratios(case)  # before any run
     load_case_kernels(case, None if args.quiet else sys.stderr)

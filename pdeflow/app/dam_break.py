@@ -4,9 +4,11 @@ Every change runs each model of the case twice with :func:`pdeflow.simulate.run_
 once exactly as ``pdeflow run`` does (the summary table, the same numbers as the command
 line printed under it, and the final state: these go to the browser at once), and then
 once with a :class:`~pdeflow.trackers.FextraStorageTracker` that records the frames of the
-animation. Observers do not change the solver's steps (frames are interpolated between
-them, docs/user_guide.md), so that run takes the same steps as the first; the numbers and
-the last frame still come from the first.
+animation. Observers do not change the solver's steps (docs/user_guide.md), so that run
+takes the same steps as the first; its frames are the states after the first step at or
+past each frame time, at their true times (fv-split's ``outputs="step"``: states of the
+scheme, hyperbolic after the restoration); the numbers and the last frame come from the
+first run.
 Depths in m, velocities in m/s, F_extra/rho1 in m^2/s^2, times in s.
 """
 
@@ -28,7 +30,7 @@ from bokeh.plotting import figure
 from ..cases import Case, CaseError
 from ..numerics.state import velocity_profile
 from ..plotting import DRY
-from ..simulate import RunResult, print_summary, run_model
+from ..simulate import Run, RunResult, print_summary, run_model
 from ..solvers.fv_split import SimulationBlowUp
 from ..trackers import FextraStorageTracker
 from .controls import ParameterControls, command_line, list_cases, served
@@ -87,7 +89,13 @@ def _frames(case: Case, model: str) -> list[tuple[float, np.ndarray, np.ndarray]
     c.data.setdefault("output", {})["snapshot_times"] = []
     c.validate()
     snaps = FextraStorageTracker(case.t_end / FRAMES_PER_T_END)
-    run_model(c, model, tracker=snaps)
+    run = Run(c, model)
+    kwargs = run.solver_arguments()
+    if kwargs["solver"] == "fv-split":
+        # frames that are states of the scheme (the hyperbolicity page shows a cell
+        # after its restoration), at the true time of the first step past each time
+        kwargs["outputs"] = "step"
+    run.pde.solve(run.state, t_range=c.t_end, tracker=[snaps], **kwargs)
     return [(t, d, f) for t, (d, f) in sorted(snaps.snapshots.items())]
 
 

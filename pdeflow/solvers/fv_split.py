@@ -220,7 +220,8 @@ class FVSplitSolver(SolverBase):
 
     def __init__(self, pde: GranularPDE, *, backend: str = "numba", cfl: float = 0.3,
                  splitting: str = "lie", stop_at_rest: bool = True,
-                 max_steps: int = 100_000_000, t_end: float | None = None):
+                 max_steps: int = 100_000_000, t_end: float | None = None,
+                 outputs: str = "interpolate"):
         """
         Args:
             pde: a :class:`~pdeflow.models.TwoLayerGranular` or
@@ -239,6 +240,11 @@ class FVSplitSolver(SolverBase):
                 it and returns the state interpolated at that time (see
                 :mod:`pdeflow.solvers.outputs`), so that observers do not change the
                 steps. None: every call's end shortens the step (py-pde's behaviour).
+            outputs: what such a call returns: 'interpolate' (the state at the
+                requested time, interpolated between the steps around it) or 'step'
+                (the state after the first step that reaches it, at its true time: a
+                state of the scheme, with every property the scheme gives its states,
+                e.g. hyperbolicity after the restoration). Neither changes the steps.
         """
         if not isinstance(pde, GranularPDE):
             raise TypeError("fv-split solves pdeflow's granular models only")
@@ -255,6 +261,9 @@ class FVSplitSolver(SolverBase):
         self.stop_at_rest = bool(stop_at_rest)
         self.max_steps = int(max_steps)
         self.t_end = None if t_end is None else float(t_end)
+        if outputs not in ("interpolate", "step"):
+            raise ValueError(f"outputs must be 'interpolate' or 'step', got {outputs!r}")
+        self.outputs = outputs
         self.diagnostics: np.ndarray | None = None
 
     def make_stepper(self, state: Any, dt: float | None = None):
@@ -324,7 +333,7 @@ class FVSplitSolver(SolverBase):
             self.info["dt"] = float(diag[L.D_DT]) or None
             if status == STATUS_FAIL:
                 self._blowup(state, entry, t_start, t, t_run, replay)
-            if t > t_pause and t < t_run:
+            if t_pause < t < t_run and self.outputs == "interpolate":
                 # the step went past the output time: output the state at that time,
                 # continue from the step's end at the next call
                 dt = float(diag[L.D_DT]) * (2.0 if self.splitting == "strang" else 1.0)
