@@ -15,6 +15,7 @@ import pytest
 from pdeflow.cases import load_case
 from pdeflow.cli import main
 from pdeflow.simulate import Run, run_model
+from pdeflow.solvers.fv_split import FVSplitSolver
 from pdeflow.trackers import FextraStorageTracker, ProgressBar
 
 ROOT = Path(__file__).parents[1]
@@ -96,7 +97,7 @@ def test_a_frame_is_the_state_interpolated_between_the_steps_around_its_time():
     """The frame at 0.5 s: the linear interpolation, at exactly 0.5 s, of the states of
     the unshortened run before and after the step across 0.5 s (found by running the
     stepping loop to the first step that reaches 0.5 s)."""
-    from pdeflow.solvers.fv_split import FVSplitSolver
+
 
     c = case("output.snapshot_times=[0.5]", "case.t_end=1.0")
     with warnings.catch_warnings():
@@ -159,3 +160,27 @@ quantities = ["two_layer.stop_time", "two_layer.max_fextra_over_rho1",
     assert len(app.times) > 10  # the animation was recorded (its own runs)
     for model, res in app.results.items():
         assert numbers(res.summary) == plain[model], model
+
+
+def test_step_outputs_are_states_of_the_unshortened_run():
+    """outputs='step': each frame is the state after the first step that reaches the
+    requested time, at its true time; the final state is the plain run's, bit for bit."""
+    c = case("output.snapshot_times=[]", "case.t_end=1.0")
+    run = Run(c, "two_layer")
+    ref = run.pde.solve(run.state, t_range=1.0, solver="fv-split", cfl=c.cfl, tracker=None)
+    frames = FextraStorageTracker([0.25, 0.5])
+    final = run.pde.solve(run.state, t_range=1.0, solver="fv-split", cfl=c.cfl,
+                          tracker=[frames], outputs="step")
+    np.testing.assert_array_equal(final.data, ref.data)
+    times = sorted(frames.snapshots)
+    assert len(times) == 2 and 0.25 < times[0] < 0.26 and 0.5 < times[1] < 0.51
+    # the frame at 0.5+ is the unshortened run stopped after the same number of steps
+    again = Run(c, "two_layer")
+    state = again.state.copy()
+    solver = FVSplitSolver(again.pde, cfl=c.cfl, max_steps=1)
+    stepper = solver.make_stepper(state)
+    t = 0.0
+    while t < 0.5:
+        t = stepper(state, t, 1.0)
+    assert round(t, 9) == times[1]
+    np.testing.assert_array_equal(frames.snapshots[times[1]][0], state.data)
