@@ -97,8 +97,6 @@ def test_a_frame_is_the_state_interpolated_between_the_steps_around_its_time():
     """The frame at 0.5 s: the linear interpolation, at exactly 0.5 s, of the states of
     the unshortened run before and after the step across 0.5 s (found by running the
     stepping loop to the first step that reaches 0.5 s)."""
-
-
     c = case("output.snapshot_times=[0.5]", "case.t_end=1.0")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
