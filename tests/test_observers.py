@@ -182,3 +182,18 @@ def test_step_outputs_are_states_of_the_unshortened_run():
         t = stepper(state, t, 1.0)
     assert round(t, 9) == times[1]
     np.testing.assert_array_equal(frames.snapshots[times[1]][0], state.data)
+
+
+def test_an_output_time_inside_the_step_that_comes_to_rest(plain):
+    """A snapshot asked for within the last step (the one after which everything is at
+    rest): it is recorded, and the run still ends at rest at the plain run's time."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ref = run_model(case("output.snapshot_times=[]"), "two_layer")
+        t_rest, dt = ref.t_final, ref.diagnostics.dt
+        t_snap = round(t_rest - 0.5 * dt, 9)
+        res = run_model(case(f"output.snapshot_times=[{t_snap!r}]"), "two_layer")
+    assert res.summary["at_rest"] and res.t_final == t_rest
+    assert numbers(res.summary) == plain["two_layer"]
+    assert list(res.snapshots) == [t_snap]
+    assert np.all(res.snapshots[t_snap][0][::2] >= 0)

@@ -316,17 +316,9 @@ class FVSplitSolver(SolverBase):
         def stepper(state: Any, t_start: float, t_end: float) -> float:
             t_pause = float(t_end)
             t_run = t_pause if self.t_end is None else max(self.t_end, t_pause)
-            if ahead:
-                if t_pause < ahead[0].t:  # another output time within the same step
-                    ahead[0].interpolate(state.data, t_pause)
-                    return t_pause
-                step = ahead.pop()
-                state.data[...] = step.q
-                t_start = step.t
-                if step.at_rest:
-                    self._at_rest(t_start)
-                if t_start >= t_pause:
-                    return t_start
+            done, t_start = self._resume(ahead, state, float(t_start), t_pause)
+            if done:
+                return t_start
             entry = state.data.copy()
             t, steps, status = advance(state.data, float(t_start), t_pause, t_run)
             self.info["steps"] += int(steps)
@@ -346,6 +338,23 @@ class FVSplitSolver(SolverBase):
             return float(t)
 
         return stepper
+
+    def _resume(self, ahead: list[StepAhead], state: Any, t_start: float,
+                t_pause: float) -> tuple[bool, float]:
+        """After an interpolated output (``ahead`` holds the step past it): ``(True,
+        t)`` if the call to ``t_pause`` [s] is answered from it (another output time
+        within the same step, or its end), else ``(False, t)`` with the step's end
+        restored as the state at ``t``; ``(False, t_start)`` if nothing is ahead."""
+        if not ahead:
+            return False, t_start
+        if t_pause < ahead[0].t:  # another output time within the same step
+            ahead[0].interpolate(state.data, t_pause)
+            return True, t_pause
+        step = ahead.pop()
+        state.data[...] = step.q
+        if step.at_rest:
+            self._at_rest(step.t)
+        return step.t >= t_pause, step.t
 
     def _at_rest(self, t: float) -> None:
         """End the run: everything is at rest from ``t`` [s] on."""
