@@ -47,12 +47,14 @@ def plain() -> dict[str, dict]:
 
 
 def test_cli_observers_do_not_change_the_summary(plain, tmp_path):
-    """--progress, --store (every 0.05 s) and live frames (every 0.3 s) attached."""
+    """--progress, --store (every 0.05 s), live frames and a movie (every 0.3 s)."""
     out = tmp_path / "s.json"
     assert main(["run", str(CASE_51), *sum((["--set", s] for s in SMALL), []),
                  "--summary", str(out), "-q", "--progress", "--store",
                  str(tmp_path / "r.h5"), "--store-every", "0.05", "--frames",
-                 str(tmp_path / "frames"), "--live-every", "0.3"]) == 0
+                 str(tmp_path / "frames"), "--movie", str(tmp_path / "m.gif"),
+                 "--live-every", "0.3"]) == 0
+    assert (tmp_path / "m.gif").stat().st_size > 0
     models = json.loads(out.read_text())["models"]
     for model, s in models.items():
         assert numbers(s) == plain[model], model
