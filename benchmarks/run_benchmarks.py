@@ -39,6 +39,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 sys.path.insert(0, str(ROOT))
 
 import cold_start  # noqa: E402
+import geometry_cost  # noqa: E402
 import study_scaling  # noqa: E402
 import suite  # noqa: E402
 
@@ -225,7 +226,8 @@ def _best(rows: list[dict[str, Any]], model: str) -> str:
 
 def render(wp: dict[str, Any] | None, bench: dict[str, Any] | None,
            studies: dict[str, Any] | None = None,
-           cold: dict[str, Any] | None = None) -> str:
+           cold: dict[str, Any] | None = None,
+           geometry: dict[str, Any] | None = None) -> str:
     """docs/performance.md from the stored measurements."""
     L: list[str] = []
     a = L.append
@@ -272,6 +274,8 @@ def render(wp: dict[str, Any] | None, bench: dict[str, Any] | None,
         a(_render_bench(bench))
     if cold:
         a(cold_start.render(cold))
+    if geometry:
+        a(geometry_cost.render(geometry))
     if studies:
         a(f"Studies conditions: {_cond(studies['conditions'])}.\n")
         a(study_scaling.render(studies))
@@ -606,7 +610,8 @@ def _findings(wp: dict[str, Any] | None, b: dict[str, Any] | None) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--only", choices=("wp", "bench", "studies", "cold"), default=None)
+    p.add_argument("--only", choices=("wp", "bench", "studies", "cold", "geometry"),
+                   default=None)
     p.add_argument("--label", default="after",
                    help="name of the cold-start measurement (e.g. before, after)")
     p.add_argument("--tree", default=str(ROOT),
@@ -630,6 +635,7 @@ def main(argv: list[str] | None = None) -> int:
     wp_path, bench_path = results / "workprecision.json", results / "bench.json"
     studies_path = results / "studies.json"
     cold_path = results / "cold_start.json"
+    geometry_path = results / "geometry.json"
     if not args.render:
         import pyclaw_run
 
@@ -648,6 +654,9 @@ def main(argv: list[str] | None = None) -> int:
             c[args.label] = cold_start.measure(max(3, repeats // 2 + 1), Path(args.tree),
                                                log=sys.stderr, commit_id=args.commit)
             cold_path.write_text(json.dumps(c, indent=1, default=str))
+        if args.only in (None, "geometry"):
+            geometry_path.write_text(json.dumps(geometry_cost.measure(max(repeats, 7)),
+                                                indent=1, default=str))
         if args.only in (None, "wp"):
             w = measure_wp(args.quick, max(3, repeats) if not args.quick else repeats,
                            results)
@@ -656,7 +665,8 @@ def main(argv: list[str] | None = None) -> int:
     bench = json.loads(bench_path.read_text()) if bench_path.exists() else None
     studies = json.loads(studies_path.read_text()) if studies_path.exists() else None
     cold = json.loads(cold_path.read_text()) if cold_path.exists() else None
-    Path(doc).write_text(render(wp, bench, studies, cold))
+    geometry = json.loads(geometry_path.read_text()) if geometry_path.exists() else None
+    Path(doc).write_text(render(wp, bench, studies, cold, geometry))
     _log(f"written {doc}")
     return 0
 

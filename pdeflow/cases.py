@@ -47,7 +47,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from . import systems
-from .initial_shapes import REQUIRED, SHAPES, profiles_from_file, total_depth
+from .initial_shapes import SHAPES, check_initial, profiles_from_file, total_depth
 from .models.base import check_range
 from .numerics.layout import GEOMETRIES
 from .variant import Variant, VariantError, variant_of
@@ -57,6 +57,8 @@ PAPER_MODEL = "two_layer"
 BASELINE_MODEL = "single_layer"
 """the registered name of the single-layer Coulomb baseline (exact solutions are its)"""
 DEFAULT_MODELS = [PAPER_MODEL]
+FRAMES = ("interpolate", "step")
+"""output.frames choices (see :attr:`Case.frames`)"""
 """case.models when a case names none"""
 
 SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
@@ -73,7 +75,8 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
     "numerics": {"solver": (str,), "cfl": (float, int), "dt": (float, int),
                  "flux": (str,), "reconstruction": (str,), "limiter": (str,),
                  "splitting": (str,)},
-    "output": {"snapshot_times": (list,), "front_threshold": (float, int)},
+    "output": {"snapshot_times": (list,), "front_threshold": (float, int),
+               "frames": (str,)},
     "sweep": {"aspect_ratios": (list,)},
 }
 
@@ -184,6 +187,9 @@ class Case:
         except ValueError as err:
             raise self._err(str(err)) from None
         self._check_geometry()
+        if self.frames not in FRAMES:
+            raise self._err(f"output.frames must be one of {list(FRAMES)}, got "
+                            f"{self.frames!r}")
         for side in ("left", "right"):
             bc = self.data.get("boundaries", {}).get(side, "wall" if side == "left"
                                                       else "open")
@@ -245,36 +251,10 @@ class Case:
                     f"(0, {self.length:g}] m with length/dx an integer, or grid.cells")
 
     def _check_initial(self) -> None:
-        ini = self.initial
-        shape = ini["shape"]
-        for key in REQUIRED[shape]:
-            if key not in ini:
-                raise self._err(f"initial.{key} is required for shape {shape!r}")
         try:
-            for key in ("L0", "H0", "height"):
-                if key in ini:
-                    check_range(f"initial.{key}", ini[key], 0, math.inf, low_open=True,
-                                unit="m")
-            for key in ("h_left", "h_right"):
-                if key in ini:
-                    check_range(f"initial.{key}", ini[key], 0, math.inf, unit="m")
-            if "wedge_angle_deg" in ini:
-                check_range("initial.wedge_angle_deg", ini["wedge_angle_deg"], 0, 90,
-                            low_open=True, high_open=True, unit="deg")
-            if "slope_deg" in ini:
-                check_range("initial.slope_deg", ini["slope_deg"], 0, 90,
-                            low_open=True, high_open=True, unit="deg")
-            if "upper_fraction" in ini:
-                check_range("initial.upper_fraction", ini["upper_fraction"], 0, 1)
+            check_initial(self.initial, self.length, self.base_dir)
         except ValueError as err:
             raise self._err(str(err)) from None
-        if shape == "column" and ini["L0"] > self.length:
-            raise self._err(f"initial.L0 = {ini['L0']:g} m is longer than the domain "
-                            f"(grid.length = {self.length:g} m): the column must lie in "
-                            f"(0, {self.length:g}] m; lengthen the domain or shorten the column")
-        if shape == "file" and not (self.base_dir / ini["path"]).is_file():
-            raise self._err(f"initial.path: file {ini['path']} not found next to "
-                            "the case file")
 
     # --- accessors ------------------------------------------------------------------------
     def _get(self, section: str, key: str, default: Any) -> Any:
@@ -343,6 +323,14 @@ class Case:
     @property
     def snapshot_times(self) -> list[float]:
         return [float(t) for t in self._get("output", "snapshot_times", [])]
+
+    @property
+    def frames(self) -> str:
+        """What a snapshot at time t holds (fv-split): 'interpolate' (the state at t,
+        linear between the steps around it; the default) or 'step' (the state after the
+        first step at or past t, at its own time: a state of the scheme, e.g.
+        hyperbolic after the restoration)."""
+        return self._get("output", "frames", "interpolate")
 
     @property
     def front_threshold(self) -> float:

@@ -1,4 +1,4 @@
-"""Command line: ``pdeflow run | plot | export`` (``pdeflow COMMAND --help`` for each).
+"""Command line: ``pdeflow run | plot | export | ...`` (``pdeflow COMMAND --help``).
 
 Each subcommand is a function ``cmd_<name>(args) -> exit code`` and its options are set
 up in :func:`build_parser`; errors in the user's input (case files, stored runs, movie
@@ -29,21 +29,6 @@ examples:
   pdeflow run cases/ritter_dam_break.toml --live            # desktop window
   pdeflow run cases/paper_5_1_dam_break.toml --movie 5_1.mp4 --store 5_1.h5
   pdeflow plot 5_1.h5 5_1.single_layer.h5 --time 0.4 --out t04.png"""
-
-PLOT_HELP = """Plot stored runs (written by `pdeflow run --store`) at one time, or as a movie.
-
-The first run is drawn filled (layers stacked on the bed), further runs as lines on
-top, for comparison: e.g. the two-layer and single-layer runs of one case, or two
-parameter sets. Each run is shown at its stored time nearest to --time (default: its
-last frame, the final state). A short description of each file is printed."""
-
-EXPORT_HELP = """Export a stored run to CSV, NumPy .npz or NetCDF (chosen by the suffix).
-
-CSV: one row per (time, cell), columns t [s], x [m], h1, u1, h2, u2 [m, m/s] and
-fextra_over_rho1 [m^2/s^2] (two layers) or h, u (one layer). NPZ: arrays t, x and
-each quantity as (time, cell), plus the metadata as JSON. NetCDF needs xarray
-(pip install 'pdeflow[export]'); the metadata goes into its attributes."""
-
 
 def _model_path(path: str | Path, model: str, first: bool) -> Path:
     """Per-model output name: PATH for the first model, NAME.<model>.SUFFIX after it."""
@@ -99,17 +84,34 @@ def _import_plotting() -> None:
     from . import plotting  # noqa: F401
 
 
-def cmd_run(args: argparse.Namespace) -> int:
-    from .cases import load_case
-    from .io import check_output, write_json, write_npz
-    from .numerics.warmup import prepare
-    from .simulate import case_steppers, print_summary, run_model
+def _load_run_case(args: argparse.Namespace) -> Any:
+    """The case of ``pdeflow run``; a study file is pointed to ``pdeflow study``."""
+    import tomllib
 
-    case = load_case(args.case, args.set)
-    for name in ("live_every", "store_every", "fps"):
-        _positive(f"--{name.replace('_', '-')}", getattr(args, name))
-    for name in ("summary", "final", "plot", "outdir", "store", "movie", "frames"):
-        check_output(getattr(args, name), f"--{name}")
+    from .cases import CaseError, load_case
+
+    try:
+        with open(args.case, "rb") as fh:
+            is_study = "study" in tomllib.load(fh)
+    except (OSError, tomllib.TOMLDecodeError):
+        is_study = False  # load_case says what is wrong with the file
+    if is_study:
+        raise CaseError(f"{args.case} is a study file ([study]): run it with "
+                        f"`pdeflow study {args.case}`")
+    return load_case(args.case, args.set)
+
+
+def _check_run_outputs(args: argparse.Namespace, outdir: Path | None) -> None:
+    """Every output of ``pdeflow run`` can be written, checked before the run."""
+    from .outpaths import FIGURE_SUFFIXES, check_dir, check_file
+
+    check_file(args.summary, "--summary", (".json",))
+    check_file(args.final, "--final", (".npz",))
+    check_file(args.plot, "--plot", FIGURE_SUFFIXES)
+    check_file(args.store, "--store", (".h5", ".hdf5"))
+    check_file(args.movie, "--movie")
+    check_dir(args.frames, "--frames")
+    check_dir(outdir, "--outdir", create=not args.outdir)
     if args.movie:
         from .trackers.live import check_movie_path
 
@@ -118,23 +120,28 @@ def cmd_run(args: argparse.Namespace) -> int:
         from .storage import require_h5py
 
         require_h5py()
-    live_window = False
-    if args.live:
-        from .trackers.live import display_mode
 
-        live_window = display_mode("auto") == "window"
-        if display_mode("auto") == "none":
-            print("pdeflow: warning: --live needs a display (matplotlib backend "
-                  "is non-interactive); use --movie or --frames on a headless machine",
-                  file=sys.stderr)
-    default_out = not (args.summary or args.final or args.plot or args.outdir
-                       or args.store or args.movie or args.frames)
-    outdir = Path(args.outdir) if args.outdir else (
-        Path("results") / case.name if default_out else None)
-    # matplotlib's import (~0.5 s) fills the wait for the kernels a helper compiles
-    prepare(case_steppers(case), log=None if args.quiet else sys.stderr,
-            meanwhile=_import_plotting if args.plot or outdir else None)
-    results = {}
+
+def _live_window(args: argparse.Namespace) -> bool:
+    """Whether ``--live`` opens a window (it warns on a headless machine)."""
+    if not args.live:
+        return False
+    from .trackers.live import display_mode
+
+    if display_mode("auto") == "none":
+        print("pdeflow: warning: --live needs a display (matplotlib backend "
+              "is non-interactive); use --movie or --frames on a headless machine",
+              file=sys.stderr)
+    return display_mode("auto") == "window"
+
+
+def _run_models(args: argparse.Namespace, case: Any) -> tuple[dict, dict, list]:
+    """Run every model with the trackers the options ask for: (results, storage
+    trackers by model, all trackers). Nothing of a failed or interrupted run stays."""
+    from .interrupts import SignalCheck
+    from .simulate import run_model
+
+    results: dict[str, Any] = {}
     stores: dict[str, Any] = {}
     all_trackers: list[Any] = []
     if args.live or args.movie or args.frames:
@@ -148,24 +155,26 @@ def cmd_run(args: argparse.Namespace) -> int:
             for t in trackers:
                 if hasattr(t, "commit"):
                     stores[model] = t
-            results[model] = run_model(case, model, tracker=trackers or None)
+            # a signal is handled within a second (observers do not change the run)
+            results[model] = run_model(case, model, tracker=[*trackers, SignalCheck()])
     except BaseException:
         for t in all_trackers:  # no partial movie or storage file stays behind
             if hasattr(t, "discard"):
                 t.discard()
         raise
-    summary = {
-        "case": case.name,
-        "case_file": str(args.case),
-        "overrides": args.set,
-        "pdeflow_version": __version__,
-        "parameters": {m: case.make_pde(m).parameters.to_dict() for m in case.models},
-        "models": {m: r.summary for m, r in results.items()},
-    }
-    written = []
+    return results, stores, all_trackers
+
+
+def _write_run_outputs(args: argparse.Namespace, case: Any, summary: dict,
+                       results: dict, stores: dict, trackers: list,
+                       outdir: Path | None) -> list[Any]:
+    """Write (commit) every output of ``pdeflow run``; returns what was written."""
+    from .io import write_json, write_npz
+
+    written: list[Any] = []
     for model, tracker in stores.items():
         written.append(tracker.commit({"summary": summary["models"][model]}))
-    for t in all_trackers:
+    for t in trackers:
         if getattr(t, "movie", None) is not None:
             written.append(t.movie.path)
         if getattr(t, "frames_dir", None) is not None and t.frame_paths:
@@ -176,15 +185,56 @@ def cmd_run(args: argparse.Namespace) -> int:
         for i, m in enumerate(case.models):
             written.append(write_npz(_model_path(args.final, m, i == 0),
                                      results[m].final_arrays()))
-    if args.plot or outdir:
-        from .case_figures import case_figures, deposit_figure
-        from .plotting import save
     if args.plot:
+        from .case_figures import deposit_figure
+        from .plotting import save
+
         runs = list(results.values())
-        fig = deposit_figure(runs[0].x, [(r.model, r.state.data) for r in runs], case.name)
+        coordinate = runs[0].pde.metric(runs[0].state.grid).coordinate
+        fig = deposit_figure(runs[0].x, [(r.model, r.state.data) for r in runs], case.name,
+                             coordinate=coordinate)
         written.append(save(fig, args.plot))
     if outdir:
+        from .case_figures import case_figures
+
         written.extend(case_figures(results, outdir))
+    return written
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from .interrupts import deferred_signals
+    from .numerics.warmup import prepare
+    from .simulate import case_steppers, print_summary
+    from .sizecheck import check_size
+
+    case = _load_run_case(args)
+    for name in ("live_every", "store_every", "fps"):
+        _positive(f"--{name.replace('_', '-')}", getattr(args, name))
+    default_out = not (args.summary or args.final or args.plot or args.outdir
+                       or args.store or args.movie or args.frames)
+    outdir = Path(args.outdir) if args.outdir else (
+        Path("results") / case.name if default_out else None)
+    _check_run_outputs(args, outdir)
+    check_size(case, args.force, "use a coarser grid (--set grid.dx=...)")
+    live_window = _live_window(args)
+    # matplotlib's import (~0.5 s) fills the wait for the kernels a helper compiles
+    prepare(case_steppers(case), log=None if args.quiet else sys.stderr,
+            meanwhile=_import_plotting if args.plot or outdir else None)
+    results, stores, trackers = _run_models(args, case)
+    summary = {
+        "case": case.name,
+        "case_file": str(args.case),
+        "overrides": args.set,
+        "pdeflow_version": __version__,
+        "parameters": {m: case.make_pde(m).parameters.to_dict() for m in case.models},
+        "models": {m: r.summary for m, r in results.items()},
+    }
+    with deferred_signals() as came:  # the results are written completely, or not
+        written = _write_run_outputs(args, case, summary, results, stores, trackers,
+                                     outdir)
+    if came:
+        print("pdeflow: interrupted after the results were written", file=sys.stderr)
+        return 130
     if not args.quiet:
         print_summary(summary)
         for p in written:
@@ -198,111 +248,13 @@ def cmd_run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _plot_labels(runs: list[Any]) -> list[str]:
-    """Legend names of stored runs: none where their models differ (the model names
-    them), else the file names (their paths where the names repeat)."""
-    if len({r.model for r in runs}) == len(runs):
-        return [""] * len(runs)
-    if len({r.path.stem for r in runs}) == len(runs):
-        return [r.path.stem for r in runs]
-    return [str(r.path) for r in runs]
+RAW = argparse.RawDescriptionHelpFormatter
 
 
-def _say_nearest_frames(runs: list[Any], idx: list[int], t: float | None) -> None:
-    """Tell which stored frame is shown where a run has none at the asked time."""
-    if t is None:
-        return
-    for r, i in zip(runs, idx, strict=True):
-        shown = float(r.times[i])
-        if abs(shown - t) > 1e-9 * max(1.0, abs(t)):
-            last = " (its last frame)" if i == len(r.times) - 1 else ""
-            print(f"pdeflow: note: {r.path.name} has no frame at t = {t:g} s; showing "
-                  f"the nearest, t = {shown:.4g} s{last}", file=sys.stderr)
-
-
-def cmd_plot(args: argparse.Namespace) -> int:
-    from .io import check_output
-    from .plotting import RunFigure, Series
-    from .storage import open_run
-
-    _positive("--fps", args.fps)
-    check_output(args.out, "--out")
-    check_output(args.movie, "--movie")
-    if args.movie:
-        from .trackers.live import check_movie_path
-
-        check_movie_path(args.movie)
-    runs = [open_run(p) for p in args.runs]
-    series = [Series(r.x, r.model, lab, r.dry_tolerance, r.coordinate)
-              for r, lab in zip(runs, _plot_labels(runs), strict=True)]
-    title = args.title if args.title is not None else runs[0].metadata.get(
-        "case_name", runs[0].path.stem)
-    written = []
-    if args.movie:
-        from .trackers.live import replay
-
-        frames = []
-        for t in runs[0].times:
-            idx = [r.index(min(t, r.times[-1])) for r in runs]
-            frames.append((float(t), [r.data[i] for r, i in zip(runs, idx, strict=True)],
-                           [r.fextra[i] for r, i in zip(runs, idx, strict=True)]))
-        written.append(replay(frames, series, args.movie, title=title, fps=args.fps))
-    if args.out or not args.movie:
-        idx = [r.index(args.time) for r in runs]
-        times = [float(r.times[i]) for r, i in zip(runs, idx, strict=True)]
-        if not args.quiet:
-            _say_nearest_frames(runs, idx, args.time)
-        # deposits at rest: velocities and F_extra are zero, so only the depths are drawn
-        deposits = args.time is None and all(r.metadata.get("at_rest") for r in runs)
-        if len({round(t, 9) for t in times}) > 1 and not deposits:
-            for s, t in zip(series, times, strict=True):  # show each run's own time
-                s.label = f"{s.label or s.model.replace('_', ' ')}, t = {t:.3g} s"
-        fig = RunFigure(series, title=title, panels=1 if deposits else 3)
-        fig.update(times[0], [r.data[i] for r, i in zip(runs, idx, strict=True)],
-                   [r.fextra[i] for r, i in zip(runs, idx, strict=True)])
-        if deposits:
-            fig.set_title("final deposits (at rest: " + ", ".join(
-                f"{fig.name(s)} t = {t:.3g} s" for s, t in zip(series, times, strict=True))
-                + ")")
-        elif len({round(t, 9) for t in times}) > 1:
-            fig.set_title("(times in the legend)" if args.time is None
-                          else f"(nearest stored times to t = {args.time:g} s)")
-        out = args.out or runs[0].path.with_suffix(".png")
-        written.append(fig.save(out))
-        fig.close()
-    if not args.quiet:
-        for r in runs:
-            print(r.describe())
-        for p in written:
-            print(f"wrote {p}")
-    return 0
-
-
-def cmd_export(args: argparse.Namespace) -> int:
-    from .io import check_output
-    from .storage import open_run
-
-    check_output(args.out, "OUT")
-    run = open_run(args.run)
-    out = run.export(args.out)
-    if not args.quiet:
-        print(run.describe())
-        print(f"wrote {out}")
-    return 0
-
-
-def build_parser() -> argparse.ArgumentParser:
-    raw = argparse.RawDescriptionHelpFormatter
-    parser = argparse.ArgumentParser(
-        prog="pdeflow",
-        description="Depth-averaged single- and two-layer granular flow models on py-pde.",
-        epilog="docs/user_guide.md explains the commands, docs/cases.md the case files.")
-    parser.add_argument("--version", action="version", version=f"pdeflow {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-
-    # --- run ------------------------------------------------------------------------------
+def _add_run(sub: Any) -> None:
+    """``pdeflow run``: its options."""
     run = sub.add_parser("run", help="run a case file", description=RUN_HELP,
-                         formatter_class=raw)
+                         formatter_class=RAW)
     run.add_argument("case", help="TOML case file (see cases/ and docs/cases.md)")
     run.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                      help="override a case value, e.g. --set two_layer.c=0.05 (repeatable)")
@@ -338,37 +290,15 @@ def build_parser() -> argparse.ArgumentParser:
                        help="simulation time between live frames [s] (default t_end/100)")
     watch.add_argument("--fps", type=float, default=10.0,
                        help="frames per second of --movie (default 10)")
+    run.add_argument("--force", action="store_true",
+                     help="run even if the run is estimated to take more than a day or "
+                     "half the machine's memory (refused otherwise)")
     run.add_argument("-q", "--quiet", action="store_true", help="print nothing")
     run.set_defaults(func=cmd_run)
 
-    # --- plot -----------------------------------------------------------------------------
-    plot = sub.add_parser("plot", help="plot or compare stored runs (.h5)",
-                          description=PLOT_HELP, formatter_class=raw)
-    plot.add_argument("runs", nargs="+", metavar="RUN.h5",
-                      help="stored runs (pdeflow run --store); the first is drawn filled")
-    plot.add_argument("--time", type=float, metavar="T",
-                      help="time to show [s] (nearest stored frame; default: the end)")
-    plot.add_argument("--out", metavar="FIG.png",
-                      help="write the figure here (default: the first RUN with .png)")
-    plot.add_argument("--movie", metavar="OUT.mp4",
-                      help="write a movie over all stored frames (.mp4, .m4v, .mov, "
-                      ".mkv, .avi: needs ffmpeg; or .gif)")
-    plot.add_argument("--fps", type=float, default=10.0,
-                      help="frames per second of --movie (default 10)")
-    plot.add_argument("--title", help="figure title (default: the case name)")
-    plot.add_argument("-q", "--quiet", action="store_true", help="print nothing")
-    plot.set_defaults(func=cmd_plot)
 
-    # --- export ---------------------------------------------------------------------------
-    export = sub.add_parser("export", help="export a stored run to CSV, NPZ or NetCDF",
-                            description=EXPORT_HELP, formatter_class=raw)
-    export.add_argument("run", metavar="RUN.h5", help="stored run (pdeflow run --store)")
-    export.add_argument("out", metavar="OUT.csv",
-                        help="output file: .csv, .npz or .nc (NetCDF, needs xarray)")
-    export.add_argument("-q", "--quiet", action="store_true", help="print nothing")
-    export.set_defaults(func=cmd_export)
-
-    # --- the commands whose module owns its options (add_arguments) and body ----------
+def _add_module_commands(sub: Any) -> None:
+    """The commands whose module owns its options (``add_arguments``) and body."""
     from .analysis import convergence, sweep, workprecision
     from .app import server  # panel is imported only when the app runs
     from .study import command as study
@@ -384,10 +314,25 @@ def build_parser() -> argparse.ArgumentParser:
             ("study", study, study.cmd_study,
              "parameter study, sensitivity or calibration on Dask"),
             ("app", server, server.cmd_app, "teaching app in the browser (needs panel)")):
-        cmd = sub.add_parser(name, help=help_, formatter_class=raw,
+        cmd = sub.add_parser(name, help=help_, formatter_class=RAW,
                              description=getattr(module, "HELP", module.__doc__))
         module.add_arguments(cmd)
         cmd.set_defaults(func=func)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``pdeflow`` parser: one subcommand per command."""
+    parser = argparse.ArgumentParser(
+        prog="pdeflow",
+        description="Depth-averaged single- and two-layer granular flow models on py-pde.",
+        epilog="docs/user_guide.md explains the commands, docs/cases.md the case files.")
+    parser.add_argument("--version", action="version", version=f"pdeflow {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    _add_run(sub)
+    from .cli_stored import add_plot_and_export
+
+    add_plot_and_export(sub, RAW)
+    _add_module_commands(sub)
     return parser
 
 
@@ -414,13 +359,22 @@ def main(argv: list[str] | None = None) -> int:
 
 def _main(argv: list[str] | None = None) -> int:
     from .cases import CaseError
+    from .interrupts import RunInterrupted, signals_interrupt
     from .solvers.fv_split import SimulationBlowUp
     from .storage import StorageError
 
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser().parse_args(argv)
     try:
-        return args.func(args)
+        with signals_interrupt():
+            return args.func(args)
+    except KeyboardInterrupt as err:
+        # Ctrl-C or SIGTERM: temporary files are gone (atomic writes, discarded trackers)
+        t = getattr(err, "t", None)
+        when = f"at t = {t:.6g} s" if isinstance(err, RunInterrupted) and t is not None \
+            else "before the results were complete"
+        print(f"pdeflow: interrupted {when}; nothing written", file=sys.stderr)
+        return 130
     except (CaseError, StorageError) as err:
         print(f"pdeflow: error: {err}", file=sys.stderr)
         return 2
@@ -436,6 +390,12 @@ def _main(argv: list[str] | None = None) -> int:
             raise
         print(f"pdeflow: error: {err}", file=sys.stderr)
         return 2
+
+
+def module_main(command: str) -> None:
+    """``python -m pdeflow.<module>`` of a command's module: ``pdeflow COMMAND`` on the
+    command line's arguments (the same errors and exit codes), then exit."""
+    sys.exit(main([command, *sys.argv[1:]]))
 
 
 if __name__ == "__main__":  # pragma: no cover

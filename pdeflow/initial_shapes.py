@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from .models.base import check_range
+
 REQUIRED: dict[str, tuple[str, ...]] = {
     "column": ("L0", "H0"),
     "dam_break": ("x_dam", "h_left"),
@@ -22,6 +24,36 @@ REQUIRED: dict[str, tuple[str, ...]] = {
 }
 """the keys of [initial] each shape needs"""
 SHAPES = tuple(REQUIRED)
+
+
+def check_initial(initial: dict[str, Any], length: float, base_dir: Path) -> None:
+    """ValueError (one line, naming the key and its range) unless the [initial] table
+    ``initial`` has what its shape needs, in range, inside a domain of ``length`` [m]
+    (``path`` relative to ``base_dir``)."""
+    shape = initial["shape"]
+    for key in REQUIRED[shape]:
+        if key not in initial:
+            raise ValueError(f"initial.{key} is required for shape {shape!r}")
+    for key in ("L0", "H0", "height"):
+        if key in initial:
+            check_range(f"initial.{key}", initial[key], 0, math.inf, low_open=True,
+                        unit="m")
+    for key in ("h_left", "h_right"):
+        if key in initial:
+            check_range(f"initial.{key}", initial[key], 0, math.inf, unit="m")
+    for key in ("wedge_angle_deg", "slope_deg"):
+        if key in initial:
+            check_range(f"initial.{key}", initial[key], 0, 90, low_open=True,
+                        high_open=True, unit="deg")
+    if "upper_fraction" in initial:
+        check_range("initial.upper_fraction", initial["upper_fraction"], 0, 1)
+    if shape == "column" and initial["L0"] > length:
+        raise ValueError(f"initial.L0 = {initial['L0']:g} m is longer than the domain "
+                         f"(grid.length = {length:g} m): the column must lie in "
+                         f"(0, {length:g}] m; lengthen the domain or shorten the column")
+    if shape == "file" and not (base_dir / initial["path"]).is_file():
+        raise ValueError(f"initial.path: file {initial['path']} not found next to the "
+                         "case file")
 
 
 def total_depth(initial: dict[str, Any], x: np.ndarray) -> np.ndarray:

@@ -113,7 +113,7 @@ class Run:
             return {"solver": self.variant.solver,
                     "dt": float(self.case.data.get("numerics", {}).get("dt", 1e-4))}
         return {"solver": "fv-split", "cfl": self.case.cfl, "backend": self.backend,
-                "splitting": self.variant.splitting}
+                "splitting": self.variant.splitting, "outputs": self.case.frames}
 
     def make_solver(self) -> Any:
         """The py-pde solver of this run (for timing the bare stepper, as the
@@ -157,8 +157,11 @@ class Run:
         if stop.startswith("User interrupted"):
             # py-pde turns Ctrl-C into a normal return; a truncated run must not be
             # written out as if it were complete
-            raise KeyboardInterrupt(f"{model} run of {case.name} interrupted at "
-                                    f"t={info['controller'].get('t_final')}")
+            from .interrupts import RunInterrupted
+
+            t_stop = info["controller"].get("t_final")
+            raise RunInterrupted(f"{model} run of {case.name} interrupted at t={t_stop}",
+                                 t=t_stop)
         sinfo = info.get("solver", {})
         data = sinfo.get("post_step_data")
         if self.variant.is_mol and not np.all(np.isfinite(final.data)):
@@ -194,8 +197,8 @@ def run_model(case: Case, model: str, *, tracker: Any = None,
 
 _COMMON_KEYS = ("model", "solver", "geometry", "t_final", "at_rest", "front_position", "runout",
                 "mass_relative_error", "steps", "wall_time_s", "stop_reason", "stop_time",
-                "max_fextra_over_rho1", "flux_fallback_steps", "mass_change",
-                "runout_lower_bound", "domain_ends", "warnings")
+                "max_fextra_over_rho1", "flux_fallback_steps", "positivity_retries",
+                "mass_change", "runout_lower_bound", "domain_ends", "warnings")
 
 
 def summary_keys(model: str) -> tuple[str, ...]:
@@ -236,6 +239,9 @@ def summarize(res: RunResult, mass0: float, wall: float,
     if diag is not None:
         # steps that IFCP could not keep positive, redone with HLL (0 for other fluxes)
         out["flux_fallback_steps"] = diag.flux_fallbacks
+        # steps rejected by the positivity safety net and redone with dt/2 (see
+        # docs/stability.md): 0 where the scheme kept depths non-negative by itself
+        out["positivity_retries"] = diag.positivity_retries
         out.update(res.pde.system.summarize(diag, res.t_final, at_rest, res.x, d,
                                             res.pde.metric(res.state.grid)))
     else:

@@ -179,6 +179,28 @@ def test_cache_key_follows_the_code_of_every_called_kernel(monkeypatch):
     assert key() != before
 
 
+def test_the_cache_key_changes_with_the_constants_a_kernel_reads(monkeypatch):
+    """numba compiles module constants in (``L.N_DIAG``, the per-cell F_extra's offset in
+    the diagnostics): a kernel whose code is unchanged but whose layout constant moved
+    must be recompiled, not loaded with the old offset (a stale source stage once wrote
+    F_extra over the retry counter). The key also changes with a constant of the
+    kernel's own module, and not with anything else."""
+    from pdeflow.numerics import source_stage
+    from pdeflow.numerics.source_stage import sources_two_layer
+
+    def key() -> tuple:
+        return sources_two_layer._cache._index_key(
+            compiled._SIGNATURES[sources_two_layer], sources_two_layer.targetctx.codegen())
+
+    before = key()
+    monkeypatch.setattr(L, "N_DIAG", L.N_DIAG + 1)
+    assert key() != before
+    monkeypatch.setattr(L, "N_DIAG", L.N_DIAG - 1)
+    assert key() == before
+    monkeypatch.setattr(source_stage, "UNREAD_CONSTANT", 3, raising=False)
+    assert key() == before
+
+
 # three independent kernels of different sizes in a module of their own (a helper
 # process that compiled one that another calls would not be seen: the caller compiles
 # its callees itself)

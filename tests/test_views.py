@@ -150,3 +150,23 @@ def test_sweep_axis_is_labelled_at_2_4_8_16_30(tmp_path):
     np.testing.assert_allclose(ticks, [2, 4, 8, 16, 30])
     assert all(t.get_text() == "" for t in ax.xaxis.get_minorticklabels())
     original(closed[0])
+
+
+def test_richardson_only_in_the_asymptotic_range_and_says_why_not():
+    """Issue 28: measured stop times 1.37, 1.10, 0.84 s (p = 0.05) gave an estimate
+    far outside them; now only orders within ORDER_RANGE, consistent over the last two
+    triples, are extrapolated, and the table says why not."""
+    slow = richardson([1.369, 1.10, 0.84])
+    assert slow["extrapolated"] is None and "outside" in slow["reason"]
+    first = [1.0 + 0.5 * h for h in (0.8, 0.4, 0.2, 0.1)]
+    assert richardson(first)["extrapolated"] == pytest.approx(1.0)
+    assert richardson(first)["reason"] is None
+    kinked = richardson([1.0, 1.9, 1.95, 1.975])  # orders 4.2 then 1
+    assert kinked["extrapolated"] is None and "disagree" in kinked["reason"]
+    assert richardson([1.0, 1.5, 1.3])["reason"] == "not monotone"
+    assert richardson([1.0, 1.5])["reason"] == "fewer than 3 values"
+    res = {"levels": [{"dx": 0.1, "stop_time": 1.369}, {"dx": 0.05, "stop_time": 1.10},
+                      {"dx": 0.025, "stop_time": 0.84}],
+           "analysis": {"stop_time": slow}}
+    last = table(res).splitlines()[-1]
+    assert last.startswith("| no Richardson because |") and "outside" in last

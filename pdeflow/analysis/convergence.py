@@ -87,19 +87,38 @@ def converge(case: Case, levels: int, model: str = PAPER_MODEL,
             "analysis": {k: richardson([r[k] for r in rows]) for k in qois}}
 
 
-def richardson(values: list[float | None]) -> dict[str, float | None]:
+#: observed orders taken as the asymptotic range of the schemes (first order: 1, MUSCL
+#: up to 2, both about 1/2 at discontinuities); outside it no extrapolation is given
+ORDER_RANGE = (0.5, 3.0)
+
+
+def _order(v: Sequence[float]) -> tuple[float | None, str | None]:
+    """Observed order of three values, or (None, why there is none)."""
+    d1 = v[1] - v[0]
+    d2 = v[2] - v[1]
+    if d1 == 0 or d2 == 0:
+        return None, "no change"
+    p = math.log2(abs(d1) / abs(d2))
+    if d1 * d2 < 0:
+        return p, "not monotone"
+    return p, None
+
+
+def richardson(values: list[float | None]) -> dict[str, Any]:
     """Change between the finest two values, observed order and extrapolation.
 
     The relative change is |Q_h/4 - Q_h/2| / |Q_h/4|: None where the finest value is 0
     and the one before is not (no relative change of a zero), 0 where both are 0. The
     order p = log2(|Q_h - Q_h/2| / |Q_h/2 - Q_h/4|) needs three values; the Richardson
-    estimate Q_h/4 + (Q_h/4 - Q_h/2)/(2^p - 1) is given only where the last three
-    values are monotone, p > 0, and the estimate keeps the sign of the values (stop
-    times, run-outs and volumes are not negative): elsewhere the sequence is not in its
-    asymptotic range and an extrapolation would mislead.
+    estimate Q_h/4 + (Q_h/4 - Q_h/2)/(2^p - 1) is given only in the asymptotic range:
+    the last three values monotone, p within :data:`ORDER_RANGE`, with four or more
+    values the order of the three before also there and within a factor 2 of p (the
+    ratios of differences consistent), and the estimate keeping the sign of the
+    values (stop times, run-outs and volumes are not negative). Otherwise
+    ``extrapolated`` is None and ``reason`` says why (a short phrase).
     """
-    out: dict[str, float | None] = {"finest": values[-1], "relative_change": None,
-                                    "order": None, "extrapolated": None}
+    out: dict[str, Any] = {"finest": values[-1], "relative_change": None,
+                           "order": None, "extrapolated": None, "reason": None}
     v = values
     if len(v) >= 2 and v[-1] is not None and v[-2] is not None:
         change = abs(v[-1] - v[-2])
@@ -107,18 +126,27 @@ def richardson(values: list[float | None]) -> dict[str, float | None]:
             out["relative_change"] = change / abs(v[-1])
         elif change == 0:
             out["relative_change"] = 0.0
-    if len(v) >= 3 and None not in v[-3:]:
-        d1 = v[-2] - v[-3]
-        d2 = v[-1] - v[-2]
-        if d1 != 0 and d2 != 0:
-            p = math.log2(abs(d1) / abs(d2))
-            out["order"] = p
-            if p > 0 and d1 * d2 > 0:  # converging and monotone
-                estimate = v[-1] + d2 / (2**p - 1)
-                lo, hi = min(v[-3:]), max(v[-3:])
-                if (lo < 0 < hi or (lo >= 0 and estimate >= 0)
-                        or (hi <= 0 and estimate <= 0)):
-                    out["extrapolated"] = estimate
+    if len(v) < 3 or None in v[-3:]:
+        out["reason"] = "fewer than 3 values"
+        return out
+    p, why = _order(v[-3:])
+    out["order"] = p
+    lo_p, hi_p = ORDER_RANGE
+    if why is None and not lo_p <= p <= hi_p:
+        why = f"order {p:.2g} outside [{lo_p:g}, {hi_p:g}]"
+    if why is None and len(v) >= 4 and None not in v[-4:]:
+        p0, why0 = _order(v[-4:-1])
+        if why0 is not None or not (lo_p <= p0 <= hi_p and 0.5 <= p / p0 <= 2.0):
+            why = "orders of the last two triples disagree"
+    if why is None:
+        estimate = v[-1] + (v[-1] - v[-2]) / (2**p - 1)
+        lo, hi = min(v[-3:]), max(v[-3:])
+        if (lo < 0 < hi or (lo >= 0 and estimate >= 0)
+                or (hi <= 0 and estimate <= 0)):
+            out["extrapolated"] = estimate
+        else:
+            why = "estimate changes sign"
+    out["reason"] = why
     return out
 
 
@@ -180,8 +208,9 @@ def table(result: dict[str, Any], keys: Sequence[str] | None = None) -> str:
         lines.append("| " + " | ".join(_fmt(r.get(k)) for k in keys) + " |")
     ana = result["analysis"]
     for label, field in (("rel. change (finest two)", "relative_change"),
-                         ("observed order", "order"), ("Richardson", "extrapolated")):
-        cells = [label] + [_fmt(ana[k][field]) if k in ana else "" for k in keys[1:]]
+                         ("observed order", "order"), ("Richardson", "extrapolated"),
+                         ("no Richardson because", "reason")):
+        cells = [label] + [_fmt(ana[k].get(field)) if k in ana else "" for k in keys[1:]]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
@@ -193,21 +222,36 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="override a case value (repeatable)")
     ap.add_argument("--model", default=PAPER_MODEL, choices=list(systems.names()))
     ap.add_argument("--summary", metavar="OUT.json", help="write the results as JSON")
+    ap.add_argument("--force", action="store_true",
+                    help="run even a finest grid estimated beyond a day or half the "
+                    "machine's memory (refused otherwise)")
     ap.add_argument("--all", action="store_true",
                     help="print every quantity (default: stop times, run-out, F_extra, "
                     "wall time)")
 
 
 def cmd_converge(args: argparse.Namespace) -> int:
-    from ..io import check_output, write_json
+    from ..io import write_json
+    from ..outpaths import check_file
 
     if not args.case:
         raise CaseError("pdeflow converge: a case file is required")
     if args.levels < 2:
         raise CaseError(f"--levels must be an integer >= 2 (the number of grids), got "
                         f"{args.levels}")
-    check_output(args.summary, "--summary")
+    check_file(args.summary, "--summary", (".json",))
     case = load_case(args.case, args.set)
+    if not case.data.get("sweep"):
+        from ..sizecheck import check_size
+
+        dx = case.dx / 2 ** (args.levels - 1)
+        remedy = (f"the finest grid (level {args.levels} of --levels {args.levels}, "
+                  f"dx = {dx:.3g} m) is too fine: use fewer --levels")
+        try:
+            finest = refined(case, args.levels - 1)
+        except CaseError as err:  # more memory than the machine has
+            raise CaseError(f"{err}; {remedy}") from None
+        check_size(finest, args.force, remedy)
     prepare(case_steppers(case), log=sys.stderr)
     if case.data.get("sweep"):
         res = converge_sweep(case, args.levels, args.model)
@@ -223,3 +267,9 @@ def cmd_converge(args: argparse.Namespace) -> int:
     if args.summary:
         write_json(args.summary, res)
     return 0
+
+
+if __name__ == "__main__":  # python -m: the command's errors and exit codes
+    from pdeflow.cli import module_main
+
+    module_main("converge")

@@ -186,9 +186,10 @@ def add_arguments(ap: Any) -> None:
 def cmd_sweep(args: Any) -> int:
     """``pdeflow sweep``: run the sweep described by parsed ``args``; print the fits."""
     from .. import io
+    from ..outpaths import FIGURE_SUFFIXES, check_file
 
-    io.check_output(args.summary, "--summary")
-    io.check_output(args.plot, "--plot")
+    check_file(args.summary, "--summary", (".json",))
+    check_file(args.plot, "--plot", FIGURE_SUFFIXES)
     case = load_case(args.case, args.set)
     sweep_ratios(case)  # before any run
     prepare(case_steppers(case), log=None if args.quiet else sys.stderr)
@@ -206,3 +207,9 @@ def cmd_sweep(args: Any) -> int:
                   f"a^{res['paper_exponent']})   a:r {pts}")
         print(f"wall time {summary['wall_time_s']:.2f} s")
     return 0
+
+
+if __name__ == "__main__":  # python -m: the command's errors and exit codes
+    from pdeflow.cli import module_main
+
+    module_main("sweep")

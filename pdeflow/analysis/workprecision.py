@@ -426,3 +426,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
         print(f"pdeflow compare: error: {err}", file=sys.stderr)
         return 2
     return 0
+
+
+if __name__ == "__main__":  # python -m: the command's errors and exit codes
+    from pdeflow.cli import module_main
+
+    module_main("compare")

@@ -23,6 +23,8 @@ from ..analysis.workprecision import DEFAULT_VARIANTS
 from ..cases import Case, CaseError, load_case
 from ..variant import Variant
 
+GEOMETRIES = ("planar", "axisymmetric")
+"""grid.geometry choices: a slope of unit width, or a column collapsing radially"""
 CLOSURES = ("paper", "relaxed")
 """The exchange closures offered (a case with another one adds it to the choice)."""
 SCHEMES = tuple(v for v in DEFAULT_VARIANTS if not Variant.parse(v).is_mol)
@@ -160,7 +162,8 @@ def command_line(case_path: Path, overrides: Sequence[str]) -> str:
 
 
 class ParameterControls:
-    """A case selector, the sliders of :data:`KNOBS` and the closure and scheme choices.
+    """A case selector, the sliders of :data:`KNOBS` and the closure, geometry and
+    scheme choices.
 
     ``on_change()`` is called after the user changed the case, released a slider, or
     picked a closure or scheme; never while :meth:`set_case` puts a case's own values
@@ -188,6 +191,9 @@ class ParameterControls:
         self.closure = pn.widgets.RadioButtonGroup(
             label="exchange closure", options=list(CLOSURES), value="paper",
             css_classes=["pdeflow-closure"])
+        self.geometry = pn.widgets.RadioButtonGroup(
+            label="geometry", options=list(GEOMETRIES), value="planar",
+            css_classes=["pdeflow-geometry"])
         self.scheme = pn.widgets.Select(label="scheme (flux/reconstruction[/limiter]"
                                         "[+splitting])", options=list(SCHEMES),
                                         value=SCHEMES[0], css_classes=["pdeflow-scheme"])
@@ -197,6 +203,7 @@ class ParameterControls:
         for s in self.sliders.values():
             s.param.watch(self._changed, "value_throttled")
         self.closure.param.watch(self._changed, "value")
+        self.geometry.param.watch(self._changed, "value")
         self.scheme.param.watch(self._changed, "value")
 
     # --- the case's own values into the widgets -------------------------------------------
@@ -229,6 +236,10 @@ class ParameterControls:
             self.closure.options = list(dict.fromkeys([*CLOSURES, closure]))
             self.closure.value = closure
             self.closure.disabled = not two
+            self.geometry.value = case.geometry
+            # the axis is a wall at x = 0: a case starting elsewhere or open there has
+            # no axisymmetric counterpart
+            self.geometry.disabled = not (case.bc[0] == "wall" and case.x_start == 0.0)
             scheme = case_scheme(case)
             self.scheme.options = list(dict.fromkeys([*SCHEMES, scheme]))
             self.scheme.value = scheme
@@ -253,6 +264,8 @@ class ParameterControls:
         if not self.closure.disabled and self.closure.value != case_value(
                 case, "two_layer.exchange_closure"):
             out.append(f"two_layer.exchange_closure={toml_value(self.closure.value)}")
+        if not self.geometry.disabled and self.geometry.value != case.geometry:
+            out.append(f"grid.geometry={toml_value(self.geometry.value)}")
         if not self.scheme.disabled and self.scheme.value != case_scheme(case):
             own = case.variant.numerics()
             for key, value in Variant.parse(self.scheme.value).numerics().items():
@@ -282,7 +295,8 @@ class ParameterControls:
         """The widgets, for a page's side bar."""
         return pn.Column(f"### {title}", self.case_select,
                          *self.sliders.values(), "exchange closure", self.closure,
-                         self.scheme, sizing_mode="stretch_width")
+                         "geometry", self.geometry, self.scheme,
+                         sizing_mode="stretch_width")
 
 
 def _keys_of_case(knob: Knob, case: Case) -> list[str]:

@@ -4,9 +4,11 @@ Every change runs each model of the case twice with :func:`pdeflow.simulate.run_
 once exactly as ``pdeflow run`` does (the summary table, the same numbers as the command
 line printed under it, and the final state: these go to the browser at once), and then
 once with a :class:`~pdeflow.trackers.FextraStorageTracker` that records the frames of the
-animation. The solver lands on every frame time, so those frames come from a run whose
-steps differ a little from the first (by the order of the discretisation error, as any
-tracker's: docs/user_guide.md); the numbers and the last frame never come from it.
+animation. Observers do not change the solver's steps (docs/user_guide.md), so that run
+takes the same steps as the first; its frames are the states after the first step at or
+past each frame time, at their true times (fv-split's ``outputs="step"``: states of the
+scheme, hyperbolic after the restoration); the numbers and the last frame come from the
+first run.
 Depths in m, velocities in m/s, F_extra/rho1 in m^2/s^2, times in s.
 """
 
@@ -22,14 +24,14 @@ from typing import Any
 import numpy as np
 import panel as pn
 import param
-from bokeh.models import ColumnDataSource, Div, Range1d, Span
+from bokeh.models import ColumnDataSource, Div, LinearColorMapper, Range1d, Span
 from bokeh.plotting import figure
 
 from .. import systems
 from ..cases import BASELINE_MODEL, PAPER_MODEL, Case, CaseError
 from ..numerics.state import velocity_profile
 from ..plotting import DRY
-from ..simulate import RunResult, print_summary, run_model
+from ..simulate import Run, RunResult, print_summary, run_model
 from ..solvers.fv_split import SimulationBlowUp
 from ..trackers import FextraStorageTracker
 from .controls import ParameterControls, command_line, list_cases, served
@@ -43,6 +45,19 @@ SEND_MS = 40
 (the frames' run would otherwise hold the message back until it is done)."""
 LABELS = {m: systems.get(m).label for m in (PAPER_MODEL, BASELINE_MODEL)}
 """The models as the pages name them."""
+PLAN_PIXELS = 121
+"""Pixels across the plan view of an axisymmetric run (the revolved total depth)."""
+
+
+def plan_view(r: np.ndarray, depth: np.ndarray, radius: float,
+              pixels: int = PLAN_PIXELS) -> np.ndarray:
+    """The total depth ``depth`` [m] at the cell centres ``r`` [m] revolved about the
+    axis, on ``pixels`` x ``pixels`` points of [-radius, radius]^2 (NaN outside the
+    domain and where dry): what a camera above the collapse sees."""
+    axis = np.linspace(-radius, radius, pixels)
+    rr = np.hypot(*np.meshgrid(axis, axis))
+    image = np.interp(rr, r, depth, right=np.nan)
+    return np.where(image > DRY, image, np.nan)
 
 
 @dataclass
@@ -88,7 +103,13 @@ def _frames(case: Case, model: str) -> list[tuple[float, np.ndarray, np.ndarray]
     c.data.setdefault("output", {})["snapshot_times"] = []
     c.validate()
     snaps = FextraStorageTracker(case.t_end / FRAMES_PER_T_END)
-    run_model(c, model, tracker=snaps)
+    run = Run(c, model)
+    kwargs = run.solver_arguments()
+    if kwargs["solver"] == "fv-split":
+        # frames that are states of the scheme (the hyperbolicity page shows a cell
+        # after its restoration), at the true time of the first step past each time
+        kwargs["outputs"] = "step"
+    run.pde.solve(run.state, t_range=c.t_end, tracker=[snaps], **kwargs)
     return [(t, d, f) for t, (d, f) in sorted(snaps.snapshots.items())]
 
 
@@ -200,9 +221,19 @@ class DamBreakPage:
                        for m in (PAPER_MODEL, BASELINE_MODEL)}
         for s in self.fronts.values():
             fh.add_layout(s)
-        for f, name in ((fh, "depths"), (fu, "velocities"), (ff, "fextra")):
+        # an axisymmetric run seen from above: the first model's total depth revolved
+        self.src_plan = ColumnDataSource({"image": [np.full((2, 2), np.nan)], "x": [-1.0],
+                                          "y": [-1.0], "dw": [2.0], "dh": [2.0]})
+        fp = figure(title="seen from above (total depth)", height=300, width=320,
+                    match_aspect=True, x_axis_label="x [m]", y_axis_label="y [m]",
+                    toolbar_location=None, visible=False)
+        self.plan_colours = LinearColorMapper(palette="Cividis256", low=0.0, high=1.0,
+                                              nan_color="white")
+        fp.image("image", x="x", y="y", dw="dw", dh="dh", source=self.src_plan,
+                 color_mapper=self.plan_colours)
+        for f, name in ((fh, "depths"), (fu, "velocities"), (ff, "fextra"), (fp, "plan")):
             f.css_classes = [f"pdeflow-{name}"]  # for the browser tests
-        self.fig_h, self.fig_u, self.fig_f = fh, fu, ff
+        self.fig_h, self.fig_u, self.fig_f, self.fig_plan = fh, fu, ff, fp
 
     # --- running --------------------------------------------------------------------------
     def rerun(self) -> None:
@@ -241,6 +272,9 @@ class DamBreakPage:
         self.run = run
         case = run.case
         self.fig_h.x_range.start, self.fig_h.x_range.end = case.x_start, case.x_start + case.length
+        axisymmetric = case.geometry == "axisymmetric"
+        self.fig_f.xaxis.axis_label = "r [m]" if axisymmetric else "x [m]"
+        self.fig_plan.visible = axisymmetric
         for m, span in self.fronts.items():
             front = run.results[m].summary["front_position"] if m in run.results else None
             span.visible = front is not None
@@ -248,6 +282,7 @@ class DamBreakPage:
         initial = [case.initial_profiles(m) for m in run.results]
         depth = max(float(sum(p[k] for k in p if k.startswith("h")).max()) for p in initial)
         self.fig_h.y_range.start, self.fig_h.y_range.end = -0.02 * depth, 1.1 * depth
+        self.plan_colours.high = depth
         # the final state; the player and the velocity limits wait for the frames (each
         # change of the player would redraw it in the browser twice per move)
         self.show_frame(len(run.times) - 1)
@@ -295,9 +330,19 @@ class DamBreakPage:
                                  "u": velocity_profile(h, m, fill=np.nan)}
         else:
             self.src_one.data = {"x": x, "h": nan, "u": nan}
+        if self.fig_plan.visible:
+            self._show_plan(run, i)
         self.fig_h.title.text = (f"{run.case.name}   t = {run.times[i]:.3f} s"
                                  + ("   (final state)" if i == len(run.times) - 1 else "")
                                  + "   dotted: the final fronts")
+
+    def _show_plan(self, run: DamBreakRun, i: int) -> None:
+        """The plan view of frame ``i``: the first model's total depth revolved."""
+        state = next(iter(run.states.values()))[i]
+        radius = run.case.length
+        self.src_plan.data = {"image": [plan_view(run.x, state[::2].sum(axis=0), radius)],
+                              "x": [-radius], "y": [-radius], "dw": [2 * radius],
+                              "dh": [2 * radius]}
 
     def _summary_html(self, run: DamBreakRun) -> str:
         rows = []
@@ -320,6 +365,8 @@ class DamBreakPage:
         plots = pn.Column(self.status, self.player, pn.pane.Bokeh(self.fig_h),
                           pn.pane.Bokeh(self.fig_u), pn.pane.Bokeh(self.fig_f),
                           sizing_mode="stretch_width")
+        results = pn.Column("### results", pn.pane.Bokeh(self.fig_plan),
+                            pn.pane.Bokeh(self.summary), width=400)
         return pn.Row(pn.Column(self.controls.panel("dam break"), width=320), plots,
-                      pn.Column("### results", pn.pane.Bokeh(self.summary), width=400),
+                      results,
                       sizing_mode="stretch_width")

@@ -229,7 +229,12 @@ class GranularPDE(PDEBase):
         asked for by name (``tracker="auto"``, the default, or ``"progress"``) is
         :class:`pdeflow.trackers.ProgressBar`: updated at 1/100 of ``t_range`` in
         simulation time, it fills up and says so when ``fv-split`` ends a run at rest
-        (py-pde's own bar would stop where the run stopped)."""
+        (py-pde's own bar would stop where the run stopped). ``fv-split`` is told the
+        end of the run, the only time at which it shortens a step (observers do not
+        change the steps: :mod:`pdeflow.solvers.outputs`)."""
+        if kwargs.get("solver") == "fv-split":
+            kwargs.setdefault("t_end", float(t_range if np.isscalar(t_range)
+                                             else t_range[1]))
         return super().solve(state, t_range, dt, _named_progress(tracker, t_range),
                              **kwargs)
 

@@ -185,8 +185,10 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
               + \bar A_i \mathcal{A}(q_i^-, q_i^+)}{V_i}
               - \frac{A_{i+1/2} - A_{i-1/2}}{V_i} \overline{F^{adv}}_i,
 
-    \bar A_i the mean of the cell's face areas and F^adv = (h u, h u^2) of each layer
-    averaged over the cell's two face values: the flux difference
+    \bar A_i the mean of the cell's face areas (on py-pde's uniform radial grid
+    \bar A_i / V_i = 2 pi r_i / (2 pi r_i dr) = 1/dr, so the MUSCL cell jump is the
+    planar one) and F^adv = (h u, h u^2) of each layer averaged over the cell's two face
+    values: the flux difference
     A_{i+1/2} F_{i+1/2} - A_{i-1/2} F_{i-1/2} written with the fluctuations, the
     pressure kept in gradient form g h d(h...)/dr. Mass is conserved exactly (the cell
     term cancels the area change of the mass fluctuations), and a layer at rest feels
@@ -201,7 +203,7 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
     # the MUSCL and axisymmetric kernels, only where they are called (see compiled.ready)
     reconstruct = reconstruct_muscl if muscl else None
     cell_jump = model.cell_jump if muscl else None
-    area_change = _area_change if axisymmetric else None
+    area_change = (_area_change_muscl if muscl else _area_change) if axisymmetric else None
 
     def advect(q, rate, work, dx, metric, bc_left, bc_right, g, r, dry, start, stop):
         lo, hi = wet_cells(q, dry, start, stop)
@@ -231,8 +233,8 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
             dm, dp, s = fluct(face(qp, i - 1, 1.0), face(qm, i, 1.0), g, r, dry)
             smax = max(smax, s)
             if axisymmetric:
-                w_l = metric[L.M_AREA, i] * metric[L.M_INV_VOLUME, i - 1]
-                w_r = metric[L.M_AREA, i] * metric[L.M_INV_VOLUME, i]
+                w_l = metric[L.M_LEFT, i]
+                w_r = metric[L.M_RIGHT, i]
             for k in range(fields):
                 rate[k, i - 1] -= dm[k] * w_l
                 rate[k, i] -= dp[k] * w_r
@@ -240,21 +242,19 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
             dm, dp, s = fluct(face(qm, 0, s_left), face(qm, 0, 1.0), g, r, dry)
             smax = max(smax, s)
             if axisymmetric:
-                w_r = metric[L.M_AREA, 0] * metric[L.M_INV_VOLUME, 0]
+                w_r = metric[L.M_RIGHT, 0]
             for k in range(fields):
                 rate[k, 0] -= dp[k] * w_r
         if hi == n - 1:
             dm, dp, s = fluct(face(qp, n - 1, 1.0), face(qp, n - 1, s_right), g, r, dry)
             smax = max(smax, s)
             if axisymmetric:
-                w_l = metric[L.M_AREA, n] * metric[L.M_INV_VOLUME, n - 1]
+                w_l = metric[L.M_LEFT, n]
             for k in range(fields):
                 rate[k, n - 1] -= dm[k] * w_l
-        if muscl and not axisymmetric:
+        if muscl:
+            # axisymmetric too: the mean face area over the volume is 1/dr exactly
             cell_jump(qm, qp, rate, r_lo, r_hi, inv_dx, g, r, dry)
-        elif muscl:
-            for i in range(r_lo, r_hi + 1):
-                cell_jump(qm, qp, rate, i, i, metric[L.M_MEAN_AREA, i], g, r, dry)
         if axisymmetric:
             area_change(qm, qp, rate, r_lo, r_hi, metric, dry)
         return smax, r_lo, r_hi
@@ -263,18 +263,30 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
 
 
 @cached
-def _area_change(qm, qp, rate, lo, hi, metric, dry):
-    """Subtract (A_{i+1/2} - A_{i-1/2}) / V_i F^adv_i in the cells lo..hi, F^adv =
-    (h u, h u^2) of each layer averaged over the cell's face values qm, qp."""
+def _area_change(q, unused, rate, lo, hi, metric, dry):
+    """Subtract (A_{i+1/2} - A_{i-1/2}) / V_i F^adv(q_i) in the cells lo..hi, F^adv =
+    (h u, h u^2) of each layer (first order: the cell averages)."""
+    for i in range(lo, hi + 1):
+        c = metric[L.M_AREA_CHANGE, i]
+        for k in range(0, q.shape[0], 2):
+            h = q[k, i]
+            u = velocity(h, q[k + 1, i], dry)  # as the fluctuations: 0 in a dry layer
+            rate[k, i] -= c * (u * h)
+            rate[k + 1, i] -= c * (u * u * h)
+
+
+@cached
+def _area_change_muscl(qm, qp, rate, lo, hi, metric, dry):
+    """:func:`_area_change` with F^adv averaged over the cell's face values qm, qp."""
     for i in range(lo, hi + 1):
         c = metric[L.M_AREA_CHANGE, i]
         for k in range(0, qm.shape[0], 2):
-            mm = qm[k + 1, i]
-            mp = qp[k + 1, i]
-            um = velocity(qm[k, i], mm, dry)
-            up = velocity(qp[k, i], mp, dry)
-            rate[k, i] -= c * 0.5 * (mm + mp)
-            rate[k + 1, i] -= c * 0.5 * (mm * um + mp * up)
+            hm = qm[k, i]
+            hp = qp[k, i]
+            um = velocity(hm, qm[k + 1, i], dry)
+            up = velocity(hp, qp[k + 1, i], dry)
+            rate[k, i] -= c * 0.5 * (um * hm + up * hp)
+            rate[k + 1, i] -= c * 0.5 * (um * um * hm + up * up * hp)
 
 
 @functools.cache

@@ -41,7 +41,7 @@ from __future__ import annotations
 import hashlib
 import sys
 from collections.abc import Callable, Iterable, Iterator
-from types import CodeType
+from types import CodeType, ModuleType
 from typing import Any
 
 from numba import types
@@ -273,12 +273,31 @@ def _code_digest(code: CodeType) -> str:
 
 
 def _describe_function(func: Callable, depth: int = 0) -> tuple:
-    """Code digest, closed-over values and called kernels of a kernel's function."""
+    """Code digest, closed-over values, global constants read and called kernels of a
+    kernel's function."""
     callees = tuple((name, _describe(value, depth + 1)) for name in func.__code__.co_names
                     if isinstance(value := func.__globals__.get(name), Dispatcher))
     cells = tuple(_describe(c.cell_contents, depth + 1) for c in func.__closure__ or ())
     return (func.__module__, func.__qualname__, _code_digest(func.__code__), cells,
-            callees)
+            callees, _constants_read(func))
+
+
+def _constants_read(func: Callable) -> tuple:
+    """The global numbers a kernel's code reads, by name, and the numbers of the modules
+    it reads attributes of (``L.N_DIAG``): numba compiles them in as constants, so a
+    kernel must be recompiled when one changes although its code did not."""
+    out = []
+    for name in func.__code__.co_names:
+        value = func.__globals__.get(name)
+        if isinstance(value, (bool, int, float)):
+            out.append((name, repr(value)))
+        elif isinstance(value, ModuleType):
+            numbers = tuple(sorted((k, repr(v)) for k, v in vars(value).items()
+                                   if not k.startswith("_")
+                                   and isinstance(v, (bool, int, float))))
+            if numbers:
+                out.append((name, value.__name__, numbers))
+    return tuple(out)
 
 
 def _describe(value: Any, depth: int = 0) -> Any:

@@ -47,12 +47,12 @@ class Metric:
         return L.GEOMETRIES[self.geometry]
 
     def array(self) -> np.ndarray:
-        """The rows layout.M_* as one C-contiguous array of shape (N_METRIC, n + 1)."""
+        """The rows layout.M_* as one C-contiguous array of shape (N_METRIC, n + 1): per face
+        its weights in the cells left and right of it, per cell its area change."""
         n = self.volumes.size
         out = np.zeros((L.N_METRIC, n + 1))
-        out[L.M_AREA] = self.areas
-        out[L.M_INV_VOLUME, :n] = 1.0 / self.volumes
-        out[L.M_MEAN_AREA, :n] = 0.5 * (self.areas[:-1] + self.areas[1:]) / self.volumes
+        out[L.M_LEFT, 1:] = self.areas[1:] / self.volumes  # face i - 1/2 into cell i - 1
+        out[L.M_RIGHT, :n] = self.areas[:-1] / self.volumes
         out[L.M_AREA_CHANGE, :n] = (self.areas[1:] - self.areas[:-1]) / self.volumes
         return out
 

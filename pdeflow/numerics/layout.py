@@ -36,7 +36,8 @@ D_FLUX_FALLBACKS = 14  #: steps redone with HLL because the IFCP step was not po
 D_HYP_BISECTIONS = 15  #: restorations that needed the bisection fallback (see splitting)
 D_BAD_STEPS = 16  #: steps of a generic py-pde solver that left a non-finite value or a depth
 #: below -1e-12 m, before the post-step hook clipped it (models.base.make_post_step_hook)
-N_DIAG = 17  #: the per-cell F_extra/rho1 of the last step follows at N_DIAG
+D_RETRIES = 17  #: steps rejected (a depth would turn negative) and retried with dt / 2
+N_DIAG = 18  #: the per-cell F_extra/rho1 of the last step follows at N_DIAG
 
 # --- boundary conditions ---------------------------------------------------------------
 BC_WALL = 0
@@ -67,8 +68,7 @@ HYPERBOLICITY_MODES = {"none": HYPERBOLICITY_NONE, "exact": HYPERBOLICITY_EXACT,
 GEOMETRY_PLANAR = 0  #: a 1D Cartesian grid: the planar slope, per unit width
 GEOMETRY_AXISYMMETRIC = 1  #: py-pde's PolarSymGrid: radial flow on a horizontal plane
 GEOMETRIES = {"planar": GEOMETRY_PLANAR, "axisymmetric": GEOMETRY_AXISYMMETRIC}
-M_AREA = 0  #: metric row: area of face i - 1/2 (1 planar; 2 pi r [m] axisymmetric), n + 1
-M_INV_VOLUME = 1  #: metric row: 1 / volume of cell i, n entries
-M_MEAN_AREA = 2  #: metric row: (A_{i-1/2} + A_{i+1/2}) / (2 V_i) [1/m]
-M_AREA_CHANGE = 3  #: metric row: (A_{i+1/2} - A_{i-1/2}) / V_i [1/m]
-N_METRIC = 4
+M_LEFT = 0  #: metric row: A_{i-1/2} / V_{i-1}, face i - 1/2's weight in cell i - 1 [1/m]
+M_RIGHT = 1  #: metric row: A_{i-1/2} / V_i, face i - 1/2's weight in cell i [1/m]
+M_AREA_CHANGE = 2  #: metric row: (A_{i+1/2} - A_{i-1/2}) / V_i [1/m] (n entries)
+N_METRIC = 3

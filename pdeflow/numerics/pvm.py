@@ -96,6 +96,19 @@ def upper_layer_at_uncovered_step(h1L: float, u1L: float, sL: float, h1R: float,
     pressure = jump - (h1R * u1R * u1R - h1L * u1L * u1L)
     wL = 0.5 * (1.0 - c1) if h1L > dry else 0.0
     wR = 0.5 * (1.0 + c1) if h1R > dry else 0.0
+    if wL > 0.0 and wR > 0.0:
+        # the thinner side gets at most the share its own depth carries, the thicker
+        # side the rest (the sum stays the path-conservative jump): g h1bar Delta H
+        # with the mean depth h1bar pushed a film barely above the dry tolerance, beside
+        # a thicker layer, to tens of m/s in one step, and MUSCL's corrector (CFL far
+        # above 1/2 at those speeds) then made its depth negative (issue 28)
+        h1bar = 0.5 * (h1L + h1R)
+        if h1L < h1R:
+            wL *= h1L / h1bar
+            wR = 1.0 - wL
+        else:
+            wR *= h1R / h1bar
+            wL = 1.0 - wR
     return (mass - h1L * u1L, mom - h1L * u1L * u1L + wL * pressure,
             h1R * u1R - mass, h1R * u1R * u1R - mom + wR * pressure)
 

@@ -51,6 +51,7 @@ from .model_kernels import ModelKernels
 STATUS_END = 0  #: reached t_end
 STATUS_REST = 1  #: everything at rest: nothing will change any more
 STATUS_FAIL = 2  #: non-finite or negative state: the step was undone
+MAX_RETRIES = 30  #: halvings of dt tried on a step that left a depth negative
 
 
 @cached(inline="always")
@@ -173,8 +174,8 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any) -> Any:
     """The stepping loop as a Python closure (compiled by :func:`stepping_kernel`, which
     documents it); ``advect_step`` is :func:`advect_step_function`."""
 
-    def advance(q, t, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag, rate,
-                backup, diag_backup, work, max_steps, stop_at_rest, advect, sources,
+    def advance(q, t, t_pause, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag,
+                rate, backup, diag_backup, work, prev, max_steps, stop_at_rest, advect, sources,
                 predictor, fallback):
         n = q.shape[1]
         steps = 0
@@ -194,7 +195,7 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any) -> Any:
         s_lo = 0
         s_hi = n - 1
         first = True
-        while t < t_end and steps < max_steps:
+        while t < t_pause and steps < max_steps:
             # cells a step can change: two advection stages around the wet region
             lo, hi = wet_cells(q, dry, w_lo, w_hi)
             if first:
@@ -214,17 +215,36 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any) -> Any:
                 advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right, P,
                 g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, lo,
                 hi, b_lo, b_hi)
+            fell_back = False
             if ifcp and not ok:
                 # IFCP is Roe's linearisation for one layer: not positive where cells
                 # move apart fast. Redo the step with HLL, which is, and count it.
                 _copy_cells(q, backup, b_lo, b_hi)
                 _copy_range(diag, diag_keep, 0, L.N_DIAG - 1)
                 _copy_range(fex, fex_keep, b_lo, b_hi)
-                diag[L.D_FLUX_FALLBACKS] += 1.0
+                fell_back = True
                 dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
                     fallback, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
                     P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep,
                     first, lo, hi, b_lo, b_hi)
+            retries = 0
+            while not ok and retries < MAX_RETRIES:
+                # safety net: a step that would leave a depth negative is rejected and
+                # redone with half the time step (the limited schemes are positive for
+                # a small enough dt); counted in diag[D_RETRIES]
+                _copy_cells(q, backup, b_lo, b_hi)
+                if strang or ifcp:
+                    _copy_range(diag, diag_keep, 0, L.N_DIAG - 1)
+                    _copy_range(fex, fex_keep, b_lo, b_hi)
+                retries += 1
+                # (the step ends at t + dt/2 at the latest: its own end time caps dt)
+                dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
+                    fallback if fell_back else advect, sources, predictor, q, t,
+                    t + 0.5 * dt, dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag,
+                    rate, backup, rec, q0, diag_keep, fex_keep, first, lo, hi, b_lo, b_hi)
+            if fell_back:
+                diag[L.D_FLUX_FALLBACKS] += 1.0
+            diag[L.D_RETRIES] += retries
             t_new = t + dt if dt < t_end - t else t_end
             if not ok:
                 _copy_cells(q, backup, b_lo, b_hi)
@@ -249,6 +269,11 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any) -> Any:
                 w_lo = max(lo - 2, 0)
                 w_hi = min(hi + 2, n - 1)
             first = False
+            if t_new >= t_pause:
+                # the state before this step, for output at t_pause (interpolated by the
+                # caller): the step changed cells b_lo..b_hi only, kept in backup
+                _copy_cells(prev, q, 0, n - 1)
+                _copy_cells(prev, backup, b_lo, b_hi)
             t = t_new
             steps += 1
             if stop_at_rest and mass_rate == 0.0 and changed == 0.0:
@@ -273,10 +298,15 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
     :func:`pdeflow.numerics.compiled.ready`): advance ``q`` from ``t`` to ``t_end`` with
     the CFL-limited splitting scheme,
 
-    ``advance(q, t, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag, rate,
-    backup, diag_backup, work, max_steps, stop_at_rest, advect, sources, predictor,
-    fallback) -> (t, steps, status)``; ``metric``: the grid's
+    ``advance(q, t, t_pause, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl,
+    diag, rate, backup, diag_backup, work, prev, max_steps, stop_at_rest, advect, sources,
+    predictor, fallback) -> (t, steps, status)``; ``metric``: the grid's
     (:class:`~pdeflow.numerics.geometry.Metric`).
+
+    Only ``t_end`` (the end of the run) shortens a step: the loop returns after the
+    first step that reaches ``t_pause`` (<= ``t_end``; an output time), so that the
+    steps do not depend on when the caller looks at the state; ``prev`` then holds the
+    state before that step (dt earlier), for output at ``t_pause`` in between.
 
     ``rate`` and ``backup`` have the shape of ``q``, ``diag_backup`` that of ``diag``;
     ``work`` has shape (3, *q.shape); ``g`` = g_z [m/s^2], ``r`` = rho1/rho2 (0 for one
@@ -296,8 +326,9 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
     undone; ``q`` holds the last good state).
     """
     step = njit(inline="always")(advect_step_function(order, strang))
-    return specialise(stepping_function(ifcp, strang, step), STATE, f8, f8, f8, METRIC, i8,
-                      i8, PARAMS, f8, f8, f8, f8, VECTOR, FIELDS, FIELDS, VECTOR, WORK, i8, flag,
+    return specialise(stepping_function(ifcp, strang, step), STATE, f8, f8, f8, f8,
+                      METRIC, i8, i8, PARAMS, f8, f8, f8, f8, VECTOR, FIELDS, FIELDS, VECTOR,
+                      WORK, FIELDS, i8, flag,
                       ADVECT, SOURCES, PREDICTOR if order == 2 else types.none,
                       ADVECT if ifcp else types.none, pointer=False)
 
@@ -335,20 +366,27 @@ class Stepper:
     def __call__(self, q: np.ndarray, t: float, t_end: float, dx: float,
                  metric: np.ndarray, bc_left: int, bc_right: int, P: np.ndarray,
                  cfl: float, diag: np.ndarray, rate: np.ndarray, backup: np.ndarray,
-                 work: np.ndarray, max_steps: int,
-                 stop_at_rest: bool) -> tuple[float, int, int]:
+                 work: np.ndarray, max_steps: int, stop_at_rest: bool,
+                 t_pause: float | None = None,
+                 prev: np.ndarray | None = None) -> tuple[float, int, int]:
         return self.run(self.ready().loop, q, t, t_end, dx, metric, bc_left, bc_right, P,
-                        cfl, diag, rate, backup, work, max_steps, stop_at_rest)
+                        cfl, diag, rate, backup, work, max_steps, stop_at_rest, t_pause,
+                        prev)
 
     def run(self, loop: Any, q: np.ndarray, t: float, t_end: float, dx: float,
             metric: np.ndarray, bc_left: int, bc_right: int, P: np.ndarray, cfl: float,
             diag: np.ndarray, rate: np.ndarray, backup: np.ndarray, work: np.ndarray,
-            max_steps: int, stop_at_rest: bool) -> tuple[float, int, int]:
+            max_steps: int, stop_at_rest: bool, t_pause: float | None = None,
+            prev: np.ndarray | None = None) -> tuple[float, int, int]:
         """``loop`` (the compiled loop, or its Python code) with this scheme's kernels
-        on the stepper's arguments."""
-        return loop(q, t, t_end, dx, metric, bc_left, bc_right, P,
-                    *self.model.constants(P), cfl, diag, rate, backup, np.empty_like(diag),
-                    work, max_steps, stop_at_rest, *self.ready().arguments)
+        on the stepper's arguments; ``t_pause`` (default ``t_end``): return after the
+        first step that reaches it, with the state before that step in ``prev`` (see
+        :func:`stepping_kernel`)."""
+        return loop(q, t, t_end if t_pause is None else min(t_pause, t_end), t_end, dx,
+                    metric, bc_left, bc_right, P, *self.model.constants(P), cfl, diag,
+                    rate, backup, np.empty_like(diag), work,
+                    np.empty_like(q) if prev is None else prev, max_steps, stop_at_rest,
+                    *self.ready().arguments)
 
 
 @functools.cache

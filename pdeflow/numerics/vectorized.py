@@ -58,6 +58,15 @@ def _at_uncovered_steps(left, right, ul, ur, sL, sR, a0, a1, dH, g, dry, fluct):
     mom = f_l * ul + _hll_split(sL, sR, f_r - f_l, f_r * ur - f_l * ul)[0]
     share_l = _hll_split(sL, sR, 0.0 * pressure, pressure)[0]  # the flux's share of it
     share_r = pressure - share_l
+    # both wet: the thinner side gets at most the share its own depth carries, the
+    # thicker side the rest (as pvm.upper_layer_at_uncovered_step)
+    both = (h1l > dry) & (h1r > dry)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        h1bar = 0.5 * (h1l + h1r)
+        thin_l = np.where(both & (h1l < h1r), share_l * h1l / h1bar, share_l)
+        thin_r = np.where(both & (h1l >= h1r), share_r * h1r / h1bar, share_r)
+    share_l, share_r = (np.where(both & (h1l >= h1r), pressure - thin_r, thin_l),
+                        np.where(both & (h1l < h1r), pressure - thin_l, thin_r))
     # a side without upper layer gets no share of the hydrostatic jump
     share_l = np.where(h1l > dry, share_l, 0.0)
     share_r = np.where(h1r > dry, share_r, 0.0)

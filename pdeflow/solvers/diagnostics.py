@@ -51,6 +51,8 @@ class SplitDiagnostics:
     """steps redone with HLL because the IFCP step was not positive"""
     source_stages: int
     """number of source stages applied"""
+    positivity_retries: int
+    """steps rejected because a depth would have turned negative, retried with dt/2"""
     fextra_over_rho1: np.ndarray
     """F_extra/rho1 per cell of the last step [m^2/s^2]"""
 
@@ -71,4 +73,5 @@ class SplitDiagnostics:
             hyperbolicity_bisections=int(diag[L.D_HYP_BISECTIONS]),
             flux_fallbacks=int(diag[L.D_FLUX_FALLBACKS]),
             source_stages=int(diag[L.D_STEPS]),
+            positivity_retries=int(diag[L.D_RETRIES]),
             fextra_over_rho1=np.array(diag[L.N_DIAG:], dtype=float))

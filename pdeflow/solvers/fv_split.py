@@ -27,6 +27,7 @@ from pde.trackers.base import FinishedSimulation
 from ..models.base import GranularPDE, check_range
 from ..numerics import layout as L
 from ..numerics.splitting import STATUS_FAIL, STATUS_REST, python_stepping, scheme_stepper
+from .outputs import StepAhead, pending_output
 
 
 class _RestProfilerFilter(logging.Filter):
@@ -178,7 +179,8 @@ class FVSplitSolver(SolverBase):
 
     def __init__(self, pde: GranularPDE, *, backend: str = "numba", cfl: float = 0.3,
                  splitting: str = "lie", stop_at_rest: bool = True,
-                 max_steps: int = 100_000_000):
+                 max_steps: int = 100_000_000, t_end: float | None = None,
+                 outputs: str = "interpolate"):
         """
         Args:
             pde: a :class:`~pdeflow.models.TwoLayerGranular` or
@@ -191,6 +193,17 @@ class FVSplitSolver(SolverBase):
                 source step on each side of the advection step).
             stop_at_rest: end the run once nothing moves or changes any more.
             max_steps: safety limit on the number of steps per call.
+            t_end: end of the run [s] (``GranularPDE.solve`` passes its ``t_range``):
+                the only time that shortens a step. A call of the stepper with an
+                earlier end (a tracker's interrupt) takes the first step that reaches
+                it and returns the state interpolated at that time (see
+                :mod:`pdeflow.solvers.outputs`), so that observers do not change the
+                steps. None: every call's end shortens the step (py-pde's behaviour).
+            outputs: what such a call returns: 'interpolate' (the state at the
+                requested time, interpolated between the steps around it) or 'step'
+                (the state after the first step that reaches it, at its true time: a
+                state of the scheme, with every property the scheme gives its states,
+                e.g. hyperbolicity after the restoration). Neither changes the steps.
         """
         if not isinstance(pde, GranularPDE):
             raise TypeError("fv-split solves pdeflow's granular models only")
@@ -206,6 +219,10 @@ class FVSplitSolver(SolverBase):
         self.splitting = splitting
         self.stop_at_rest = bool(stop_at_rest)
         self.max_steps = int(max_steps)
+        self.t_end = None if t_end is None else float(t_end)
+        if outputs not in ("interpolate", "step"):
+            raise ValueError(f"outputs must be 'interpolate' or 'step', got {outputs!r}")
+        self.outputs = outputs
         self.diagnostics: np.ndarray | None = None
 
     def make_stepper(self, state: Any, dt: float | None = None):
@@ -230,44 +247,81 @@ class FVSplitSolver(SolverBase):
         rate = np.empty_like(state.data)
         backup = np.empty_like(state.data)
         work = np.empty((3, *state.data.shape))
+        prev = np.empty_like(state.data)
         scheme = scheme_codes(pde, self.splitting, metric.code)
         cfl = self.cfl
         stop = self.stop_at_rest
 
         def run_kernel(kernel: Any, q: np.ndarray, t0: float, t1: float, diag_: np.ndarray,
                        rate_: np.ndarray, backup_: np.ndarray, work_: np.ndarray,
-                       max_steps: int):
+                       max_steps: int, t_pause: float | None = None):
             return kernel(q, t0, t1, dx, M, bcl, bcr, P, cfl, diag_, rate_, backup_, work_,
-                          max_steps, stop)
+                          max_steps, stop, t_pause, prev)
 
         if self.backend_name == "numba":
             kernel = scheme_stepper(*scheme)  # compiled (or loaded) at its first call
 
-            def advance(q: np.ndarray, t0: float, t1: float):
+            def advance(q: np.ndarray, t0: float, t_pause: float, t1: float):
                 return run_kernel(kernel, q, t0, t1, diag, rate, backup, work,
-                                  self.max_steps)
+                                  self.max_steps, t_pause)
         else:
-            advance = self._numpy_loop(state, dx, P, hook, diag)
+            advance = self._numpy_loop(state, dx, P, hook, diag, prev)
 
         def replay(q: np.ndarray, t0: float, t1: float, update: Any) -> None:
             # one step of the kernel's own Python code with an instrumented state update
             run_kernel(python_stepping(*scheme, update), q, t0, t1, diag.copy(),
                        np.empty_like(q), np.empty_like(q), np.empty_like(work), 1)
 
+        ahead: list[StepAhead] = []  # the state past the last output time, if any
+
         def stepper(state: Any, t_start: float, t_end: float) -> float:
+            t_pause = float(t_end)
+            t_run = t_pause if self.t_end is None else max(self.t_end, t_pause)
+            done, t_start = self._resume(ahead, state, float(t_start), t_pause)
+            if done:
+                return t_start
             entry = state.data.copy()
-            t, steps, status = advance(state.data, float(t_start), float(t_end))
+            t, steps, status = advance(state.data, float(t_start), t_pause, t_run)
             self.info["steps"] += int(steps)
             self.info["dt"] = float(diag[L.D_DT]) or None
             if status == STATUS_FAIL:
-                self._blowup(state, entry, t_start, t, t_end, replay)
+                self._blowup(state, entry, t_start, t, t_run, replay)
+            if t_pause < t < t_run and self.outputs == "interpolate":
+                # the step went past the output time: output the state at that time,
+                # continue from the step's end at the next call
+                dt = float(diag[L.D_DT]) * (2.0 if self.splitting == "strang" else 1.0)
+                ahead.append(pending_output(state.data, prev, t, dt,
+                                            status == STATUS_REST))
+                ahead[0].interpolate(state.data, t_pause)
+                return t_pause
             if status == STATUS_REST:
-                self.info["rest_time"] = float(t)
-                _RestProfilerFilter.ended_at_rest = True
-                raise FinishedSimulation(f"everything at rest at t={t:.6g} s")
+                self._at_rest(t)
             return float(t)
 
         return stepper
+
+    def _resume(self, ahead: list[StepAhead], state: Any, t_start: float,
+                t_pause: float) -> tuple[bool, float]:
+        """After an interpolated output (``ahead`` holds the step past it): ``(True,
+        t)`` if the call to ``t_pause`` [s] is answered from it (another output time
+        within the same step, or its end), else ``(False, t)`` with the step's end
+        restored as the state at ``t``; ``(False, t_start)`` if nothing is ahead."""
+        if not ahead:
+            return False, t_start
+        if t_pause < ahead[0].t:  # another output time within the same step
+            ahead[0].interpolate(state.data, t_pause)
+            return True, t_pause
+        step = ahead.pop()
+        state.data[...] = step.q
+        if step.at_rest:
+            self._at_rest(step.t)
+        return step.t >= t_pause, step.t
+
+    def _at_rest(self, t: float) -> None:
+        """End the run: everything is at rest from ``t`` [s] on."""
+        self.info["rest_time"] = float(t)
+        _RestProfilerFilter.ended_at_rest = True
+        raise FinishedSimulation(f"everything at rest at t={t:.6g} s")
 
     def _blowup(self, state: Any, entry: np.ndarray, t_start: float, t: float,
                 t_end: float, replay: Any) -> None:
@@ -315,7 +369,7 @@ class FVSplitSolver(SolverBase):
         raise SimulationBlowUp(msg, report=report, state=state.data.copy())
 
     def _numpy_loop(self, state: Any, dx: float, P: np.ndarray, hook: Any,
-                    diag: np.ndarray):
+                    diag: np.ndarray, prev: np.ndarray):
         """Pure numpy/Python version of the stepping loop (same stages, slow)."""
         from ..numerics.splitting import STATUS_END
 
@@ -323,9 +377,10 @@ class FVSplitSolver(SolverBase):
         pde._require_numpy_variant(state.grid)
         if self.splitting != "lie":
             raise NotImplementedError("the numpy loop implements Lie splitting only")
-        def advance(q: np.ndarray, t: float, t_end: float):
+        def advance(q: np.ndarray, t: float, t_pause: float, t_end: float):
             steps = 0
-            while t < t_end and steps < self.max_steps:
+            while t < t_pause and steps < self.max_steps:
+                prev[...] = q  # the state before the step, as the compiled loop keeps
                 rate, smax = pde.kernels.numpy_advection(q, dx, pde.bc_codes, P)
                 dt = t_end - t if smax <= 0 else min(t_end - t, self.cfl * dx / smax)
                 new = q + dt * rate

@@ -24,8 +24,8 @@ Example::
 The last frame is the final state (the rest time if the run stopped at rest). Movies
 and frames are complete or absent: a movie is written under a temporary name and
 renamed when the run ends; :meth:`LayersPlotTracker.discard` removes it if the run fails.
-Every interrupt makes the solver land exactly on that time, which shortens one step:
-results differ from a run without the tracker at the level of the discretisation error.
+The tracker does not change the run: fv-split shows it the state interpolated at its
+interrupt times without shortening a step (:mod:`pdeflow.solvers.outputs`).
 """
 
 from __future__ import annotations
