@@ -50,7 +50,7 @@ from . import systems
 from .initial_shapes import SHAPES, check_initial, profiles_from_file, total_depth
 from .models.base import check_range
 from .numerics.layout import GEOMETRIES
-from .variant import Variant, VariantError, variant_of
+from .variant import MAX_CFL, Variant, VariantError, variant_of
 
 PAPER_MODEL = "two_layer"
 """the registered name of the paper's two-layer model"""
@@ -174,9 +174,10 @@ class Case:
             self._check_cells()
             check_range("grid.dx", self.dx, 0, self.length, low_open=True, unit="m")
             check_range("numerics.cfl", self.cfl, 0, 1, low_open=True)
-            if self.data.get("numerics", {}).get("reconstruction") == "muscl":
+            reconstruction = self.data.get("numerics", {}).get("reconstruction")
+            if reconstruction == "muscl":
                 check_range("numerics.cfl (with reconstruction = 'muscl')", self.cfl, 0,
-                            0.5, low_open=True)
+                            MAX_CFL[reconstruction], low_open=True)
             if "dt" in self.data.get("numerics", {}):
                 check_range("numerics.dt", self.data["numerics"]["dt"], 0, math.inf,
                             low_open=True, unit="s")

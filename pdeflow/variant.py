@@ -23,10 +23,13 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
+from .models.base import MAX_CFL as BASE_MAX_CFL
 from .numerics import layout as L
 
 FLUXES: tuple[str, ...] = tuple(L.FLUXES)
 RECONSTRUCTIONS: tuple[str, ...] = ("first-order", "muscl")
+MAX_CFL = BASE_MAX_CFL
+"""The largest Courant number of each reconstruction (see pdeflow.models.base)."""
 LIMITERS: tuple[str, ...] = tuple(L.LIMITERS)
 SPLITTINGS: tuple[str, ...] = ("lie", "strang")
 HYPERBOLICITY: tuple[str, ...] = ("exact", "bound", "none")

@@ -96,3 +96,17 @@ def test_command_line(tmp_path, capsys):
     assert (tmp_path / "ritter_dam_break_workprecision.png").exists()
     assert main(["compare", ritter, "--variants", "roe/first-order", "--quiet"]) == 2
     assert "flux must be one of" in capsys.readouterr().err
+
+
+def test_a_variant_runs_at_its_own_cfl_limit_below_the_cases(capsys):
+    """Ritter's case runs at CFL 0.9, above MUSCL's limit 0.5: compare runs MUSCL at 0.5
+    and the first-order variant at the case's 0.9 (the README's command), and says so."""
+    import sys
+
+    case = load_case(CASES / "ritter_dam_break.toml", ["output.snapshot_times=[]"])
+    res = wp.compare(case, ["hll/first-order", "hll/muscl/minmod"], [50], out_dir=None,
+                     repeats=1, log=sys.stderr)
+    steps = {r["variant"]: r["steps"] for r in res.rows}
+    assert "hll/muscl/minmod at CFL 0.5" in capsys.readouterr().err
+    # about 0.9/0.5 as many steps at the larger Courant number (dt ~ cfl dx / smax)
+    assert 1.4 < steps["hll/muscl/minmod"] / steps["hll/first-order"] < 2.2

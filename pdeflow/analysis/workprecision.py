@@ -66,7 +66,7 @@ import numpy as np
 
 from ..cases import Case, CaseError, load_case
 from ..study.core import Study
-from ..variant import Variant
+from ..variant import MAX_CFL, Variant
 from .exact import exact_solution_for
 from .points import Point, case_on_grid, resolve_case
 from .timing import run_variant, timed
@@ -209,7 +209,7 @@ class _Harness:
         if self.reference == "exact" and exact is None:
             raise ValueError(f"no exact solution for {model} on {self.base.name}")
         use_exact = exact if self.reference in ("auto", "exact") else None
-        points = [Point(case_on_grid(self.base, gr, v, self.cfl), model, v)
+        points = [Point(case_on_grid(self.base, gr, v, self.cfl_of(v)), model, v)
                   for v in variants for gr in grids]
         runs = Study(points, self.timed).execute()
         rows: list[dict[str, Any]] = []
@@ -218,6 +218,19 @@ class _Harness:
             prev = rows[-1] if rows and rows[-1]["variant"] == point.variant.name else None
             rows.append(self.row(point, out["run"], ref, ref_name, prev))
         return rows
+
+    def cfl_of(self, v: Variant) -> float | None:
+        """The Courant number of variant ``v``: ``cfl`` if given, else the case's, or the
+        variant's own limit (:data:`pdeflow.variant.MAX_CFL`) where the case's is above
+        it (a case at CFL 0.9 compares MUSCL at 0.5); None: the case's."""
+        if self.cfl is not None or v.is_mol:
+            return self.cfl
+        limit = MAX_CFL[v.reconstruction]
+        if self.base.cfl <= limit:
+            return None
+        self.say(f"  {v.name} at CFL {limit:g}: the case's {self.base.cfl:g} is above the "
+                 f"limit of {v.reconstruction}")
+        return limit
 
     def timed(self, point: Point) -> dict[str, Any]:
         """Measure: the timing of one point, announced on the log."""
@@ -242,7 +255,7 @@ class _Harness:
         rv = Variant.parse(common) if common else (v if not v.is_mol else Variant())
         key = (model, rv.name)
         if key not in self.fine:
-            fc = case_on_grid(self.base, self.ref_dx, rv, self.cfl)
+            fc = case_on_grid(self.base, self.ref_dx, rv, self.cfl_of(rv))
             self.say(f"  reference {model} {rv.name} dx={self.ref_dx:g} ({fc.cells} cells)")
             run = run_variant(fc, model, rv, self.t, repeats=0)
             if run.status != "ok":

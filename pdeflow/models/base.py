@@ -28,6 +28,10 @@ from ..numerics.state import DRY_TOLERANCE
 
 BC_NAMES = L.BOUNDARIES
 RECONSTRUCTIONS = {"first-order": 1, "muscl": 2}
+MAX_CFL = {"first-order": 1.0, "muscl": 0.5}
+"""The largest Courant number of each reconstruction: the first-order update is positive
+up to 1; MUSCL's SSP-RK2 update with limited slopes keeps depths non-negative only up to
+1/2 (docs/stability.md)."""
 
 
 def check_range(name: str, value: Any, low: float, high: float, *,

@@ -24,7 +24,7 @@ import numpy as np
 from pde.solvers.base import SolverBase
 from pde.trackers.base import FinishedSimulation
 
-from ..models.base import GranularPDE, check_range
+from ..models.base import MAX_CFL, GranularPDE, check_range
 from ..numerics import layout as L
 from ..numerics.splitting import STATUS_FAIL, STATUS_REST, python_stepping, scheme_stepper
 from .outputs import StepAhead, pending_output
@@ -213,7 +213,8 @@ class FVSplitSolver(SolverBase):
         self.cfl = check_range("cfl", cfl, 0, 1, low_open=True)
         if pde.reconstruction == "muscl":
             # SSP-RK2 with limited reconstructions keeps depths non-negative only up to 1/2
-            check_range("cfl (with reconstruction='muscl')", cfl, 0, 0.5, low_open=True)
+            check_range("cfl (with reconstruction='muscl')", cfl, 0, MAX_CFL["muscl"],
+                        low_open=True)
         if splitting not in ("lie", "strang"):
             raise ValueError(f"splitting must be 'lie' or 'strang', got {splitting!r}")
         self.splitting = splitting
