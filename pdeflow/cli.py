@@ -57,9 +57,7 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
         from .trackers import ProgressBar
 
         trackers.append(ProgressBar(interval, label=model))
-    from .trackers.live import display_mode
-
-    show = args.live and display_mode("auto") != "none"  # headless: nothing to show
+    show = args.live and _live_display()  # headless: nothing to show
     if show or args.movie or args.frames:
         from .trackers.live import LayersPlotTracker
 
@@ -120,6 +118,13 @@ def _check_run_outputs(args: argparse.Namespace, outdir: Path | None) -> None:
         from .storage import require_h5py
 
         require_h5py()
+
+
+def _live_display() -> bool:
+    """Whether a live plot can be shown here (imports matplotlib: only for --live)."""
+    from .trackers.live import display_mode
+
+    return display_mode("auto") != "none"
 
 
 def _live_window(args: argparse.Namespace) -> bool:
@@ -384,9 +389,10 @@ def _main(argv: list[str] | None = None) -> int:
         return 3
     except ValueError as err:
         from .io import OutputError
-        from .trackers.live import MovieError
 
-        if not isinstance(err, (MovieError, OutputError)):
+        movie_error = "pdeflow.trackers.live" in sys.modules and isinstance(
+            err, sys.modules["pdeflow.trackers.live"].MovieError)  # only movies raise it
+        if not (movie_error or isinstance(err, OutputError)):
             raise
         print(f"pdeflow: error: {err}", file=sys.stderr)
         return 2

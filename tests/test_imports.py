@@ -1,0 +1,42 @@
+"""A run that draws, serves, studies, stores and shows nothing imports nothing for it.
+
+py-pde itself imports scipy and tqdm (``import pde``), so those are not checked."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+CASE = ROOT / "cases" / "paper_5_1_dam_break.toml"
+NOT_NEEDED = ("matplotlib", "panel", "bokeh", "dask", "distributed", "pandas", "h5py",
+              "xarray", "optuna", "SALib", "imageio_ffmpeg", "pdeflow.plotting",
+              "pdeflow.case_figures", "pdeflow.trackers.live", "pdeflow.app.dam_break")
+
+SCRIPT = """
+import json, sys
+from pdeflow.cases import load_case
+from pdeflow.simulate import run_model
+case = load_case(sys.argv[1], ["output.snapshot_times=[]", "grid.dx=0.1"])
+for model in case.models:
+    run_model(case, model)
+api = sorted(m for m in sys.argv[3:] if m in sys.modules)
+from pdeflow.cli import main
+main(["run", sys.argv[1], "--set", "grid.dx=0.1", "--summary", sys.argv[2], "-q"])
+cli = sorted(m for m in sys.argv[3:] if m in sys.modules)
+print("MODULES" + json.dumps([api, cli]))
+"""
+
+
+def test_a_quiet_run_imports_no_plotting_serving_or_study_machinery(tmp_path):
+    proc = subprocess.run([sys.executable, "-c", SCRIPT, str(CASE),
+                           str(tmp_path / "s.json"), *NOT_NEEDED],
+                          capture_output=True, text=True, cwd=tmp_path, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    line = next(x for x in proc.stdout.splitlines() if x.startswith("MODULES"))
+    api, cli = json.loads(line[len("MODULES"):])
+    assert api == [], f"the Python API imported {api}"
+    assert cli == [], f"pdeflow run -q --summary imported {cli}"
+    assert json.loads((tmp_path / "s.json").read_text())["models"]
