@@ -276,3 +276,17 @@ def test_create_app_displays_in_jupyter():
         skip_or_fail_in_ci(f"no Jupyter kernel can start here: {err!r}")
     data = [o.get("data", {}) for o in nb.cells[0].outputs]
     assert any("application/vnd.holoviews_exec.v0+json" in d for d in data), data
+
+
+def test_command_lines_are_readable_and_mean_the_overrides():
+    """A TOML string value is shown in double quotes (not shlex's '"'"' chains), and
+    every command line splits back into exactly the overrides (a POSIX shell's view)."""
+    import shlex
+
+    overrides = ["two_layer.exchange_closure='relaxed'", "grid.dx=0.05",
+                 "case.name=\"a b\"", "case.models=['single_layer']",
+                 "case.description='it''s $HOME'"]
+    line = command_line(CASE_51, overrides)
+    assert "--set \"two_layer.exchange_closure='relaxed'\"" in line
+    assert "'\"'\"'" not in line.split("case.description")[0]
+    assert shlex.split(line)[4::2] == overrides

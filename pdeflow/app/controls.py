@@ -158,7 +158,17 @@ def command_line(case_path: Path, overrides: Sequence[str]) -> str:
     args = ["pdeflow", "run", str(shown)]
     for item in overrides:
         args += ["--set", item]
-    return " ".join(shlex.quote(a) for a in args)
+    return " ".join(_quote(a) for a in args)
+
+
+def _quote(arg: str) -> str:
+    """``arg`` for a POSIX shell, readably: a TOML string value in single quotes goes in
+    double quotes (``"two_layer.exchange_closure='relaxed'"``), where nothing else in it
+    is special to the shell, instead of shlex's '...'"'"'...'"'"' form."""
+    quoted = shlex.quote(arg)
+    if quoted != arg and "'" in arg and not any(c in arg for c in '"$`\\!'):
+        return f'"{arg}"'
+    return quoted
 
 
 class ParameterControls:
