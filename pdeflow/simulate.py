@@ -277,6 +277,8 @@ def print_summary(summary: dict[str, Any], out: Any = None) -> None:
         # the front and the run-out are radii: R_f and R_f - R0
         rows = [("front radius" if k == "front_position" else label, k, u)
                 for label, k, u in rows]
+    # rows no model of the run has (a single-layer case: no lower/upper stop)
+    rows = [row for row in rows if any(row[1] in s for s in models.values())]
     print(f"case {summary['case']}", file=out)
     print(f"{'':18}" + "".join(f"{m:>16}" for m in models), file=out)
     for label, key, unit in rows:

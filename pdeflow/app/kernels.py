@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import threading
 import time
+import warnings
 from collections.abc import Callable
 
 from ..cases import BASELINE_MODEL, PAPER_MODEL
@@ -29,6 +30,7 @@ WARMUP_CASE = {
 def warm_kernels() -> None:
     """Run every kernel the app uses once: compiles them, or loads them from the cache."""
     from ..cases import Case
+    from ..checks import RunWarning
     from ..numerics import hyperbolicity as hyp
     from ..numerics.warmup import prepare
     from ..simulate import case_steppers, run_model
@@ -46,8 +48,11 @@ def warm_kernels() -> None:
     case = Case.from_dict(WARMUP_CASE, source="<kernel warm-up>")
     # both models' kernels at once: compiled on two cores
     prepare(case_steppers(case), meanwhile=spectrum_functions)
-    for model in case.models:
-        run_model(case, model)
+    with warnings.catch_warnings():
+        # the warm-up's runs are not the user's: their "still moving" is no news
+        warnings.simplefilter("ignore", RunWarning)
+        for model in case.models:
+            run_model(case, model)
 
 
 class KernelWarmup:
