@@ -75,6 +75,35 @@ def test_progress_bar_says_it_compiles_and_restarts_its_clock(monkeypatch, capsy
     assert "at rest" in capsys.readouterr().err
 
 
+def test_each_update_draws_the_bar_once_with_its_label(monkeypatch):
+    """py-pde's own update draws the bar with an empty label; the bar here draws every
+    update once, with the model's label (no flicker)."""
+    monkeypatch.setattr(warmup, "status", lambda work=None: warmup.READY)
+    eq, state = _readme_state()
+    bar = ProgressBar(0.5, label="two_layer")
+    drawn: list[str] = []
+
+    class Spy(TrackerBase):
+        def initialize(self, field, info=None):
+            tqdm_bar = bar.progress_bar
+            refresh = tqdm_bar.refresh
+
+            def counted(*args, **kwargs):
+                drawn.append(tqdm_bar.desc)
+                return refresh(*args, **kwargs)
+
+            monkeypatch.setattr(tqdm_bar, "refresh", counted)
+            return super().initialize(field, info)
+
+        def handle(self, field, t):
+            pass
+
+    eq.solve(state, t_range=2, solver="fv-split", tracker=[bar, Spy(0.5)])
+    updates = [d for d in drawn if d]
+    assert updates and all(d.rstrip(": ") == "two_layer" for d in drawn[:-1])
+    assert len(drawn) <= 2 * len(updates)  # at most the close's own draw besides
+
+
 def test_prepare_says_when_it_compiles(monkeypatch):
     """``pdeflow run`` compiles (or loads) the kernels before its runs and, when it has
     to compile them, says so with the time it took."""

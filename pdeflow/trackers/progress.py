@@ -56,8 +56,10 @@ class ProgressBar(ProgressTracker):
         return result
 
     def handle(self, field: Any, t: float) -> None:
-        super().handle(field, t)
+        # py-pde's handle draws the bar with an empty label, then this one drew it with
+        # its own: two draws per update, a flickering label. One draw here.
         bar = self.progress_bar
+        bar.n = round(min(t, bar.total) if bar.total else t, self.ndigits)
         if not self._clock_started and t > bar.initial:
             if self._waiting != self.label:
                 # the first interval held the compilation: restart the clock here, so
@@ -65,8 +67,8 @@ class ProgressBar(ProgressTracker):
                 bar.start_t = bar.last_print_t = bar._time()
                 bar.initial = bar.n
             self._clock_started = True
-        bar.set_description(self.label if self._clock_started else self._waiting)
         bar.set_postfix_str(f"t = {t:.4g} s", refresh=False)
+        bar.set_description(self.label if self._clock_started else self._waiting)
 
     def finalize(self, info: InfoDict | None = None) -> None:
         TrackerBase.finalize(self, info)
