@@ -68,7 +68,7 @@ from ..cases import Case, CaseError, load_case
 from ..study.core import Study
 from ..variant import Variant
 from .exact import exact_solution_for
-from .points import Point, case_on_grid, resolve_case
+from .points import Point, case_on_grid, resolve_case, with_sets
 from .timing import run_variant, timed
 
 DEFAULT_VARIANTS: tuple[str, ...] = (
@@ -399,7 +399,28 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--hyperbolicity", action="store_true",
                    help="also compare the hyperbolicity modes exact/bound/none "
                         "(two-layer cases)")
+    p.add_argument("--laws", nargs="+", default=None, metavar="LAW",
+                   help="basal friction laws to compare on the same grids (coulomb, "
+                        "pouliquen, mu_i, voellmy): each model's friction_law in turn; "
+                        "default: the case's")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
+
+
+def _cases_and_laws(args: argparse.Namespace) -> list[tuple[str, Case, str | None]]:
+    """(path, case, label) of every case file, once per ``--laws`` entry if given (the
+    case with every model's ``friction_law`` set to it, labelled ``<case>_<law>``: the
+    laws then run on the same grids, variants and reference time)."""
+    out: list[tuple[str, Case, str | None]] = []
+    for path in args.cases:
+        case = load_case(path, args.set)
+        if not getattr(args, "laws", None):
+            out.append((path, case, None))
+            continue
+        models = args.models or case.models
+        for law in args.laws:
+            sets = [f"{m}.friction_law={law}" for m in models]
+            out.append((path, with_sets(case, sets), f"{case.name}_{law}"))
+    return out
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
@@ -408,12 +429,11 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
     log = None if args.quiet else sys.stderr
     try:
-        for path in args.cases:
-            case = load_case(path, args.set)
+        for path, case, label in _cases_and_laws(args):
             res = compare(case, args.variants, args.grids, args.reference, args.out_dir,
                           t=args.t, repeats=args.repeats, models=args.models,
                           cfl=args.cfl, reference_dx=args.reference_dx,
-                          mol_cap=args.mol_cap, log=log)
+                          mol_cap=args.mol_cap, label=label, log=log)
             print(f"## {res.case} (t = {res.t:g} s)\n")
             print(markdown_table(res))
             print(f"written: {', '.join(res.files.values())}\n")
