@@ -140,6 +140,33 @@ def cell_update_rates(variants: Sequence[str] = BENCH_VARIANTS, dx: float = 0.01
     return rows
 
 
+def friction_law_costs(repeats: int = 5, dx: float = 0.0125, t_end: float = 0.4,
+                       laws: Sequence[str] = ("pouliquen", "mu_i", "voellmy")
+                       ) -> list[dict[str, Any]]:
+    """ns per cell update of each basal friction law against Coulomb on the 5.1 case
+    (hll/first-order, dx [m], to ``t_end`` [s]), every model; the runs interleaved
+    (Coulomb, law, Coulomb, law, ...) so that the machine's load hits both alike, and
+    ``ratio`` the law's median over Coulomb's (issue 23's target for pouliquen: 1.2)."""
+    from pdeflow.analysis.points import case_on_grid, resolve_case
+    from pdeflow.variant import Variant
+
+    base = case_on_grid(resolve_case(CASE_5_1), dx, Variant.parse("hll/first-order"))
+    rows = []
+    for model in ("single_layer", "two_layer"):
+        for law in laws:
+            c = base.copy()
+            c.data.setdefault(model, {})["friction_law"] = law
+            runs = [fv_stepper_run(base, model, t_end), fv_stepper_run(c, model, t_end)]
+            outs = [run() for run in runs]  # warm-up (compiles)
+            walls = interleaved_walls(runs, repeats)
+            ns = [1e9 * statistics.median(w) / (o["steps"] * o["cells"])
+                  for w, o in zip(walls, outs, strict=True)]
+            rows.append({"model": model, "law": law, "coulomb_ns": ns[0], "law_ns": ns[1],
+                         "ratio": ns[1] / ns[0], "steps": [o["steps"] for o in outs],
+                         "load_avg": os.getloadavg()[0]})
+    return rows
+
+
 def _cell_update_cost(run: Callable[[], dict[str, Any]], repeats: int) -> dict[str, Any]:
     """Cells, dx [m], steps, final time [s], median wall time [s] (and all walls) of
     ``run`` (an ``fv_stepper_run``), cell updates per second and ns per cell update."""

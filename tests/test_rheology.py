@@ -14,7 +14,12 @@ from pdeflow.models.friction_laws import h_stop
 from pdeflow.numerics import layout as L
 from pdeflow.numerics import layout_single_layer as S
 from pdeflow.numerics import layout_two_layer as T
-from pdeflow.numerics.rheology import basal_accel, friction_two_layer_law, law_speed
+from pdeflow.numerics.rheology import (
+    basal_accel,
+    friction_two_layer_law,
+    law_block,
+    law_speed,
+)
 from tests.helpers import grid, step
 
 LAWS = ["pouliquen", "mu_i", "voellmy"]
@@ -133,23 +138,24 @@ def test_backward_euler_step_is_the_root_and_set_valued(law):
     u + dt a(u) = |b| (a: the law's deceleration) to round-off; u grows with |b|; thin
     films (h down to 1e-12 m) give finite speeds."""
     P = law_parameters(law)
+    law = law_block(P, S.LAW)
     rng = np.random.default_rng(3)
     gz = P[S.G_Z]
     for _ in range(2000):
         h = 10.0 ** rng.uniform(-12, 0.5)
         dt = 10.0 ** rng.uniform(-5, -1)
-        a_static = dt * basal_accel(P, S.LAW, h, gz, h, 0.0)
+        a_static = dt * basal_accel(law, h, gz, h, 0.0)
         b = a_static * rng.uniform(0.0, 3.0) + (rng.uniform(0, 5) if rng.random() < 0.3
                                                  else 0.0)
-        s = law_speed(b, h, gz, h, dt, P, S.LAW)
+        s = law_speed(b, h, gz, h, dt, law)
         assert np.isfinite(s) and s >= 0.0
         if b <= a_static:
             assert s == 0.0
         else:
             assert s > 0.0 or b - a_static < 1e-300
-            residual = s + dt * basal_accel(P, S.LAW, h, gz, h, s) - b
+            residual = s + dt * basal_accel(law, h, gz, h, s) - b
             assert abs(residual) <= 1e-12 * b
-            assert law_speed(b * 1.01, h, gz, h, dt, P, S.LAW) >= s
+            assert law_speed(b * 1.01, h, gz, h, dt, law) >= s
 
 
 @pytest.mark.parametrize("law", LAWS)
@@ -158,6 +164,7 @@ def test_two_layer_root_balances_the_total_momentum(law):
     total momentum m1 (u1 - b1) + m2 (u2 - b2) + dt B(u2) = 0, and a stuck one is held
     by the static bound."""
     P = law_parameters(law, pdeflow.TwoLayerGranular)
+    law = law_block(P, T.LAW)
     rng = np.random.default_rng(5)
     g, r = P[T.G_Z], P[T.R]
     for _ in range(1000):
@@ -166,16 +173,16 @@ def test_two_layer_root_balances_the_total_momentum(law):
         b1, b2 = rng.normal(0, 2, 2)
         m1 = r * h1
         kdt = dt * 0.65 * r * g * h1 * P[T.TAN_INT]
-        u1, u2 = friction_two_layer_law(b1, b2, m1, h2, kdt, dt * 0.03, dt, g, h1 + h2, P,
-                                        T.LAW)
+        u1, u2 = friction_two_layer_law(b1, b2, m1, h2, kdt, dt * 0.03, dt, g, h1 + h2,
+                                        law)
         assert np.isfinite(u1) and np.isfinite(u2)
         w = m1 + h2
         if u2 == 0.0:
             push = h2 * b2 + m1 * (b1 - u1)
-            assert abs(push) <= dt * basal_accel(P, T.LAW, h1 + h2, g * w, 1.0, 0.0) * (
+            assert abs(push) <= dt * basal_accel(law, h1 + h2, g * w, 1.0, 0.0) * (
                 1 + 1e-12)
         else:
-            bdt = dt * basal_accel(P, T.LAW, h1 + h2, g * w, 1.0, abs(u2)) * np.sign(u2)
+            bdt = dt * basal_accel(law, h1 + h2, g * w, 1.0, abs(u2)) * np.sign(u2)
             balance = m1 * (u1 - b1) + h2 * (u2 - b2) + bdt
             assert abs(balance) <= 1e-10 * (m1 * abs(b1) + h2 * abs(b2) + abs(bdt))
 

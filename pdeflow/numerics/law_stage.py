@@ -28,7 +28,7 @@ from . import friction, source_stage
 from . import layout_single_layer as S
 from . import layout_two_layer as T
 from .compiled import PARAMS, STATE, VECTOR, cached, f8, i8, kernel
-from .rheology import friction_two_layer_law, law_velocity
+from .rheology import friction_two_layer_law, law_block, law_velocity
 from .source_stage import _close_stage
 from .sources import _drag_root
 from .state import velocity
@@ -63,8 +63,8 @@ def implicit_friction_law(b1, b2, h1, h2, dt, P, f, k, c):
             b1 = b1 - dt * f / m1
             b2 = b2 + dt * f / h2
         kdt = dt * k * r * g * h1 * P[T.TAN_INT]
-        return friction_two_layer_law(b1, b2, m1, h2, kdt, dt * c, dt, g, h1 + h2, P,
-                                      T.LAW)
+        return friction_two_layer_law(b1, b2, m1, h2, kdt, dt * c, dt, g, h1 + h2,
+                                      law_block(P, T.LAW))
     if wet1:
         # no lower layer: the upper layer rubs on the bed with the interface law (22)
         m1 = r * h1
@@ -73,7 +73,7 @@ def implicit_friction_law(b1, b2, h1, h2, dt, P, f, k, c):
         return (u1 if b1 > 0.0 else -u1), 0.0
     if wet2:
         gw = g * (h2 + r * max(h1, 0.0)) / h2
-        return 0.0, law_velocity(b2, h2 + max(h1, 0.0), gw, h2, dt, P, T.LAW)
+        return 0.0, law_velocity(b2, h2 + max(h1, 0.0), gw, h2, dt, law_block(P, T.LAW))
     return 0.0, 0.0
 
 
@@ -102,6 +102,7 @@ def sources_single_law(q: np.ndarray, dt: float, t: float, P: np.ndarray,
     g = P[S.G_Z]
     gx = P[S.G_X]
     dry = P[S.DRY]
+    law = law_block(P, S.LAW)
     moving = False
     fast = False
     for i in range(lo, hi + 1):
@@ -112,7 +113,7 @@ def sources_single_law(q: np.ndarray, dt: float, t: float, P: np.ndarray,
         h = max(h, 0.0)
         u = velocity(h, m, dry)
         if dt > 0.0 and h > dry:
-            u = law_velocity(u + dt * gx, h, g, h, dt, P, S.LAW)
+            u = law_velocity(u + dt * gx, h, g, h, dt, law)
         m = h * u if h > dry else 0.0
         if m != 0.0:
             moving = True
@@ -136,10 +137,11 @@ def predictor_single_law(q: np.ndarray, dt: float, P: np.ndarray, lo: int,
     """:func:`pdeflow.numerics.friction.predictor_single` with the basal law: zero the
     momentum of cells that the law's implicit friction would hold at rest."""
     dry = P[S.DRY]
+    law = law_block(P, S.LAW)
     for i in range(lo, hi + 1):
         h = max(q[0, i], 0.0)
         if h > dry:
-            u = law_velocity(q[1, i] / h + dt * P[S.G_X], h, P[S.G_Z], h, dt, P, S.LAW)
+            u = law_velocity(q[1, i] / h + dt * P[S.G_X], h, P[S.G_Z], h, dt, law)
             if u == 0.0:
                 q[1, i] = 0.0
 

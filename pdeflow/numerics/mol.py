@@ -29,7 +29,7 @@ from . import layout as L
 from . import layout_single_layer as S
 from . import layout_two_layer as T
 from .compiled import FIELDS, PARAMS, STATE, kernel
-from .rheology import basal_accel
+from .rheology import basal_accel, law_block
 from .sources import closure_rate, relaxed_rate
 from .state import velocity
 
@@ -71,8 +71,9 @@ def source_rate_two_layer(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> Non
             if coulomb:
                 bf = g * (r * h1 + h2) * P[T.TAN_B] * u2 / max(abs(u2), eps)
             else:  # the law's stress: h2 x deceleration per unit mass
-                bf = h2 * basal_accel(P, T.LAW, h1 + h2, g * (r * h1 + h2) / h2, h2,
-                                      abs(u2)) * u2 / max(abs(u2), eps)
+                bf = h2 * basal_accel(law_block(P, T.LAW), h1 + h2,
+                                      g * (r * h1 + h2) / h2, h2, abs(u2)) * u2 / max(
+                                          abs(u2), eps)
             rate[3, i] += gx * h2 - u1 * m + t1 - bf
         else:
             rate[3, i] -= u1 * m
@@ -91,4 +92,5 @@ def source_rate_single(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> None:
                     abs(u), P[S.MOL_EPS])
             else:
                 rate[1, i] += P[S.G_X] * h - h * basal_accel(
-                    P, S.LAW, h, P[S.G_Z], h, abs(u)) * u / max(abs(u), P[S.MOL_EPS])
+                    law_block(P, S.LAW), h, P[S.G_Z], h, abs(u)) * u / max(
+                        abs(u), P[S.MOL_EPS])
