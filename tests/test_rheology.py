@@ -244,3 +244,23 @@ def test_coulomb_runs_compile_none_of_the_laws_code():
         found = {}
         compile_parallel._call_tree(coulomb.system.law_kernels.sources, found)
         assert law_kernels & {id(k) for k in found.values()}
+
+
+def test_rheology_report_generator_runs(tmp_path):
+    """docs/generate/rheology.py on a coarse grid and two aspect ratios (a few seconds):
+    the report names the closest law of each model and the figure exists."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    proc = subprocess.run(
+        [sys.executable, str(root / "docs" / "generate" / "rheology.py"), "--out",
+         str(tmp_path), "--dx", "0.05", "--length", "12", "--ratios", "2", "4"],
+        capture_output=True, text=True, timeout=600,
+        env={**__import__("os").environ, "PYTHONPATH": str(root)})
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    text = (tmp_path / "rheology.md").read_text()
+    for model in ("two_layer", "single_layer"):
+        assert f"* {model}: closest to Lube et al. is **" in text
+    assert (tmp_path / "figures" / "rheology_runout.png").stat().st_size > 1000
