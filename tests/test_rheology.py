@@ -264,3 +264,21 @@ def test_rheology_report_generator_runs(tmp_path):
     for model in ("two_layer", "single_layer"):
         assert f"* {model}: closest to Lube et al. is **" in text
     assert (tmp_path / "figures" / "rheology_runout.png").stat().st_size > 1000
+
+
+def test_case_key_reaches_the_run_and_its_stored_variant():
+    """``single_layer.friction_law`` in a case: the run uses the law, its parameters are
+    in the metadata, and the stored variant names it (a Coulomb run's variant is as
+    before, without it)."""
+    from pdeflow.cases import load_case
+    from pdeflow.storage import run_metadata
+
+    root = __import__("pathlib").Path(__file__).resolve().parents[1]
+    case_file = root / "cases" / "collapse_sweep.toml"
+    sets = ["grid.dx=0.05", "case.models=['single_layer']"]
+    coulomb = load_case(case_file, sets)
+    law = load_case(case_file, [*sets, "single_layer.friction_law='pouliquen'"])
+    assert law.make_pde("single_layer").parameters.friction_law == "pouliquen"
+    meta = run_metadata(law, "single_layer")
+    assert "friction_law=pouliquen" in meta["variant"]
+    assert "friction_law" not in run_metadata(coulomb, "single_layer")["variant"]
