@@ -395,8 +395,9 @@ def _render_bench(b: dict[str, Any]) -> str:
                  f"{r['wall_s'] * 1e3:.3g} | {r['cell_updates_per_s']:.3g} | "
                  f"{r['ns_per_cell_update']:.3g} |" for r in b["rates"]))
     if b.get("friction_laws"):  # measured since issue 23
-        L += ["", "### Basal friction laws (5.1 case, hll/first-order, interleaved "
-              "with Coulomb; target for pouliquen: <= 1.2x)\n"]
+        L += ["", "### Basal friction laws (a dam break onto a wet 30 deg slope, "
+              "hll/first-order, interleaved with Coulomb; target for pouliquen: <= "
+              "1.2x)\n"]
         L += _table(["model", "law", "Coulomb ns/update", "law ns/update", "ratio"],
                     "llrrr", (f"| {r['model']} | {r['law']} | {r['coulomb_ns']:.3g} | "
                               f"{r['law_ns']:.3g} | {r['ratio']:.2f}x |"
