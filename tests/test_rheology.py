@@ -282,3 +282,26 @@ def test_case_key_reaches_the_run_and_its_stored_variant():
     meta = run_metadata(law, "single_layer")
     assert "friction_law=pouliquen" in meta["variant"]
     assert "friction_law" not in run_metadata(coulomb, "single_layer")["variant"]
+
+
+def test_a_study_over_laws_warms_every_law_bundle(tmp_path):
+    """A study file choosing among basal laws: the kernels its workers will need (the
+    Coulomb bundle and the law bundle) are among those its process prepares."""
+    from pathlib import Path
+
+    from pdeflow.study.evaluate import study_steppers
+    from pdeflow.study.spec import load_study
+
+    root = Path(__file__).resolve().parents[1]
+    study = tmp_path / "laws.toml"
+    study.write_text(
+        '[study]\nname = "laws"\n'
+        f'case = "{(root / "cases" / "paper_5_1_dam_break.toml").as_posix()}"\n'
+        'set = ["grid.dx=0.05", "case.models=[\'single_layer\']"]\n'
+        'design = "grid"\nquantities = ["single_layer.runout"]\n'
+        '[parameters]\n"single_layer.friction_law" = { choices = ["coulomb", "voellmy"] }\n')
+    spec = load_study(study)
+    kernels = {k for s in study_steppers(spec) for k in s.kernels}
+    system = pdeflow.SingleLayerGranular.system
+    assert system.kernels.sources in kernels
+    assert system.law_kernels.sources in kernels
