@@ -9,8 +9,8 @@ them (:mod:`pdeflow.models.friction_laws`).
 
 The laws, written for s > 0 as mu(h, s) = mu1 + dmu s / (s0(h) + s), s0 = S0 h^(3/2):
 
-* ``pouliquen`` (Pouliquen & Forterre 2002, J. Fluid Mech. 453, their eqs. 2.4-2.7 as
-  we number them in docs/model.md): for Fr = s/sqrt(g_z h) >= beta,
+* ``pouliquen`` (Pouliquen & Forterre 2002, J. Fluid Mech. 453; the paper's equation
+  numbers could not be checked here, see docs/model.md): for Fr = s/sqrt(g_z h) >= beta,
   mu = tan d1 + (tan d2 - tan d1) / (1 + beta h / (L Fr)), i.e. S0 = beta sqrt(g_z) / L;
   for 0 < Fr < beta the value at Fr = beta, mu_stop(h) = tan d1 + (tan d2 - tan d1) /
   (1 + h/L), which is also the static bound. Steady uniform flow on a slope theta has
@@ -18,7 +18,7 @@ The laws, written for s > 0 as mu(h, s) = mu1 + dmu s / (s0(h) + s), s0 = S0 h^(
   (The paper's start branch mu_start with d3 > d1, and its (Fr/beta)^gamma
   interpolation, make friction *decrease* from rest to motion; a weakening law has two
   backward-Euler solutions in a step, so it is not offered: see docs/model.md.)
-* ``mu_i`` (Jop, Forterre & Pouliquen 2006, Nature 441, eq. 2 there): mu(I) = mu_s +
+* ``mu_i`` (Jop, Forterre & Pouliquen 2006, Nature 441): mu(I) = mu_s +
   (mu2 - mu_s) / (I0/I + 1) with the depth-averaged I = 5 s d / (2 h sqrt(phi g_z h))
   of a Bagnold profile, i.e. S0 = 2 I0 sqrt(phi g_z) / (5 d); static bound mu_s.
 * ``voellmy`` (Voellmy 1955, Salm 1993): mu + g s^2 / (xi h) (dmu = 0); static bound mu.
