@@ -145,6 +145,8 @@ def measure_bench(quick: bool, repeats: int, pyclaw: bool) -> dict[str, Any]:
     _log("cell update rates ...")
     out["rates"] = suite.cell_update_rates(
         suite.BENCH_VARIANTS[:2] if quick else suite.BENCH_VARIANTS, repeats=repeats)
+    _log("basal friction laws against Coulomb ...")
+    out["friction_laws"] = suite.friction_law_costs(repeats)
     _log("5.1 to rest ...")
     out["case_5_1"] = suite.case_5_1_to_rest(repeats)
     _log("10^5 cells, 200 steps ...")
@@ -396,6 +398,14 @@ def _render_bench(b: dict[str, Any]) -> str:
                 (f"| {r['model']} | {r['variant']} | {r['cells']} | {r['steps']} | "
                  f"{r['wall_s'] * 1e3:.3g} | {r['cell_updates_per_s']:.3g} | "
                  f"{r['ns_per_cell_update']:.3g} |" for r in b["rates"]))
+    if b.get("friction_laws"):  # measured since issue 23
+        L += ["", "### Basal friction laws (a dam break onto a wet 30 deg slope, "
+              "hll/first-order, interleaved with Coulomb; target for pouliquen: <= "
+              "1.2x)\n"]
+        L += _table(["model", "law", "Coulomb ns/update", "law ns/update", "ratio"],
+                    "llrrr", (f"| {r['model']} | {r['law']} | {r['coulomb_ns']:.3g} | "
+                              f"{r['law_ns']:.3g} | {r['ratio']:.2f}x |"
+                              for r in b["friction_laws"]))
     c = b["compile"]
     L += ["", "### Compilation (fresh subprocesses, own NUMBA_CACHE_DIR)\n",
           "| | import [s] | single layer 1st run [s] | 2nd run [s] | two layers 1st run "

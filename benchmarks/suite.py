@@ -140,6 +140,40 @@ def cell_update_rates(variants: Sequence[str] = BENCH_VARIANTS, dx: float = 0.01
     return rows
 
 
+CASE_WET_SLOPE = ROOT / "cases" / "mangeney_dam_break_slope.toml"
+
+
+def friction_law_costs(repeats: int = 5, cells: int = 2000, t_end: float = 0.3,
+                       laws: Sequence[str] = ("pouliquen", "mu_i", "voellmy")
+                       ) -> list[dict[str, Any]]:
+    """ns per cell update of each basal friction law against Coulomb, every model: the
+    dam break on a 30 deg slope onto a wet bed (h_right = 0.02 m, so that every cell is
+    wet and updated in both runs; ``cells`` cells, to ``t_end`` [s], hll/first-order;
+    both layers on the slope for the two-layer model), the runs interleaved (Coulomb,
+    law, Coulomb, law, ...) so that the machine's load hits both alike; ``ratio`` is the
+    law's median over Coulomb's (issue 23's target for pouliquen: 1.2)."""
+    from pdeflow.cases import load_case
+
+    sets = [f"grid.cells={cells}", "initial.h_right=0.02", "output.snapshot_times=[]",
+            "case.models=['single_layer', 'two_layer']", "two_layer.theta_deg=30.0",
+            "two_layer.phi_b_deg=20.0", f"case.t_end={t_end!r}"]
+    base = load_case(CASE_WET_SLOPE, sets)
+    rows = []
+    for model in ("single_layer", "two_layer"):
+        for law in laws:
+            case = load_case(CASE_WET_SLOPE, [*sets, f"{model}.friction_law='{law}'"])
+            runs = [fv_stepper_run(base, model, t_end, stop_at_rest=False),
+                    fv_stepper_run(case, model, t_end, stop_at_rest=False)]
+            outs = [run() for run in runs]  # warm-up (compiles)
+            walls = interleaved_walls(runs, repeats)
+            ns = [1e9 * statistics.median(w) / (o["steps"] * o["cells"])
+                  for w, o in zip(walls, outs, strict=True)]
+            rows.append({"model": model, "law": law, "coulomb_ns": ns[0], "law_ns": ns[1],
+                         "ratio": ns[1] / ns[0], "steps": [o["steps"] for o in outs],
+                         "load_avg": os.getloadavg()[0]})
+    return rows
+
+
 def _cell_update_cost(run: Callable[[], dict[str, Any]], repeats: int) -> dict[str, Any]:
     """Cells, dx [m], steps, final time [s], median wall time [s] (and all walls) of
     ``run`` (an ``fv_stepper_run``), cell updates per second and ns per cell update."""

@@ -81,8 +81,9 @@ def require_h5py() -> None:
 # --- metadata -----------------------------------------------------------------------------
 def _variant_parts(case: Any, eq: Any) -> list[str]:
     """What distinguishes this run's numerics and closure from the paper's defaults:
-    the PDE's scheme (``eq.variant``, e.g. 'hll/first-order'), the splitting, and for
-    two layers the exchange closure and the hyperbolicity mode."""
+    the PDE's scheme (``eq.variant``, e.g. 'hll/first-order'), the splitting, for
+    two layers the exchange closure and the hyperbolicity mode, and a basal friction
+    law other than Coulomb's."""
     num = case.data.get("numerics", {})
     parts = [case.solver]
     if getattr(eq, "variant", None):
@@ -96,6 +97,8 @@ def _variant_parts(case: Any, eq: Any) -> list[str]:
     for key in ("exchange_closure", "hyperbolicity"):
         if key in params:
             parts.append(f"{key}={params[key]}")
+    if getattr(eq.parameters, "rate_dependent_law", False):
+        parts.append(f"friction_law={params['friction_law']}")  # Coulomb: as before
     return parts
 
 

@@ -90,6 +90,18 @@ class EquationSystem:
     168 one layer)"""
     paper_runout_law: tuple[float, float] | None = None
     """(prefactor, exponent) of the run-out law r = p a^e of the paper's test 5.2"""
+    law_kernels: Any = None
+    """the :attr:`kernels` with a rate-dependent basal friction law, for parameters
+    whose ``rate_dependent_law`` is true (None: the model has no such choice)"""
+
+    def kernels_for(self, parameters: Any) -> Any:
+        """The kernel bundle for ``parameters``: :attr:`law_kernels` if they choose a
+        rate-dependent basal law, else :attr:`kernels` (so that a Coulomb run compiles
+        none of the laws' code)."""
+        if self.law_kernels is not None and getattr(parameters, "rate_dependent_law",
+                                                    False):
+            return self.law_kernels
+        return self.kernels
 
     @property
     def field_names(self) -> tuple[str, ...]:

@@ -290,3 +290,21 @@ def test_command_lines_are_readable_and_mean_the_overrides():
     assert "--set \"two_layer.exchange_closure='relaxed'\"" in line
     assert "'\"'\"'" not in line.split("case.description")[0]
     assert shlex.split(line)[4::2] == overrides
+
+
+def test_friction_law_choice_sets_every_model_and_enables_its_sliders():
+    """The law choice becomes ``<model>.friction_law`` of each model of the case, and
+    only the chosen law's parameter sliders are enabled (issue 23)."""
+    from pdeflow.app.controls import ParameterControls
+
+    calls = []
+    controls = ParameterControls({"5.1": CASE_51}, "5.1", lambda: calls.append(1))
+    assert controls.law.value == "coulomb" and controls.sliders["voellmy_xi"].disabled
+    controls.law.value = "voellmy"
+    assert calls and not controls.sliders["voellmy_xi"].disabled
+    assert controls.sliders["pouliquen_L"].disabled
+    over = controls.overrides()
+    assert "two_layer.friction_law='voellmy'" in over
+    assert "single_layer.friction_law='voellmy'" in over
+    case = controls.load()
+    assert case.make_pde("single_layer").parameters.friction_law == "voellmy"

@@ -228,6 +228,18 @@ def test_random_states_keep_the_invariants(scenario, n_steps):
     check_invariants_step_by_step(eq, state, scenario.cfl, scenario.splitting, n_steps)
 
 
+@settings(PROFILE, max_examples=min(PROFILE.max_examples, 60))
+@given(scenarios(), st.sampled_from(["pouliquen", "mu_i", "voellmy"]),
+       st.integers(5, 30))
+def test_random_states_keep_the_invariants_with_every_basal_law(scenario, law, n_steps):
+    """The same random states with a rate-dependent basal law (issue 23): positivity,
+    mass, dry cells at rest and hyperbolicity after every step."""
+    scenario.params["friction_law"] = law
+    eq, state = scenario.make()
+    note(repr(scenario))
+    check_invariants_step_by_step(eq, state, scenario.cfl, scenario.splitting, n_steps)
+
+
 @st.composite
 def rest_states(draw) -> Scenario:
     """Heaps whose surface is below the friction angle in every cell, with a margin.

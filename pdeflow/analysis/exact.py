@@ -145,13 +145,16 @@ def exact_solution_for(case: Any, model: str = BASELINE_MODEL) -> ExactSolution 
     Coulomb friction (``basal_friction_deg`` of its parameters; 0: frictionless):
     onto a dry bed with phi_B <= theta, Mangeney's solution (Ritter's for
     theta = phi_B = 0); onto a wet bed (``h_right > 0``) on a flat frictionless bed,
-    Stoker's. Valid while the waves stay inside the domain; on the planar grid only.
+    Stoker's. Valid while the waves stay inside the domain, on the planar grid. A
+    rate-dependent basal law (``friction_law`` other than Coulomb) has none of these.
     """
     ini = case.initial
     if (len(systems.get(model).layers) != 1 or ini.get("shape") != "dam_break"
             or case.geometry != "planar"):
         return None
     p = case.make_pde(model).parameters
+    if getattr(p, "rate_dependent_law", False):
+        return None
     phi_b = p.basal_friction_deg
     delta = phi_b if phi_b > FRICTIONLESS_DEG else 0.0
     h_right = float(ini.get("h_right", 0.0))

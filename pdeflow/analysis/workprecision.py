@@ -68,8 +68,9 @@ from ..cases import Case, CaseError, load_case
 from ..study.core import Study
 from ..variant import MAX_CFL, Variant
 from .exact import exact_solution_for
-from .points import Point, case_on_grid, resolve_case
+from .points import Point, case_on_grid, resolve_case, with_sets
 from .timing import run_variant, timed
+from .workprecision_outputs import markdown_table, write_outputs
 
 DEFAULT_VARIANTS: tuple[str, ...] = (
     "hll/first-order", "rusanov/first-order", "ifcp/first-order",
@@ -294,79 +295,6 @@ class _Harness:
         return row
 
 
-# --- outputs ---------------------------------------------------------------------------
-
-def _fmt(v: Any, spec: str) -> str:
-    if v is None or (isinstance(v, float) and not math.isfinite(v)):
-        return "-"
-    return format(v, spec)
-
-
-def markdown_table(result: CompareResult) -> str:
-    """The rows of ``result`` as a Markdown table."""
-    lines = ["| model | variant | cells | L1 depth [m^2] | L1 momentum [m^3/s] | order | "
-             "wall [ms] | steps | status |",
-             "|---|---|---:|---:|---:|---:|---:|---:|---|"]
-    for r in result.rows:
-        status = r["status"] if r["status"] == "ok" else f"{r['status']}: {r['note']}"
-        lines.append(
-            f"| {r['model']} | {r['variant']} | {r['cells']} | {_fmt(r['err_h'], '.3e')} | "
-            f"{_fmt(r['err_hu'], '.3e')} | {_fmt(r['order_h'], '.2f')} | "
-            f"{_fmt(r['wall_s'] * 1e3, '.3g')} | {r['steps']} | {status} |")
-    return "\n".join(lines) + "\n"
-
-
-def plot(result: CompareResult, path: str | Path) -> Path:
-    """Work-precision diagram: L1 depth and momentum errors against the median wall
-    time, log-log, one line per variant, one column per model."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    models = list(dict.fromkeys(r["model"] for r in result.rows))
-    variants = list(dict.fromkeys(r["variant"] for r in result.rows))
-    fig, axes = plt.subplots(2, len(models), figsize=(5.5 * len(models), 8), squeeze=False)
-    markers = "osD^v<>phX*"
-    for j, model in enumerate(models):
-        for i, (key, label) in enumerate((("err_h", "L1 depth error [m$^2$]"),
-                                          ("err_hu", "L1 momentum error [m$^3$/s]"))):
-            ax = axes[i, j]
-            for k, v in enumerate(variants):
-                rs = [r for r in result.rows if r["model"] == model and r["variant"] == v
-                      and r["status"] == "ok" and r[key] > 0]
-                if not rs:
-                    continue
-                ls = "--" if "strang" in v else (":" if Variant.parse(v).is_mol else "-")
-                ax.loglog([r["wall_s"] for r in rs], [r[key] for r in rs],
-                          marker=markers[k % len(markers)], ls=ls, label=v)
-            ax.set_xlabel("median wall time of the compiled run [s]")
-            ax.set_ylabel(label)
-            ax.set_title(f"{result.case}: {model}, t = {result.t:g} s")
-            ax.grid(True, which="both", alpha=0.3)
-        axes[0, j].legend(fontsize=8)
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
-
-
-def write_outputs(result: CompareResult, out_dir: Path) -> dict[str, str]:
-    """Write ``<case>_workprecision.json``, ``.md`` and ``.png`` into ``out_dir``."""
-    out_dir.mkdir(parents=True, exist_ok=True)
-    stem = out_dir / f"{result.case}_workprecision"
-    png = plot(result, stem.with_suffix(".png"))
-    md = stem.with_suffix(".md")
-    md.write_text(f"# Work precision: {result.case}, t = {result.t:g} s\n\n"
-                  + markdown_table(result))
-    result.files = {"png": str(png), "md": str(md), "json": str(stem.with_suffix(".json"))}
-    stem.with_suffix(".json").write_text(json.dumps(result.to_json(), indent=1,
-                                                    default=float))
-    return result.files
-
-
 # --- command line ----------------------------------------------------------------------
 
 def _grid_value(text: str) -> float | int:
@@ -412,7 +340,28 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--hyperbolicity", action="store_true",
                    help="also compare the hyperbolicity modes exact/bound/none "
                         "(two-layer cases)")
+    p.add_argument("--laws", nargs="+", default=None, metavar="LAW",
+                   help="basal friction laws to compare on the same grids (coulomb, "
+                        "pouliquen, mu_i, voellmy): each model's friction_law in turn; "
+                        "default: the case's")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
+
+
+def _cases_and_laws(args: argparse.Namespace) -> list[tuple[str, Case, str | None]]:
+    """(path, case, label) of every case file, once per ``--laws`` entry if given (the
+    case with every model's ``friction_law`` set to it, labelled ``<case>_<law>``: the
+    laws then run on the same grids, variants and reference time)."""
+    out: list[tuple[str, Case, str | None]] = []
+    for path in args.cases:
+        case = load_case(path, args.set)
+        if not getattr(args, "laws", None):
+            out.append((path, case, None))
+            continue
+        models = args.models or case.models
+        for law in args.laws:
+            sets = [f"{m}.friction_law={law}" for m in models]
+            out.append((path, with_sets(case, sets), f"{case.name}_{law}"))
+    return out
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
@@ -421,12 +370,11 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
     log = None if args.quiet else sys.stderr
     try:
-        for path in args.cases:
-            case = load_case(path, args.set)
+        for path, case, label in _cases_and_laws(args):
             res = compare(case, args.variants, args.grids, args.reference, args.out_dir,
                           t=args.t, repeats=args.repeats, models=args.models,
                           cfl=args.cfl, reference_dx=args.reference_dx,
-                          mol_cap=args.mol_cap, log=log)
+                          mol_cap=args.mol_cap, label=label, log=log)
             print(f"## {res.case} (t = {res.t:g} s)\n")
             print(markdown_table(res))
             print(f"written: {', '.join(res.files.values())}\n")

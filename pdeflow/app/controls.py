@@ -25,6 +25,8 @@ from ..variant import Variant
 
 GEOMETRIES = ("planar", "axisymmetric")
 """grid.geometry choices: a slope of unit width, or a column collapsing radially"""
+LAWS = ("coulomb", "pouliquen", "mu_i", "voellmy")
+"""The basal friction laws offered (``<model>.friction_law`` of every model of the case)."""
 CLOSURES = ("paper", "relaxed")
 """The exchange closures offered (a case with another one adds it to the choice)."""
 SCHEMES = tuple(v for v in DEFAULT_VARIANTS if not Variant.parse(v).is_mol)
@@ -59,6 +61,8 @@ class Knob:
     """the slider is enabled when the case runs one of these models"""
     column_only: bool = False
     """only for column cases (H0, L0)"""
+    laws: tuple[str, ...] = ()
+    """enabled only when the chosen basal friction law is one of these (() = any)"""
 
 
 KNOBS = (
@@ -78,6 +82,23 @@ KNOBS = (
          ("single_layer.phi_b_deg",), 15.0, 45.0, 1.0, ("single_layer",)),
     Knob("k", "friction reduction k", ("two_layer.k",), 0.0, 0.95, 0.05),
     Knob("c", "collisional coefficient c", ("two_layer.c",), 0.0, 3.0, 0.01),
+    *(Knob(name, label, (f"two_layer.{key}", f"single_layer.{key}"), lo, hi, step,
+           ("two_layer", "single_layer"), laws=laws)
+      for name, label, key, lo, hi, step, laws in (
+          ("delta1", "δ1, μ at vanishing rate [deg]", "delta1_deg", 10.0, 32.0, 0.1,
+           ("pouliquen", "mu_i")),
+          ("delta2", "δ2, μ at large rate [deg]", "delta2_deg", 21.0, 45.0, 0.1,
+           ("pouliquen", "mu_i")),
+          ("pouliquen_L", "Pouliquen L [m]", "pouliquen_L", 1e-4, 5e-3, 5e-5,
+           ("pouliquen",)),
+          ("pouliquen_beta", "Pouliquen β", "pouliquen_beta", 0.05, 0.5, 0.001,
+           ("pouliquen",)),
+          ("mu_i_I0", "μ(I) I0", "mu_i_I0", 0.05, 1.0, 0.001, ("mu_i",)),
+          ("grain_diameter", "grain diameter d [m]", "grain_diameter", 1e-4, 5e-3, 5e-5,
+           ("mu_i",)),
+          ("voellmy_mu", "Voellmy μ", "voellmy_mu", 0.0, 0.8, 0.005, ("voellmy",)),
+          ("voellmy_xi", "Voellmy ξ [m/s²]", "voellmy_xi", 100.0, 10000.0, 100.0,
+           ("voellmy",)))),
 )
 
 
@@ -132,6 +153,18 @@ def case_value(case: Case, key: str) -> Any:
         cls = systems.get(section).parameters_class
         return getattr(cls.from_dict(case.data.get(section, {})), name)
     return case.data.get(section, {}).get(name)
+
+
+def _law_models(case: Case) -> list[str]:
+    """The case's models that have a basal friction law (``friction_law``)."""
+    return [m for m in case.models
+            if hasattr(systems.get(m).parameters_class, "friction_law")]
+
+
+def case_law(case: Case) -> str:
+    """The basal friction law of the case's first model that has one (else Coulomb)."""
+    models = _law_models(case)
+    return str(case_value(case, f"{models[0]}.friction_law")) if models else LAWS[0]
 
 
 def case_scheme(case: Case) -> str:
@@ -204,6 +237,8 @@ class ParameterControls:
         self.geometry = pn.widgets.RadioButtonGroup(
             label="geometry", options=list(GEOMETRIES), value="planar",
             css_classes=["pdeflow-geometry"])
+        self.law = pn.widgets.Select(label="basal friction law", options=list(LAWS),
+                                     value=LAWS[0], css_classes=["pdeflow-law"])
         self.scheme = pn.widgets.Select(label="scheme (flux/reconstruction[/limiter]"
                                         "[+splitting])", options=list(SCHEMES),
                                         value=SCHEMES[0], css_classes=["pdeflow-scheme"])
@@ -214,6 +249,7 @@ class ParameterControls:
             s.param.watch(self._changed, "value_throttled")
         self.closure.param.watch(self._changed, "value")
         self.geometry.param.watch(self._changed, "value")
+        self.law.param.watch(self._law_changed, "value")
         self.scheme.param.watch(self._changed, "value")
 
     # --- the case's own values into the widgets -------------------------------------------
@@ -221,11 +257,14 @@ class ParameterControls:
         """Show ``case``'s values; enable what applies to its models and shape."""
         self._quiet = True
         try:
+            law = case_law(case)
+            self.law.options = list(dict.fromkeys([*LAWS, law]))
+            self.law.value = law
             for k in self.knobs:
                 s = self.sliders[k.name]
                 applies = (any(m in case.models for m in k.models)
                            and (is_column(case) or not k.column_only))
-                s.disabled = not applies
+                s.disabled = not applies or bool(k.laws and law not in k.laws)
                 keys = _keys_of_case(k, case)
                 value = case_value(case, keys[0]) if applies and keys else None
                 if value is None:
@@ -276,6 +315,9 @@ class ParameterControls:
             out.append(f"two_layer.exchange_closure={toml_value(self.closure.value)}")
         if not self.geometry.disabled and self.geometry.value != case.geometry:
             out.append(f"grid.geometry={toml_value(self.geometry.value)}")
+        for m in _law_models(case):
+            if self.law.value != case_value(case, f"{m}.friction_law"):
+                out.append(f"{m}.friction_law={toml_value(self.law.value)}")
         if not self.scheme.disabled and self.scheme.value != case_scheme(case):
             own = case.variant.numerics()
             for key, value in Variant.parse(self.scheme.value).numerics().items():
@@ -301,11 +343,19 @@ class ParameterControls:
         if not self._quiet:
             self.on_change()
 
+    def _law_changed(self, event: Any) -> None:
+        """Enable the sliders of the chosen law's parameters, then rerun."""
+        for k in self.knobs:
+            if k.laws:
+                applies = any(m in self.case.models for m in k.models)
+                self.sliders[k.name].disabled = not applies or event.new not in k.laws
+        self._changed(event)
+
     def panel(self, title: str = "parameters") -> pn.Column:
         """The widgets, for a page's side bar."""
         return pn.Column(f"### {title}", self.case_select,
                          *self.sliders.values(), "exchange closure", self.closure,
-                         "geometry", self.geometry, self.scheme,
+                         "geometry", self.geometry, self.law, self.scheme,
                          sizing_mode="stretch_width")
 
 

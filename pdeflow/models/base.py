@@ -165,8 +165,9 @@ class GranularPDE(PDEBase):
 
     @property
     def kernels(self) -> Any:
-        """The model's :class:`~pdeflow.numerics.model_kernels.ModelKernels`."""
-        return self.system.kernels
+        """The model's :class:`~pdeflow.numerics.model_kernels.ModelKernels` for its
+        parameters (:meth:`~pdeflow.systems.EquationSystem.kernels_for`)."""
+        return self.system.kernels_for(self.parameters)
 
     def __init__(self, parameters: SharedParameters | dict | None = None, *,
                  bc: Sequence[str] = ("wall", "open"), flux: str = "hll",

@@ -8,7 +8,8 @@ g_x = g sin(theta):
    \partial_t h + \partial_x(hu) &= 0 \\
    \partial_t(hu) + \partial_x(h u^2 + g_z h^2/2) &= g_x h - \mathrm{sgn}(u)\, g_z h \tan\varphi_B
 
-The friction is applied implicitly and set-valued (a layer stops in finite time).
+The friction is applied implicitly and set-valued (a layer stops in finite time); the
+basal law is Coulomb's (above) or one of :mod:`pdeflow.models.friction_laws`.
 """
 
 from __future__ import annotations
@@ -22,11 +23,13 @@ import numpy as np
 from .. import systems
 from ..numerics import layout_single_layer as S
 from ..numerics.bundles import SINGLE_LAYER as KERNELS
+from ..numerics.bundles import SINGLE_LAYER_LAWS as LAW_KERNELS
 from .base import GranularPDE, SharedParameters, check_range, stop_time
+from .friction_laws import FrictionLawParameters
 
 
 @dataclass
-class SingleLayerParameters(SharedParameters):
+class SingleLayerParameters(FrictionLawParameters, SharedParameters):
     """Parameters of :class:`SingleLayerGranular` (and those of
     :class:`~pdeflow.models.base.SharedParameters`)."""
 
@@ -38,6 +41,7 @@ class SingleLayerParameters(SharedParameters):
     def validate_model(self) -> None:
         check_range("phi_b_deg", self.phi_b_deg, 0, 90, low_open=True, high_open=True,
                     unit="deg")
+        self.validate_law()
 
     def to_array(self) -> np.ndarray:
         """Kernel parameter vector (layout in :mod:`pdeflow.numerics.layout_single_layer`)."""
@@ -50,6 +54,7 @@ class SingleLayerParameters(SharedParameters):
         P[S.SLOW_U] = self.rest_speed
         P[S.SLOW_H] = self.rest_depth
         P[S.MOL_EPS] = self.mol_eps
+        self.fill_law(P, S.LAW, P[S.TAN_B])
         return P
 
 
@@ -74,7 +79,8 @@ SYSTEM = systems.register(systems.EquationSystem(
     name="single_layer", label="single layer", adjective="single-layer",
     layers=(systems.Layer("h", "hu", "u", "single layer", "single"),),
     parameters_class=SingleLayerParameters, pde_class=SingleLayerGranular,
-    kernels=KERNELS, densities=lambda p: (1.0,), layer_depths=lambda h, x, ini, p: (h,),
+    kernels=KERNELS, law_kernels=LAW_KERNELS, densities=lambda p: (1.0,),
+    layer_depths=lambda h, x, ini, p: (h,),
     summarize=summarize, bytes_per_cell=180, paper_runout_law=(2.25, 1.06),
     quantities=(systems.Quantity("slow_time", "slow", "s"),)))
 """The single-layer Coulomb baseline as an equation system."""

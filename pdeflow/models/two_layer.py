@@ -27,14 +27,16 @@ from .. import systems
 from ..numerics import layout as L
 from ..numerics import layout_two_layer as T
 from ..numerics.bundles import TWO_LAYER as KERNELS
+from ..numerics.bundles import TWO_LAYER_LAWS as LAW_KERNELS
 from ..numerics.geometry import Metric
 from .base import GranularPDE, SharedParameters, check_range, stop_time
+from .friction_laws import FrictionLawParameters
 
 HYPERBOLICITY_MODES = L.HYPERBOLICITY_MODES
 
 
 @dataclass
-class TwoLayerParameters(SharedParameters):
+class TwoLayerParameters(FrictionLawParameters, SharedParameters):
     """Physical and numerical parameters of :class:`TwoLayerGranular` (and those of
     :class:`~pdeflow.models.base.SharedParameters`).
 
@@ -89,6 +91,7 @@ class TwoLayerParameters(SharedParameters):
         if self.hyperbolicity not in HYPERBOLICITY_MODES:
             raise ValueError(f"hyperbolicity must be one of {list(HYPERBOLICITY_MODES)}, "
                              f"got {self.hyperbolicity!r}")
+        self.validate_law()
 
     def to_array(self) -> np.ndarray:
         """Kernel parameter vector (layout in :mod:`pdeflow.numerics.layout_two_layer`)."""
@@ -111,6 +114,7 @@ class TwoLayerParameters(SharedParameters):
         P[T.MOL_EPS] = self.mol_eps
         P[T.CLOSURE] = L.CLOSURES[self.exchange_closure]
         P[T.TAU_STAR] = self.tau_star
+        self.fill_law(P, T.LAW, P[T.TAN_B])
         return P
 
 
@@ -174,6 +178,7 @@ SYSTEM = systems.register(systems.EquationSystem(
     layers=(systems.Layer("h1", "h1u1", "u1", "upper layer", "upper"),
             systems.Layer("h2", "h2u2", "u2", "lower layer", "lower")),
     parameters_class=TwoLayerParameters, pde_class=TwoLayerGranular, kernels=KERNELS,
+    law_kernels=LAW_KERNELS,
     densities=lambda p: (p.density_ratio, 1.0), layer_depths=layer_depths,
     summarize=summarize, has_fextra=True, bytes_per_cell=320,
     paper_runout_law=(1.61, 0.84),

@@ -2,12 +2,22 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from . import layout_single_layer as S
 from . import layout_two_layer as T
 from .advection import cell_jump_single, cell_jump_two_layer
 from .friction import predictor_single, predictor_two_layer
+from .law_stage import (
+    predictor_single_law,
+    predictor_two_layer_law,
+    source_stage_single_law,
+    source_stage_two_layer_law,
+    sources_single_law,
+    sources_two_layer_law,
+)
 from .model_kernels import ModelKernels
 from .mol import source_rate_single, source_rate_two_layer
 from .pvm import face_single, face_two_layer, fluctuations_single, fluctuations_two_layer
@@ -54,3 +64,14 @@ SINGLE_LAYER = ModelKernels(
     numpy_advection=_single_numpy_advection, numpy_sources=source_rate_single_np,
     constants=_single_constants)
 """the Savage-Hutter-type layer with implicit Coulomb friction"""
+
+TWO_LAYER_LAWS = dataclasses.replace(
+    TWO_LAYER, sources=sources_two_layer_law, source_stage=source_stage_two_layer_law,
+    predictor=predictor_two_layer_law)
+""":data:`TWO_LAYER` with a rate-dependent basal law (:mod:`.law_stage`); the
+method-of-lines rates read the law's code themselves"""
+
+SINGLE_LAYER_LAWS = dataclasses.replace(
+    SINGLE_LAYER, sources=sources_single_law, source_stage=source_stage_single_law,
+    predictor=predictor_single_law)
+""":data:`SINGLE_LAYER` with a rate-dependent basal law (:mod:`.law_stage`)"""

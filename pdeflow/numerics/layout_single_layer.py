@@ -3,7 +3,7 @@
 Starts with the header of :mod:`.layout`.
 """
 
-from .layout import G_X, G_Z, N_HEADER
+from .layout import G_X, G_Z, N_HEADER, N_LAW
 
 __all__ = ["G_Z", "G_X"]
 
@@ -12,4 +12,5 @@ DRY = N_HEADER + 1  #: dry tolerance [m]
 SLOW_U = N_HEADER + 2  #: speed below which the layer counts as practically at rest [m/s]
 SLOW_H = N_HEADER + 3  #: depth above which the practical rest test looks at a cell [m]
 MOL_EPS = N_HEADER + 4  #: velocity scale regularising sgn(u) in the method-of-lines rate [m/s]
-SIZE = N_HEADER + 5
+LAW = N_HEADER + 5  #: start of the basal friction law's block (offsets layout.LAW_*)
+SIZE = LAW + N_LAW

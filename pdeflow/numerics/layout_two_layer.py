@@ -3,7 +3,7 @@
 Starts with the header of :mod:`.layout`; choices are codes from :mod:`.layout`.
 """
 
-from .layout import G_X, G_Z, N_HEADER
+from .layout import G_X, G_Z, N_HEADER, N_LAW
 
 __all__ = ["G_Z", "G_X"]
 
@@ -22,4 +22,5 @@ SLOW_H = N_HEADER + 11  #: depth above which the practical rest test looks at a 
 MOL_EPS = N_HEADER + 12  #: velocity scale regularising sgn(u) in the method-of-lines rate [m/s]
 CLOSURE = N_HEADER + 13  #: exchange closure, layout.CLOSURE_* [code]
 TAU_STAR = N_HEADER + 14  #: relaxed closure: tau = TAU_STAR sqrt(H/g_z) [-]
-SIZE = N_HEADER + 15
+LAW = N_HEADER + 15  #: start of the basal friction law's block (offsets layout.LAW_*)
+SIZE = LAW + N_LAW

@@ -3,7 +3,8 @@ r"""Source terms (26)-(27) as a method-of-lines rate (for py-pde's generic solve
 The splitting scheme treats the sources implicitly and limits the exchange; a generic
 ODE integrator needs them as a plain rate instead. Two regularisations make that rate
 finite (both documented parameters): sgn(v) is replaced by v / max(|v|, eps) with
-eps = ``mol_eps``, and the closure's denominator is max(|du|, du_reg, eps). With
+eps = ``mol_eps`` (for a rate-dependent basal law, mu(h, |u|) sgn_eps(u), see
+:mod:`pdeflow.numerics.rheology`), and the closure's denominator is max(|du|, du_reg, eps). With
 ``exchange_closure = "relaxed"`` the rate is bounded by the relaxation towards h1_eq
 (:func:`pdeflow.numerics.sources.relaxed_rate`), the rate form of the relaxed stage. A state at
 rest is therefore *not* held by static friction in this form: that is the price of
@@ -28,6 +29,7 @@ from . import layout as L
 from . import layout_single_layer as S
 from . import layout_two_layer as T
 from .compiled import FIELDS, PARAMS, STATE, kernel
+from .rheology import basal_accel, law_block
 from .sources import closure_rate, relaxed_rate
 from .state import velocity
 
@@ -42,6 +44,7 @@ def source_rate_two_layer(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> Non
     eps = P[T.MOL_EPS]
     du_reg = max(P[T.DU_REG], eps)
     closure = int(P[T.CLOSURE])
+    coulomb = int(P[T.LAW + L.LAW_CODE]) == L.FRICTION_COULOMB
     for i in range(q.shape[1]):
         h1 = max(q[0, i], 0.0)
         h2 = max(q[2, i], 0.0)
@@ -65,7 +68,12 @@ def source_rate_two_layer(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> Non
             rate[1, i] += gx * h1 + u1 * m / r - t1 / r
         rate[2, i] -= m
         if wet2:
-            bf = g * (r * h1 + h2) * P[T.TAN_B] * u2 / max(abs(u2), eps)
+            if coulomb:
+                bf = g * (r * h1 + h2) * P[T.TAN_B] * u2 / max(abs(u2), eps)
+            else:  # the law's stress: h2 x deceleration per unit mass
+                bf = h2 * basal_accel(law_block(P, T.LAW), h1 + h2,
+                                      g * (r * h1 + h2) / h2, h2, abs(u2)) * u2 / max(
+                                          abs(u2), eps)
             rate[3, i] += gx * h2 - u1 * m + t1 - bf
         else:
             rate[3, i] -= u1 * m
@@ -73,10 +81,16 @@ def source_rate_two_layer(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> Non
 
 @kernel(STATE, FIELDS, PARAMS)
 def source_rate_single(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> None:
-    """Add gravity along the bed and regularised Coulomb friction (single layer)."""
+    """Add gravity along the bed and regularised basal friction (single layer)."""
+    coulomb = int(P[S.LAW + L.LAW_CODE]) == L.FRICTION_COULOMB
     for i in range(q.shape[1]):
         h = max(q[0, i], 0.0)
         if h > P[S.DRY]:
             u = q[1, i] / h
-            rate[1, i] += P[S.G_X] * h - P[S.G_Z] * h * P[S.TAN_B] * u / max(
-                abs(u), P[S.MOL_EPS])
+            if coulomb:
+                rate[1, i] += P[S.G_X] * h - P[S.G_Z] * h * P[S.TAN_B] * u / max(
+                    abs(u), P[S.MOL_EPS])
+            else:
+                rate[1, i] += P[S.G_X] * h - h * basal_accel(
+                    law_block(P, S.LAW), h, P[S.G_Z], h, abs(u)) * u / max(
+                        abs(u), P[S.MOL_EPS])

@@ -141,6 +141,26 @@ def advection_rate(q: np.ndarray, dx: float, bc: tuple[int, int], g: float,
     return -(dplus[:, :-1] + dmin[:, 1:]) / dx, smax
 
 
+def basal_accel_np(P: np.ndarray, base: int, h: np.ndarray, gw: np.ndarray,
+                   hm: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Friction deceleration [m/s^2] of the basal law at ``base`` over arrays (the numpy
+    twin of :func:`pdeflow.numerics.rheology.basal_accel`; depths > 0 where used)."""
+    code = int(P[base + L.LAW_CODE])
+    mu1, dmu = P[base + L.LAW_MU1], P[base + L.LAW_DMU]
+    hp = np.maximum(h, 1e-300)
+    mu_static = mu1 + (dmu / (1.0 + hp * P[base + L.LAW_INV_L])
+                       if code == L.FRICTION_POULIQUEN else 0.0)
+    if code in (L.FRICTION_COULOMB, L.FRICTION_VOELLMY):
+        mu = np.full_like(hp, mu1)
+    else:
+        s0 = P[base + L.LAW_S0] * hp * np.sqrt(hp)
+        mu = mu1 + dmu * s / np.maximum(s0 + s, 1e-300)
+        if code == L.FRICTION_POULIQUEN:
+            mu = np.where(s < P[base + L.LAW_BETA_G] * np.sqrt(hp), mu_static, mu)
+    mu = np.where(s > 0.0, mu, mu_static)
+    return gw * mu + P[base + L.LAW_DRAG] * s * s / np.maximum(hm, 1e-300)
+
+
 def source_rate_single_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
     """Gravity along the bed and regularised Coulomb friction of the single layer (the
     numpy twin of :func:`pdeflow.numerics.mol.source_rate_single`)."""
@@ -149,7 +169,11 @@ def source_rate_single_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
     u = _vel(h, q[1], P[S.DRY])
     eps = P[S.MOL_EPS]
     wet = h > P[S.DRY]
-    fric = P[S.G_Z] * h * P[S.TAN_B] * u / np.maximum(np.abs(u), eps)
+    if int(P[S.LAW + L.LAW_CODE]) == L.FRICTION_COULOMB:
+        fric = P[S.G_Z] * h * P[S.TAN_B] * u / np.maximum(np.abs(u), eps)
+    else:
+        fric = h * basal_accel_np(P, S.LAW, h, P[S.G_Z], h, np.abs(u)) * u / np.maximum(
+            np.abs(u), eps)
     rate[1] = np.where(wet, P[S.G_X] * h - fric, 0.0)
     return rate
 
@@ -184,6 +208,11 @@ def source_rate_two_layer_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
     rate[0] = m / r
     rate[1] = np.where(wet1, gx * h1 + u1 * m / r - t1 / r, 0.0)
     rate[2] = -m
-    bf = g * (r * h1 + h2) * P[T.TAN_B] * u2 / np.maximum(np.abs(u2), eps)
+    if int(P[T.LAW + L.LAW_CODE]) == L.FRICTION_COULOMB:
+        bf = g * (r * h1 + h2) * P[T.TAN_B] * u2 / np.maximum(np.abs(u2), eps)
+    else:
+        gw = g * (r * h1 + h2) / np.maximum(h2, 1e-300)
+        bf = h2 * basal_accel_np(P, T.LAW, h1 + h2, gw, h2, np.abs(u2)) * u2 / np.maximum(
+            np.abs(u2), eps)
     rate[3] = np.where(wet2, gx * h2 - u1 * m + t1 - bf, -u1 * m)
     return rate

@@ -147,15 +147,21 @@ def study_steppers(spec: StudySpec) -> list[Any]:
     """The compiled steppers of every model the study's evaluations run, for
     :func:`pdeflow.numerics.warmup.prepare` to compile or load all at once (a cold cache
     is filled on two cores). A case that cannot be built is left out: its evaluations
-    report the error."""
+    report the error. A parameter chosen among names (a basal friction law, a closure)
+    may select other kernels: the case with each of its choices is warmed too."""
     from ..simulate import case_steppers
 
+    points: list[dict[str, Any]] = [{}]
+    points += [{p.key: v} for p in spec.parameters
+               if p.kind == "choice" and all(isinstance(x, str) for x in p.values)
+               for v in p.values]
     steppers = []
     for base, models in _bases(spec):
-        try:
-            steppers += case_steppers(spec.case_for(base, {}, models))
-        except Exception:  # noqa: BLE001, S112 - warming only; evaluations report errors
-            continue
+        for point in points:
+            try:
+                steppers += case_steppers(spec.case_for(base, point, models))
+            except Exception:  # noqa: BLE001, S112 - warming only; evaluations report errors
+                continue
     return steppers
 
 

@@ -1,0 +1,87 @@
+"""The outputs of a work-precision study (:func:`pdeflow.analysis.workprecision.compare`):
+a Markdown table, a work-precision diagram and the JSON of the rows."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from ..variant import Variant
+
+if TYPE_CHECKING:
+    from .workprecision import CompareResult
+
+
+def _fmt(v: Any, spec: str) -> str:
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "-"
+    return format(v, spec)
+
+
+def markdown_table(result: CompareResult) -> str:
+    """The rows of ``result`` as a Markdown table."""
+    lines = ["| model | variant | cells | L1 depth [m^2] | L1 momentum [m^3/s] | order | "
+             "wall [ms] | steps | status |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---|"]
+    for r in result.rows:
+        status = r["status"] if r["status"] == "ok" else f"{r['status']}: {r['note']}"
+        lines.append(
+            f"| {r['model']} | {r['variant']} | {r['cells']} | {_fmt(r['err_h'], '.3e')} | "
+            f"{_fmt(r['err_hu'], '.3e')} | {_fmt(r['order_h'], '.2f')} | "
+            f"{_fmt(r['wall_s'] * 1e3, '.3g')} | {r['steps']} | {status} |")
+    return "\n".join(lines) + "\n"
+
+
+def plot(result: CompareResult, path: str | Path) -> Path:
+    """Work-precision diagram: L1 depth and momentum errors against the median wall
+    time, log-log, one line per variant, one column per model."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    models = list(dict.fromkeys(r["model"] for r in result.rows))
+    variants = list(dict.fromkeys(r["variant"] for r in result.rows))
+    fig, axes = plt.subplots(2, len(models), figsize=(5.5 * len(models), 8), squeeze=False)
+    markers = "osD^v<>phX*"
+    for j, model in enumerate(models):
+        for i, (key, label) in enumerate((("err_h", "L1 depth error [m$^2$]"),
+                                          ("err_hu", "L1 momentum error [m$^3$/s]"))):
+            ax = axes[i, j]
+            for k, v in enumerate(variants):
+                rs = [r for r in result.rows if r["model"] == model and r["variant"] == v
+                      and r["status"] == "ok" and r[key] > 0]
+                if not rs:
+                    continue
+                ls = "--" if "strang" in v else (":" if Variant.parse(v).is_mol else "-")
+                ax.loglog([r["wall_s"] for r in rs], [r[key] for r in rs],
+                          marker=markers[k % len(markers)], ls=ls, label=v)
+            ax.set_xlabel("median wall time of the compiled run [s]")
+            ax.set_ylabel(label)
+            ax.set_title(f"{result.case}: {model}, t = {result.t:g} s")
+            ax.grid(True, which="both", alpha=0.3)
+        axes[0, j].legend(fontsize=8)
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def write_outputs(result: CompareResult, out_dir: Path) -> dict[str, str]:
+    """Write ``<case>_workprecision.json``, ``.md`` and ``.png`` into ``out_dir``."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    stem = out_dir / f"{result.case}_workprecision"
+    png = plot(result, stem.with_suffix(".png"))
+    md = stem.with_suffix(".md")
+    md.write_text(f"# Work precision: {result.case}, t = {result.t:g} s\n\n"
+                  + markdown_table(result))
+    result.files = {"png": str(png), "md": str(md), "json": str(stem.with_suffix(".json"))}
+    stem.with_suffix(".json").write_text(json.dumps(result.to_json(), indent=1,
+                                                    default=float))
+    return result.files
+
+
