@@ -24,6 +24,22 @@ from .sources import _drag_root, coulomb_single, friction_two_layer
 from .state import velocity
 
 
+@cached(inline="always")
+def bed_under_both(b1, b2, m1, h1, h2, kdt, cdt, dt, g, r, P):
+    """Stage (32) of two wet layers with Coulomb friction at the bed: (u1, u2) [m/s]
+    (``m1`` = r h1, ``kdt``, ``cdt``: the interface law's terms times dt)."""
+    bdt = dt * g * (r * h1 + h2) * P[T.TAN_B]
+    return friction_two_layer(b1, b2, m1, h2, kdt, cdt, bdt)
+
+
+@cached(inline="always")
+def bed_under_lower(b2, h1, h2, dt, g, r, P):
+    """Stage (32) of the lower layer alone (a dry upper layer's weight still counted):
+    Coulomb friction at the bed, u2 [m/s]."""
+    mu_dt = dt * g * P[T.TAN_B] * (h2 + r * max(h1, 0.0)) / h2
+    return coulomb_single(b2, mu_dt)
+
+
 @cached
 def implicit_friction(b1, b2, h1, h2, dt, P, f, k, c):
     """Implicit stage (32) for one cell with extra exchange ``f`` = F_extra/rho2 and the
@@ -40,8 +56,7 @@ def implicit_friction(b1, b2, h1, h2, dt, P, f, k, c):
             b1 = b1 - dt * f / m1
             b2 = b2 + dt * f / h2
         kdt = dt * k * r * g * h1 * P[T.TAN_INT]
-        bdt = dt * g * (r * h1 + h2) * P[T.TAN_B]
-        return friction_two_layer(b1, b2, m1, h2, kdt, dt * c, bdt)
+        return bed_under_both(b1, b2, m1, h1, h2, kdt, dt * c, dt, g, r, P)
     if wet1:
         # no lower layer: the upper layer rubs on the bed with the interface law (22)
         m1 = r * h1
@@ -49,8 +64,7 @@ def implicit_friction(b1, b2, h1, h2, dt, P, f, k, c):
         u1 = _drag_root(m1 * abs(b1) - kdt, m1, dt * c)
         return (u1 if b1 > 0.0 else -u1), 0.0
     if wet2:
-        mu_dt = dt * g * P[T.TAN_B] * (h2 + r * max(h1, 0.0)) / h2
-        return 0.0, coulomb_single(b2, mu_dt)
+        return 0.0, bed_under_lower(b2, h1, h2, dt, g, r, P)
     return 0.0, 0.0
 
 

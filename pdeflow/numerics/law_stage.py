@@ -29,9 +29,6 @@ from . import layout_single_layer as S
 from . import layout_two_layer as T
 from .compiled import PARAMS, STATE, VECTOR, cached, f8, i8, kernel
 from .rheology import friction_two_layer_law, law_block, law_velocity
-from .source_stage import _close_stage
-from .sources import _drag_root
-from .state import velocity
 
 
 def _with_callees(dispatcher: Any, name: str, **callees: Any) -> Callable:
@@ -46,37 +43,25 @@ def _with_callees(dispatcher: Any, name: str, **callees: Any) -> Callable:
     return new
 
 
-@cached
-def implicit_friction_law(b1, b2, h1, h2, dt, P, f, k, c):
-    """:func:`pdeflow.numerics.friction.implicit_friction` with the lower layer's bed
-    friction given by the basal law at ``T.LAW``
-    (:func:`pdeflow.numerics.rheology.friction_two_layer_law`; the law sees the total
-    depth h1 + h2 and the weight of both layers)."""
-    r = P[T.R]
-    g = P[T.G_Z]
-    dry = P[T.DRY]
-    wet1 = h1 > dry
-    wet2 = h2 > dry
-    if wet1 and wet2:
-        m1 = r * h1
-        if f != 0.0:
-            b1 = b1 - dt * f / m1
-            b2 = b2 + dt * f / h2
-        kdt = dt * k * r * g * h1 * P[T.TAN_INT]
-        return friction_two_layer_law(b1, b2, m1, h2, kdt, dt * c, dt, g, h1 + h2,
-                                      law_block(P, T.LAW))
-    if wet1:
-        # no lower layer: the upper layer rubs on the bed with the interface law (22)
-        m1 = r * h1
-        kdt = dt * k * r * g * h1 * P[T.TAN_INT]
-        u1 = _drag_root(m1 * abs(b1) - kdt, m1, dt * c)
-        return (u1 if b1 > 0.0 else -u1), 0.0
-    if wet2:
-        gw = g * (h2 + r * max(h1, 0.0)) / h2
-        return 0.0, law_velocity(b2, h2 + max(h1, 0.0), gw, h2, dt, law_block(P, T.LAW))
-    return 0.0, 0.0
+@cached(inline="always")
+def bed_under_both_law(b1, b2, m1, h1, h2, kdt, cdt, dt, g, r, P):
+    """:func:`pdeflow.numerics.friction.bed_under_both` with the basal law at
+    ``T.LAW`` (:func:`pdeflow.numerics.rheology.friction_two_layer_law`; the law sees
+    the total depth h1 + h2 and the weight of both layers)."""
+    return friction_two_layer_law(b1, b2, m1, h2, kdt, cdt, dt, g, h1 + h2,
+                                  law_block(P, T.LAW))
 
 
+@cached(inline="always")
+def bed_under_lower_law(b2, h1, h2, dt, g, r, P):
+    """:func:`pdeflow.numerics.friction.bed_under_lower` with the basal law."""
+    gw = g * (h2 + r * max(h1, 0.0)) / h2
+    return law_velocity(b2, h2 + max(h1, 0.0), gw, h2, dt, law_block(P, T.LAW))
+
+
+implicit_friction_law = cached(_with_callees(
+    friction.implicit_friction, "implicit_friction_law",
+    bed_under_both=bed_under_both_law, bed_under_lower=bed_under_lower_law))
 bisect_fextra_law = cached(_with_callees(
     friction.bisect_fextra, "bisect_fextra_law", implicit_friction=implicit_friction_law))
 restore_hyperbolicity_law = cached(_with_callees(
@@ -94,34 +79,21 @@ source_stage_two_layer_law = kernel(STATE, f8, f8, PARAMS, VECTOR)(_with_callees
     sources_two_layer=sources_two_layer_law))
 
 
-@kernel(STATE, f8, f8, PARAMS, VECTOR, i8, i8)
-def sources_single_law(q: np.ndarray, dt: float, t: float, P: np.ndarray,
-                       diag: np.ndarray, lo: int, hi: int) -> None:
-    """:func:`pdeflow.numerics.source_stage.sources_single` with the basal law at
-    ``S.LAW``: gravity along the bed and the law's set-valued implicit friction."""
-    g = P[S.G_Z]
-    gx = P[S.G_X]
-    dry = P[S.DRY]
-    law = law_block(P, S.LAW)
-    moving = False
-    fast = False
-    for i in range(lo, hi + 1):
-        h = q[0, i]
-        m = q[1, i]
-        if h == 0.0 and m == 0.0:
-            continue
-        h = max(h, 0.0)
-        u = velocity(h, m, dry)
-        if dt > 0.0 and h > dry:
-            u = law_velocity(u + dt * gx, h, g, h, dt, law)
-        m = h * u if h > dry else 0.0
-        if m != 0.0:
-            moving = True
-            if h > P[S.SLOW_H] and abs(u) >= P[S.SLOW_U]:
-                fast = True
-        q[0, i] = h
-        q[1, i] = m
-    _close_stage(diag, t, moving, fast, False, False, False)
+@cached(inline="always")
+def basal_friction_law(dt, g, P):
+    """What the basal law needs of a step: its block of ``P`` (read once per stage)."""
+    return law_block(P, S.LAW)
+
+
+@cached(inline="always")
+def basal_velocity_law(b, h, dt, g, law):
+    """:func:`pdeflow.numerics.source_stage.basal_velocity` with the basal law."""
+    return law_velocity(b, h, g, h, dt, law)
+
+
+sources_single_law = kernel(STATE, f8, f8, PARAMS, VECTOR, i8, i8)(_with_callees(
+    source_stage.sources_single, "sources_single_law",
+    basal_friction=basal_friction_law, basal_velocity=basal_velocity_law))
 
 
 @kernel(STATE, f8, f8, PARAMS, VECTOR)

@@ -168,7 +168,7 @@ def sources_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
     g = P[S.G_Z]
     gx = P[S.G_X]
     dry = P[S.DRY]
-    mu_dt = dt * g * P[S.TAN_B]
+    friction = basal_friction(dt, g, P)
     moving = False
     fast = False
     for i in range(lo, hi + 1):
@@ -179,7 +179,7 @@ def sources_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
         h = max(h, 0.0)
         u = velocity(h, m, dry)
         if dt > 0.0 and h > dry:
-            u = coulomb_single(u + dt * gx, mu_dt)
+            u = basal_velocity(u + dt * gx, h, dt, g, friction)
         m = h * u if h > dry else 0.0
         if m != 0.0:
             moving = True
@@ -188,6 +188,20 @@ def sources_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
         q[0, i] = h
         q[1, i] = m
     _close_stage(diag, t, moving, fast, False, False, False)
+
+
+@cached(inline="always")
+def basal_friction(dt, g, P):
+    """What the single layer's implicit Coulomb friction needs of a step: mu g_z dt
+    [m/s] (computed once per stage)."""
+    return dt * g * P[S.TAN_B]
+
+
+@cached(inline="always")
+def basal_velocity(b, h, dt, g, friction):
+    """The velocity [m/s] after the implicit basal friction of a step from ``b`` [m/s]
+    (set-valued: 0 where |b| <= mu g_z dt)."""
+    return coulomb_single(b, friction)
 
 
 @cached(inline="always")
