@@ -68,3 +68,21 @@ def test_the_page_says_what_the_runs_gave(gen):
     assert recomputed["sets"] == numbers["sets"]
     assert recomputed["points"] == numbers["points"]
     assert page.render_page(numbers) == (ROOT / "docs" / "axisymmetric.md").read_text()
+
+
+def test_an_axisymmetric_sweep_reports_the_deposit():
+    """`pdeflow sweep` on an axisymmetric case adds the final height and the arrest time
+    to each run; a planar sweep's runs keep their keys."""
+    from pdeflow.analysis.sweep import run_sweep
+    from pdeflow.cases import load_case
+
+    small = ["grid.dx=0.02", "grid.length=1.5", "sweep.aspect_ratios=[1, 2]"]
+    axi = run_sweep(load_case(ROOT / "cases" / "axisymmetric_collapse_sweep.toml", small))
+    for res in axi["models"].values():
+        for row in res["runs"]:
+            assert 0 < row["H_inf_over_L0"] <= row["a"] and row["arrest_time_scaled"] > 0
+    planar = run_sweep(load_case(ROOT / "cases" / "collapse_sweep.toml",
+                                 ["grid.dx=0.05", "grid.length=3", "sweep.aspect_ratios=[2]"]))
+    assert set(planar["models"]["two_layer"]["runs"][0]) == {
+        "a", "r", "runout", "stop_time", "at_rest", "steps", "wall_time_s",
+        "mass_relative_error"}

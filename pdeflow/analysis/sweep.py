@@ -236,5 +236,11 @@ def cmd_sweep(args: Any) -> int:
                    if res["prefactor"] else "no fit")
             print(f"{model:13} {fit}   (paper {res['paper_prefactor']} "
                   f"a^{res['paper_exponent']})   a:r {pts}")
+            if res["runs"] and "H_inf_over_L0" in res["runs"][0]:  # axisymmetric
+                print(f"{'':13} a:H_inf/R0 " + ", ".join(
+                    f"{row['a']:g}:{row['H_inf_over_L0']:.3g}" for row in res["runs"])
+                    + "   a:t_stop/(H0/g)^(1/2) " + ", ".join(
+                    f"{row['a']:g}:{row['arrest_time_scaled']:.3g}" if row["arrest_time_scaled"]
+                    else f"{row['a']:g}:-" for row in res["runs"]))
         print(f"wall time {summary['wall_time_s']:.2f} s")
     return 0
