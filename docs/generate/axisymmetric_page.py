@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 from axisymmetric import BREAK, PROFILE_DX, PROFILE_RATIOS, R0, SETS, lube_runout
 from axisymmetric_figures import figures  # noqa: F401  (main() calls page.figures)
+from axisymmetric_sources import SOURCES
 
 from pdeflow.analysis.sweep import run_sweep
 from pdeflow.cases import load_case
@@ -27,8 +28,9 @@ def shape_numbers(x: np.ndarray, h: np.ndarray, H0: float, threshold: float = 1e
     """A deposit's shape [x, h in m]: its summit over R0, the radius of its undisturbed
     top over R0 (depth still H0), the ratio of its mean slope over the inner half of its
     radius to that over the outer half (a cone 1, a flat top < 1, a peak on a skirt > 1),
-    its run-out at a tenth of ``threshold`` [m] and the share of its volume beyond the
-    run-out at ``threshold``."""
+    its run-out at a tenth of ``threshold`` [m], the share of its volume beyond the
+    run-out at ``threshold``, and its raised ring: how far [over R0] and where [r/R0] the
+    depth climbs again on the way out (0 for a deposit that only falls)."""
     wet = np.nonzero(h > threshold)[0]
     rf = float(x[wet[-1]]) if wet.size else float(x[0])
     mid = float(np.interp(rf / 2, x, h))
@@ -40,7 +42,10 @@ def shape_numbers(x: np.ndarray, h: np.ndarray, H0: float, threshold: float = 1e
             next(n for bound, n in SHAPES if ratio < bound))
     dx = float(x[1] - x[0])
     thin = np.nonzero(h > threshold / 10)[0]
-    return {"summit": float(h[0]) / R0, "top_radius": top_radius, "slope_ratio": ratio,
+    rise = h - np.minimum.accumulate(h)  # how far the depth climbs again outwards
+    ring = int(np.argmax(rise))
+    return {"ring": float(rise[ring]) / R0, "ring_radius": float(x[ring]) / R0,
+            "summit": float(h[0]) / R0, "top_radius": top_radius, "slope_ratio": ratio,
             "shape": name, "r_01mm": (float(x[thin[-1]]) + dx / 2 - R0) / R0,
             "beyond": float(np.sum((h * x)[x > rf]) / np.sum(h * x))}
 
@@ -221,7 +226,9 @@ def _shape_table(numbers: dict[str, Any]) -> list[str]:
             p = numbers["profiles"][f"{name}|{a:g}"]
             layers = ("" if name == "single layer" else
                       f" ({p['lower_stop']:.2f}, {p['upper_stop']:.2f})")
-            lines.append(f"| {a:g} | {name} | {p['shape']} ({p['slope_ratio']:.2f}) | "
+            ring = (f", a ring {p['ring']:.2f} R0 high at r = {p['ring_radius']:.1f} R0"
+                    if p["ring"] > 0.02 else "")
+            lines.append(f"| {a:g} | {name} | {p['shape']} ({p['slope_ratio']:.2f}){ring} | "
                          f"{p['summit']:.2f} | {p['top_radius']:.2f} | {p['r']:.2f} | "
                          f"{p['r_01mm']:.2f} | {_pct(p['beyond'])} | {p['t95']:.2f} | "
                          f"{p['stop']:.2f}{layers} |")
@@ -258,7 +265,14 @@ def _sheet_sentence(numbers: dict[str, Any]) -> str:
             "deposition of the upper layer: upper films thinner than film_depth = 1 mm are "
             "deposited whole into the lower layer, whose density is higher, so a sheet "
             "about 1 mm deep loses a third of its depth (the density ratio 0.67) and drops "
-            "below the edge. We did not isolate this further.")
+            "below the edge. We did not isolate this further. " + _rings(p))
+
+
+def _rings(p: dict[str, Any]) -> str:
+    ringed = sorted({k.split("|")[0] for k, v in p.items() if v["ring"] > 0.02})
+    return ("Raised rings (more than 0.02 R0 above the lowest depth inside them) appear "
+            f"only in the deposits of {', '.join(ringed)}; we did not look into how they "
+            "form." if ringed else "No deposit has a raised ring.")
 
 
 def _times(numbers: dict[str, Any]) -> str:
@@ -266,51 +280,6 @@ def _times(numbers: dict[str, Any]) -> str:
     for name, res in numbers["sets"].items():
         parts.append(f"{name} {min(res['t']):.1f}-{max(res['t']):.1f}")
     return "; ".join(parts)
-
-
-SOURCES = """\
-What we could check, and where (the papers themselves were not reachable; these are pages
-that quote or summarise them):
-
-- **Lube, Huppert, Sparks & Hallworth (2004)**, J. Fluid Mech. 508. Confirmed: the regimes
-  and their limits in a = H0/R0 (below a = 0.74 only the outside of the column moves, an
-  undisturbed central top stays at the initial height and the deposit is a truncated cone;
-  between 0.74 and 1.7 that top is eroded, the deposit's height is still the initial
-  height and it forms a sharp cone), as summarised in a review in Acta Geotechnica
-  (https://springerlink.bibliotecabuap.elogim.com/doi/10.1007/s11440-018-0707-9); three
-  regimes described by scalings that do not depend on the material, friction mattering
-  only at the abrupt halt (the authors' 2003 talk abstract,
-  http://www-old.newton.ac.uk/programmes/GPF/Abstracts/huppert.html). **Not confirmed**
-  (from memory, used as such in the figures and the distances): the run-out law
-  r = 1.24 a below a = 1.7 and 1.6 a^(1/2) above, the final height H_inf/R0 = a below
-  a = 0.74 and 0.88 a^(1/6) above, and the end of the motion at about 3 (H0/g)^(1/2). The
-  review's "between 0.74 and 1.7 the height is still the initial height" and the remembered
-  0.88 a^(1/6) above 0.74 disagree (0.88 at a = 1, not 1); the figure shows both.
-- **Lajeunesse, Mangeney-Castelnau & Vilotte (2004)**, Phys. Fluids 16. **Not confirmed**:
-  their fits and their deposit shapes (truncated cones at small a, cones, "Mexican hats"
-  above a ~ 3); no page we could reach states them, so no curve of theirs is drawn.
-- **Mangeney-Castelnau, Bouchut, Vilotte, Lajeunesse, Aubertin & Pirulli (2005)**, J.
-  Geophys. Res. 110, the single-layer Saint-Venant simulation of these experiments.
-  Confirmed from its abstract
-  (http://perso-math.univ-mlv.fr/users/bouchut.francois/publications/etal_abs.html,
-  https://ja.scribd.com/document/231417357/JGR-On-the-use): the solutions depend only on a
-  and an effective friction angle; the dynamics agree with the experiments for a below
-  about 1; the saturation of the final height H_inf/R0 seen in the experiments is
-  reproduced. The friction angle they used was not confirmed; our single layer uses
-  30 deg, the project's single-layer baseline.
-- **Warnett, Denissenko, Thomas, Kiraci & Williams (2014)**, Granular Matter 16. Confirmed
-  from its abstract (https://studylib.net/doc/12847899/scalings-of-axisymmetric-granular-column-collapse-j.-m.-w...):
-  the final radius depends on R0 over the grain size as well as on a; the final height
-  mainly on a. So the run-out laws hold for one ratio of column to grain size; a
-  depth-averaged model has no grain size.
-- Two further results on the square-root regime: Larrieu, Staron & Hinch (2006, J. Fluid
-  Mech. 554), a shallow-water layer fed by the falling column, gives r ~ a^0.52 in the
-  axisymmetric case, "in agreement with ... axisymmetric experiments"
-  (https://www.cambridge.org/core/journals/journal-of-fluid-mechanics/article/raining-into-shallow-water-as-a-description-of-the-collapse-of-a-column-of-grains/91097EA39783EC40216CF8D161C88839);
-  Trepanier & Franklin (2010), columns of rods, find r_f ~ H^(1.2 +- 0.1) for low piles and
-  a square root above, "agreeing with previous experiments on ordinary sand"
-  (https://arcxiv.org/abs/1005.0319).
-"""
 
 
 def _intro(numbers: dict[str, Any]) -> list[str]:
