@@ -76,14 +76,44 @@ def sweep_ratios(case: Case) -> list[float]:
     return [float(a) for a in ratios]
 
 
-def runout_row(point: Point) -> dict[str, Any]:
-    """Measure of :func:`run_sweep`: the run-out of one column run to rest."""
-    s = point.run().execute().summary
-    L0 = point.case.L0
+def _runout_numbers(s: dict[str, Any], L0: float) -> dict[str, Any]:
+    """The run-out numbers of one run's summary ``s`` (L0 [m]: column length or radius)."""
     r = None if s["runout"] is None else s["runout"] / L0
     return {"r": r, "runout": s["runout"], "stop_time": s["stop_time"],
             "at_rest": s["at_rest"], "steps": s["steps"], "wall_time_s": s["wall_time_s"],
             "mass_relative_error": s["mass_relative_error"]}
+
+
+def runout_row(point: Point) -> dict[str, Any]:
+    """Measure of :func:`run_sweep`: the run-out of one column run to rest."""
+    return _runout_numbers(point.run().execute().summary, point.case.L0)
+
+
+def deposit_numbers(x: np.ndarray, depth: np.ndarray, L0: float, H0: float,
+                    stop_time: float | None, g: float = 9.81) -> dict[str, Any]:
+    """The deposit of a column of length (radius) L0 [m] and height H0 [m] at rest:
+    its final height H_inf = max total depth [m] (``depth`` per cell at cell centres
+    ``x`` [m]), H_inf/L0, H_inf/H0, the radius of its undisturbed top (where the depth
+    is still H0 to 1e-9 m) over L0, and the arrest time over (H0/g)^(1/2)."""
+    h_inf = float(np.max(depth))
+    top = np.nonzero(np.abs(depth - H0) <= 1e-9)[0]
+    dx = float(x[1] - x[0]) if x.size > 1 else 0.0
+    return {"final_height": h_inf, "H_inf_over_L0": h_inf / L0, "H_inf_over_H0": h_inf / H0,
+            "top_radius_over_L0": float(x[top[-1]] + dx / 2) / L0 if top.size else 0.0,
+            "arrest_time_scaled": (None if stop_time is None
+                                   else stop_time / float(np.sqrt(H0 / g)))}
+
+
+def deposit_row(point: Point) -> dict[str, Any]:
+    """Measure of :func:`run_sweep` on an axisymmetric case: :func:`runout_row` and the
+    deposit's :func:`deposit_numbers` (final height, undisturbed top, arrest time)."""
+    res = point.run().execute()
+    case = point.case
+    row = _runout_numbers(res.summary, case.L0)
+    g = float(getattr(res.pde.parameters, "g", 9.81))
+    row.update(deposit_numbers(res.x, res.state.data[::2].sum(axis=0), case.L0,
+                               float(case.initial["H0"]), res.summary["stop_time"], g))
+    return row
 
 
 def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
@@ -92,7 +122,8 @@ def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
     """Run every model at every aspect ratio; return the sweep summary.
 
     A :class:`~pdeflow.study.core.Study`: one point per model and aspect ratio a
-    (the case with H0 = a L0, no snapshots), measured by :func:`runout_row`.
+    (the case with H0 = a L0, no snapshots), measured by :func:`runout_row` (on an
+    axisymmetric case by :func:`deposit_row`: the final height and arrest time too).
     """
     ratios = aspect_ratios or sweep_ratios(case)
     L0 = case.L0
@@ -106,7 +137,8 @@ def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
                     labels={"model": model, "a": float(a)})
               for model in models for a in ratios]
     wall0 = time.perf_counter()
-    table = Study(points, runout_row).execute(executor)
+    measure = deposit_row if case.geometry == "axisymmetric" else runout_row
+    table = Study(points, measure).execute(executor)
     for model in models:
         rows = [{k: v for k, v in row.items() if k != "model"} for row in table
                 if row["model"] == model]
@@ -205,6 +237,12 @@ def cmd_sweep(args: Any) -> int:
                    if res["prefactor"] else "no fit")
             print(f"{model:13} {fit}   (paper {res['paper_prefactor']} "
                   f"a^{res['paper_exponent']})   a:r {pts}")
+            if res["runs"] and "H_inf_over_L0" in res["runs"][0]:  # axisymmetric
+                print(f"{'':13} a:H_inf/R0 " + ", ".join(
+                    f"{row['a']:g}:{row['H_inf_over_L0']:.3g}" for row in res["runs"])
+                    + "   a:t_stop/(H0/g)^(1/2) " + ", ".join(
+                    f"{row['a']:g}:{row['arrest_time_scaled']:.3g}" if row["arrest_time_scaled"]
+                    else f"{row['a']:g}:-" for row in res["runs"]))
         print(f"wall time {summary['wall_time_s']:.2f} s")
     return 0
 
