@@ -16,6 +16,7 @@ import numpy as np
 
 from . import systems
 from .numerics.compile_parallel import can_fork, fork_context
+from .numerics.geometry import COORDINATES
 from .plotting import LAYER_STYLES, _short, _symbol, _velocity, fixed_margins, save
 
 
@@ -100,7 +101,7 @@ def case_figures(results: dict[str, Any], outdir: str | Path, prefix: str = "",
     outdir.mkdir(parents=True, exist_ok=True)
     runs = list(results.values())
     first = runs[0]
-    coordinate = first.pde.metric(first.state.grid).coordinate
+    coordinate = COORDINATES[first.case.geometry]
     times = sorted(set().union(*(res.snapshots for res in runs)))
     jobs = []
     for t in times:

@@ -30,6 +30,7 @@ import numpy as np
 
 from . import systems
 from .metrics import total_depth
+from .numerics.geometry import COORDINATES
 
 #: cells x steps per second of the compiled fv-split loop on this development machine:
 #: 0.9e7 (two layers, test 5.1, dx = 0.05 m) to 1.3e8 over the cases in cases/ (dry
@@ -226,7 +227,7 @@ def _end(case: Any, side: str) -> str:
     axisymmetric grid)."""
     kind = "open" if case.bc[SIDES.index(side)] == "open" else "wall at the"
     x = case.x_start + (case.length if side == "right" else 0.0)
-    coordinate = "r" if case.geometry == "axisymmetric" else "x"
+    coordinate = COORDINATES[case.geometry]
     return f"the {kind} {side} end ({coordinate} = {x:g} m)"
 
 

@@ -175,6 +175,7 @@ def _write_run_outputs(args: argparse.Namespace, case: Any, summary: dict,
                        outdir: Path | None) -> list[Any]:
     """Write (commit) every output of ``pdeflow run``; returns what was written."""
     from .io import write_json, write_npz
+    from .numerics.geometry import COORDINATES
 
     written: list[Any] = []
     for model, tracker in stores.items():
@@ -195,7 +196,7 @@ def _write_run_outputs(args: argparse.Namespace, case: Any, summary: dict,
         from .plotting import save
 
         runs = list(results.values())
-        coordinate = runs[0].pde.metric(runs[0].state.grid).coordinate
+        coordinate = COORDINATES[case.geometry]
         fig = deposit_figure(runs[0].x, [(r.model, r.state.data) for r in runs], case.name,
                              coordinate=coordinate)
         written.append(save(fig, args.plot))

@@ -148,7 +148,7 @@ class Run:
             # compiling (first run on a machine) or loading the kernels is not the run's
             # wall time, nor should it hold up its progress bar
             prepare(scheme_stepper(*scheme_codes(self.pde, self.variant.splitting,
-                                                 self.pde.metric(self.state.grid).code)))
+                                                 GEOMETRIES[case.geometry])))
         wall0 = time.perf_counter()
         final, info = self.pde.solve(self.state, t_range=case.t_end, tracker=trackers,
                                      ret_info=True, **self.solver_arguments())
@@ -217,7 +217,8 @@ def summarize(res: RunResult, mass0: float, wall: float,
     dx = case.dx
     d = res.state.data
     weights = res.pde.system.densities(res.pde.parameters)
-    cells = res.pde.metric(res.state.grid).cells
+    metric = res.pde.metric(res.state.grid)
+    cells = metric.cells
     front = front_position(res.x, d, case.front_threshold, dx)
     at_rest = "rest_time" in res.info.get("solver", {})
     diag = res.diagnostics
@@ -243,7 +244,7 @@ def summarize(res: RunResult, mass0: float, wall: float,
         # docs/stability.md): 0 where the scheme kept depths non-negative by itself
         out["positivity_retries"] = diag.positivity_retries
         out.update(res.pde.system.summarize(diag, res.t_final, at_rest, res.x, d,
-                                            res.pde.metric(res.state.grid)))
+                                            metric))
     else:
         out.update({"stop_time": None, "max_fextra_over_rho1": None})
     if initial is not None:

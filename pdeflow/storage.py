@@ -46,6 +46,7 @@ from pde.trackers.base import InfoDict
 
 from . import systems
 from .io import PendingFile, atomic_path, jsonable
+from .numerics.geometry import COORDINATES
 from .numerics.state import DRY_TOLERANCE, velocity_profile
 from .trackers.frames import (
     FEXTRA_LABEL,
@@ -122,7 +123,7 @@ def run_metadata(case: Any, model: str, *, overrides: Sequence[str] = (),
         "boundaries": list(case.bc),
         "dx": case.dx,
         "geometry": case.geometry,
-        "coordinate": "r" if case.geometry == "axisymmetric" else "x",
+        "coordinate": COORDINATES[case.geometry],
         "pdeflow_version": __version__,
     }
     meta.update(extra)

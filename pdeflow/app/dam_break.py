@@ -29,6 +29,7 @@ from bokeh.plotting import figure
 
 from .. import systems
 from ..cases import BASELINE_MODEL, PAPER_MODEL, Case, CaseError
+from ..numerics.geometry import COORDINATES
 from ..numerics.state import velocity_profile
 from ..plotting import DRY
 from ..simulate import Run, RunResult, print_summary, run_model
@@ -273,7 +274,7 @@ class DamBreakPage:
         case = run.case
         self.fig_h.x_range.start, self.fig_h.x_range.end = case.x_start, case.x_start + case.length
         axisymmetric = case.geometry == "axisymmetric"
-        self.fig_f.xaxis.axis_label = "r [m]" if axisymmetric else "x [m]"
+        self.fig_f.xaxis.axis_label = f"{COORDINATES[case.geometry]} [m]"
         self.fig_plan.visible = axisymmetric
         for m, span in self.fronts.items():
             front = run.results[m].summary["front_position"] if m in run.results else None

@@ -23,7 +23,7 @@ from pde import CartesianGrid, FieldCollection, ScalarField
 from pde.pdes.base import PDEBase
 
 from ..numerics import layout as L
-from ..numerics.geometry import Metric, metric_of
+from ..numerics.geometry import Metric, geometry_of, metric_of
 from ..numerics.state import DRY_TOLERANCE
 
 BC_NAMES = L.BOUNDARIES
@@ -248,16 +248,23 @@ class GranularPDE(PDEBase):
     def check_grid(grid: Any) -> float:
         """Return dx [m] of a uniform non-periodic 1D grid (a ``CartesianGrid``, or a
         ``PolarSymGrid`` from the axis), else raise."""
-        return metric_of(grid).dx
+        geometry_of(grid)
+        return float(grid.discretization[0])
 
-    def metric(self, grid: Any) -> Metric:
-        """The finite-volume metric of ``grid`` (:func:`~pdeflow.numerics.geometry.metric_of`);
-        on an axisymmetric grid the left boundary is the axis and must be 'wall'."""
-        metric = metric_of(grid)
-        if metric.geometry == "axisymmetric" and self.bc[0] != "wall":
+    def geometry(self, grid: Any) -> str:
+        """The geometry of ``grid`` (:func:`~pdeflow.numerics.geometry.geometry_of`); on
+        an axisymmetric grid the left boundary is the axis and must be 'wall'."""
+        geometry = geometry_of(grid)
+        if geometry == "axisymmetric" and self.bc[0] != "wall":
             raise ValueError(f"on an axisymmetric grid the left boundary is the axis: "
                              f"bc[0] must be 'wall', got {self.bc[0]!r}")
-        return metric
+        return geometry
+
+    def metric(self, grid: Any) -> Metric:
+        """The finite-volume metric of ``grid`` (:func:`~pdeflow.numerics.geometry.metric_of`),
+        after :meth:`geometry`'s checks."""
+        self.geometry(grid)
+        return metric_of(grid)
 
     def make_state(self, grid: CartesianGrid, **profiles: np.ndarray) -> FieldCollection:
         """State from depth and velocity profiles (names: the system's
@@ -286,7 +293,8 @@ class GranularPDE(PDEBase):
 
     def check_state(self, state: FieldCollection) -> float:
         """Validate a state for this model (and its grid, see :meth:`metric`); return dx."""
-        dx = self.metric(state.grid).dx
+        self.geometry(state.grid)
+        dx = float(state.grid.discretization[0])
         if state.data.shape[0] != len(self.field_names):
             raise ValueError(f"state must have {len(self.field_names)} fields "
                              f"{self.field_names}, got {state.data.shape[0]}")
@@ -323,7 +331,7 @@ class GranularPDE(PDEBase):
             raise NotImplementedError(
                 f"the numpy backend implements hll/first-order only, not {self.variant}; "
                 "use the numba backend")
-        if self.metric(grid).geometry != "planar":
+        if self.geometry(grid) != "planar":
             raise NotImplementedError("the numpy backend implements the planar geometry "
                                       "only; use the numba backend")
 

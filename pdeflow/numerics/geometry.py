@@ -23,6 +23,9 @@ import numpy as np
 
 from . import layout as L
 
+COORDINATES = {"planar": "x", "axisymmetric": "r"}
+"""the name of each geometry's coordinate [m]"""
+
 
 @dataclass(frozen=True, eq=False)
 class Metric:
@@ -70,9 +73,10 @@ class Metric:
         return float(np.sum(values * self.volumes))
 
 
-def metric_of(grid: Any) -> Metric:
-    """The metric of a non-periodic 1D ``CartesianGrid`` or a ``PolarSymGrid`` starting at
-    the axis; ValueError for any other grid."""
+def geometry_of(grid: Any) -> str:
+    """'planar' for a non-periodic 1D ``CartesianGrid``, 'axisymmetric' for a
+    ``PolarSymGrid`` starting at the axis; ValueError for any other grid. Cheap: no
+    arrays (the method-of-lines rate checks its grid on every call)."""
     from pde import CartesianGrid, PolarSymGrid
 
     if isinstance(grid, PolarSymGrid):
@@ -80,17 +84,27 @@ def metric_of(grid: Any) -> Metric:
         if r0 != 0.0:
             raise ValueError("an axisymmetric grid must start at the axis: PolarSymGrid "
                              f"on [0, R], got [{r0:g}, {r1:g}] m")
-        n = grid.shape[0]
-        dr = float(grid.discretization[0])
-        faces = np.linspace(0.0, float(r1), n + 1)
-        return Metric("axisymmetric", "r", dr, faces, 2 * math.pi * faces,
-                      math.pi * (faces[1:] ** 2 - faces[:-1] ** 2))
+        return "axisymmetric"
     if not isinstance(grid, CartesianGrid) or grid.num_axes != 1:
         raise ValueError(f"grid must be a 1D CartesianGrid or a PolarSymGrid, got {grid!r}")
     if grid.periodic[0]:
         raise ValueError("grid must not be periodic: use wall or open boundaries")
+    return "planar"
+
+
+def metric_of(grid: Any) -> Metric:
+    """The metric of a grid that :func:`geometry_of` accepts."""
+    geometry = geometry_of(grid)
+    if geometry == "axisymmetric":
+        r1 = grid.axes_bounds[0][1]
+        n = grid.shape[0]
+        dr = float(grid.discretization[0])
+        faces = np.linspace(0.0, float(r1), n + 1)
+        return Metric(geometry, COORDINATES[geometry], dr, faces, 2 * math.pi * faces,
+                      math.pi * (faces[1:] ** 2 - faces[:-1] ** 2))
     n = grid.shape[0]
     dx = float(grid.discretization[0])
     x0, x1 = grid.axes_bounds[0]
-    return Metric("planar", "x", dx, np.linspace(x0, x1, n + 1), np.ones(n + 1),
+    return Metric(geometry, COORDINATES[geometry], dx, np.linspace(x0, x1, n + 1),
+                  np.ones(n + 1),
                   np.full(n, dx))

@@ -40,7 +40,7 @@ import numpy as np
 from pde.trackers.base import InfoDict, TrackerBase
 
 from ..io import PendingFile
-from ..numerics.geometry import metric_of
+from ..numerics.geometry import COORDINATES, geometry_of
 from ..plotting import RunFigure, Series
 from ..systems import of_fields
 from .frames import fextra_over_rho1, show_final_state, state_labels
@@ -196,7 +196,7 @@ class LayersPlotTracker(TrackerBase):
         self._field = field
         model = self.model or of_fields(state_labels(field)).name
         series = [Series(np.asarray(field.grid.axes_coords[0]), model,
-                         coordinate=metric_of(field.grid).coordinate)]
+                         coordinate=COORDINATES[geometry_of(field.grid)])]
         self.figure = RunFigure(series, title=self.title, depth_max=self.depth_max,
                                 pyplot=self.display == "window")
         if self.frames_dir is not None:
