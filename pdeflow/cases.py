@@ -7,7 +7,8 @@ names the key and the file. Sections (all optional except ``[initial]``)::
     [case]        name, description, t_end [s], models = ["two_layer", "single_layer"]
     [grid]        length [m], dx [m] (or cells), x_start [m]
     [boundaries]  left, right = "wall" | "open"
-    [initial]     shape = "column" | "dam_break" | "heap" | "file" and its keys
+    [initial]     shape = "column" | "column_on_bed" | "dam_break" | "heap" | "file"
+                  and its keys
     [numerics]    solver = "fv-split" | any py-pde solver name, cfl, dt (py-pde solvers),
                   flux = "hll" | "rusanov" | "ifcp", reconstruction = "first-order" |
                   "muscl", limiter = "minmod" | "mc", splitting = "lie" | "strang"
@@ -22,6 +23,11 @@ Initial shapes (x measured from the left end of the domain):
   two layers the lower layer is the wedge h2 = min(H0, (L0 - x) tan(alpha)) under the
   upper layer h1 = H0 - h2, alpha = ``wedge_angle_deg`` (default 45 + phi_int/2, the
   Rankine active failure plane; the paper's text says pi/4 + phi_int, see docs).
+* ``column_on_bed``: the column on an erodible bed: a layer of ``bed_thickness`` [m]
+  at rest from x = L0 over ``bed_length`` [m] (default: to the domain's end). For two
+  layers the bed is part of the lower layer (under the column's wedge it is absent);
+  the single layer has no erodible layer and runs on the rigid bed (its summary says
+  ``bed = 'rigid'``).
 * ``dam_break``: depth h_left for x < x_dam and h_right beyond (single layer; for two
   layers ``upper_fraction`` of each depth is put in the upper layer).
 * ``heap``: a symmetric triangular heap of height ``height`` [m] with flanks at
@@ -47,7 +53,14 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from . import systems
-from .initial_shapes import SHAPES, check_initial, profiles_from_file, total_depth
+from .initial_shapes import (
+    SHAPES,
+    bed_depth,
+    check_initial,
+    has_bed,
+    profiles_from_file,
+    total_depth,
+)
 from .models.base import check_range
 from .numerics.layout import GEOMETRIES
 from .variant import MAX_CFL, Variant, VariantError, variant_of
@@ -71,7 +84,8 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
                 "wedge_angle_deg": (float, int), "x_dam": (float, int),
                 "h_left": (float, int), "h_right": (float, int),
                 "upper_fraction": (float, int), "center": (float, int),
-                "height": (float, int), "slope_deg": (float, int), "path": (str,)},
+                "height": (float, int), "slope_deg": (float, int), "path": (str,),
+                "bed_thickness": (float, int), "bed_length": (float, int)},
     "numerics": {"solver": (str,), "cfl": (float, int), "dt": (float, int),
                  "flux": (str,), "reconstruction": (str,), "limiter": (str,),
                  "splitting": (str,)},
@@ -404,12 +418,32 @@ class Case:
             except ValueError as err:
                 raise self._err(str(err)) from None
         params = system.parameters_class.from_dict(self.data.get(model, {}))
-        depths = system.layer_depths(total_depth(ini, x), x, ini, params)
+        depths = list(system.layer_depths(total_depth(ini, x), x, ini, params))
+        bed = self.bed(model, x)
+        if bed is not None:
+            depths[system.bed_layer] = depths[system.bed_layer] + bed
         out: dict[str, np.ndarray] = {}
         for layer, depth in zip(system.layers, depths, strict=True):
             out[layer.depth] = depth
             out[layer.velocity] = np.zeros_like(x)
         return out
+
+    def bed(self, model: str, x: np.ndarray | None = None) -> np.ndarray | None:
+        """The erodible bed [m] ``model`` starts with at the cell centres ``x`` [m from
+        the domain's start; default: the case's grid]: the shape's bed if the model has
+        an erodible layer, else None (no bed, or the model runs on the rigid bed)."""
+        if systems.get(model).bed_layer is None:
+            return None
+        if x is None:
+            x = self.make_grid().axes_coords[0] - self.x_start
+        return bed_depth(self.initial, x)
+
+    def bed_kind(self, model: str) -> str | None:
+        """'erodible' or 'rigid' if the case lays a bed ('rigid': ``model`` has no
+        erodible layer and runs without it); None if it lays none."""
+        if not has_bed(self.initial):
+            return None
+        return "rigid" if systems.get(model).bed_layer is None else "erodible"
 
     def make_state(self, model: str):
         """PDE, grid and initial FieldCollection for ``model``."""

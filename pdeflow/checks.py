@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from . import systems
+from .initial_shapes import is_column
 from .metrics import total_depth
 from .numerics.geometry import COORDINATES
 
@@ -98,7 +99,7 @@ def max_initial_depth(case: Any) -> float:
     """Largest initial total depth [m], from the case's keys (from the file for 'file')."""
     ini = case.initial
     shape = ini.get("shape")
-    if shape == "column":
+    if is_column(ini):
         return float(ini["H0"])
     if shape == "dam_break":
         return max(float(ini["h_left"]), float(ini.get("h_right", 0.0)))
@@ -193,7 +194,7 @@ def solver_warning(case: Any) -> str | None:
 
 
 def domain_ends(case: Any, initial: np.ndarray, final: np.ndarray,
-                mass_change: float) -> dict[str, Any]:
+                mass_change: float, bed: np.ndarray | None = None) -> dict[str, Any]:
     """Where material reached an end of the domain that was clear of it initially.
 
     An end counts as reached if its outermost cell is deeper than the front threshold
@@ -203,10 +204,14 @@ def domain_ends(case: Any, initial: np.ndarray, final: np.ndarray,
     relative mass lost through open ends, 0 if none), ``runout_lower_bound`` (the
     right end was reached, so the material could have gone further) and
     ``open_through_material`` (open ends with material at t = 0, e.g. the reservoir of
-    a dam break: mass flows in or out there by design).
+    a dam break: mass flows in or out there by design). Depths are measured above the
+    initial erodible ``bed`` [m] if given: a bed at rest that reaches an end is no
+    material reaching it.
     """
     thr = case.front_threshold
     h0, h1 = total_depth(initial), total_depth(final)
+    if bed is not None:
+        h0, h1 = h0 - bed, h1 - bed
     lost = -mass_change if mass_change < -1e-9 else 0.0
     sides, reservoirs = [], []
     for (side, i), bc in zip((("left", 0), ("right", -1)), case.bc, strict=True):

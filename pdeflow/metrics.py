@@ -13,10 +13,13 @@ def total_depth(data: np.ndarray) -> np.ndarray:
 
 
 def front_position(x: np.ndarray, data: np.ndarray, threshold: float = 1e-3,
-                   dx: float | None = None) -> float | None:
-    """Last x [m] whose total depth exceeds ``threshold`` [m]: the downstream face of
-    that cell if ``dx`` is given, else its centre. None if no cell is that deep."""
-    wet = np.nonzero(total_depth(data) > threshold)[0]
+                   dx: float | None = None, bed: np.ndarray | None = None) -> float | None:
+    """Last x [m] whose total depth exceeds ``threshold`` [m] (above the initial
+    erodible ``bed`` [m] if given, so that the front is that of the material on the bed,
+    as experiments measure it): the downstream face of that cell if ``dx`` is given,
+    else its centre. None if no cell is that deep."""
+    depth = total_depth(data) if bed is None else total_depth(data) - bed
+    wet = np.nonzero(depth > threshold)[0]
     if wet.size == 0:
         return None
     i = wet[-1]

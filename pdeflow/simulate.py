@@ -195,8 +195,8 @@ def run_model(case: Case, model: str, *, tracker: Any = None,
     return Run(case, model, backend=backend).execute(tracker)
 
 
-_COMMON_KEYS = ("model", "solver", "geometry", "t_final", "at_rest", "front_position", "runout",
-                "mass_relative_error", "steps", "wall_time_s", "stop_reason", "stop_time",
+_COMMON_KEYS = ("model", "solver", "geometry", "bed", "t_final", "at_rest", "front_position",
+                "runout", "mass_relative_error", "steps", "wall_time_s", "stop_reason", "stop_time",
                 "max_fextra_over_rho1", "flux_fallback_steps", "positivity_retries",
                 "mass_change", "runout_lower_bound", "domain_ends", "warnings")
 
@@ -219,13 +219,15 @@ def summarize(res: RunResult, mass0: float, wall: float,
     weights = res.pde.system.densities(res.pde.parameters)
     metric = res.pde.metric(res.state.grid)
     cells = metric.cells
-    front = front_position(res.x, d, case.front_threshold, dx)
+    bed = case.bed(res.model, res.x - case.x_start)
+    front = front_position(res.x, d, case.front_threshold, dx, bed)
     at_rest = "rest_time" in res.info.get("solver", {})
     diag = res.diagnostics
     out: dict[str, Any] = {
         "model": res.model,
         "solver": case.solver,
         "geometry": case.geometry,
+        "bed": case.bed_kind(res.model),
         "t_final": res.t_final,
         "at_rest": at_rest,
         "front_position": front,
@@ -248,7 +250,7 @@ def summarize(res: RunResult, mass0: float, wall: float,
     else:
         out.update({"stop_time": None, "max_fextra_over_rho1": None})
     if initial is not None:
-        out["domain_ends"] = domain_ends(case, initial, d, out["mass_change"])
+        out["domain_ends"] = domain_ends(case, initial, d, out["mass_change"], bed)
         out["runout_lower_bound"] = out["domain_ends"]["runout_lower_bound"]
     out["warnings"] = result_warnings(case, res.model, out)
     return out

@@ -90,6 +90,10 @@ class EquationSystem:
     168 one layer)"""
     paper_runout_law: tuple[float, float] | None = None
     """(prefactor, exponent) of the run-out law r = p a^e of the paper's test 5.2"""
+    bed_layer: int | None = None
+    """index in :attr:`layers` of the layer an erodible bed at rest belongs to (the
+    initial shape ``column_on_bed`` adds its bed there); None: the model has no erodible
+    layer and runs such cases on the rigid bed"""
     law_kernels: Any = None
     """the :attr:`kernels` with a rate-dependent basal friction law, for parameters
     whose ``rate_dependent_law`` is true (None: the model has no such choice)"""

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import systems
+from ..initial_shapes import is_column
 from ..numerics import layout as L
 from ..numerics import layout_two_layer as T
 from ..numerics.bundles import TWO_LAYER as KERNELS
@@ -135,7 +136,7 @@ def layer_depths(h: np.ndarray, x: np.ndarray, initial: dict,
     Rankine wedge of angle ``initial.wedge_angle_deg`` (default 45 + phi_int/2 deg, the
     active failure plane) at its front ``x = L0``; other shapes split ``h`` by
     ``initial.upper_fraction`` (default 0.5)."""
-    if initial.get("shape") == "column":
+    if is_column(initial):
         L0, H0 = float(initial["L0"]), float(initial["H0"])
         alpha = float(initial.get("wedge_angle_deg", 45.0 + p.phi_int_deg / 2))
         h2 = np.where(x < L0, np.minimum(H0, (L0 - x) * math.tan(math.radians(alpha))),
@@ -181,7 +182,7 @@ SYSTEM = systems.register(systems.EquationSystem(
     law_kernels=LAW_KERNELS,
     densities=lambda p: (p.density_ratio, 1.0), layer_depths=layer_depths,
     summarize=summarize, has_fextra=True, bytes_per_cell=320,
-    paper_runout_law=(1.61, 0.84),
+    paper_runout_law=(1.61, 0.84), bed_layer=1,
     quantities=(
         Q("lower_stop_time", "lower stop", "s"), Q("upper_stop_time", "upper stop", "s"),
         Q("lower_slow_time", "lower slow", "s"), Q("upper_slow_time", "upper slow", "s"),
