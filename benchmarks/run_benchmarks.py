@@ -7,6 +7,7 @@ Usage (from the repository root)::
     python benchmarks/run_benchmarks.py --only bench    # benchmark suite only
     python benchmarks/run_benchmarks.py --only studies  # pdeflow study on Dask (~25 min)
     python benchmarks/run_benchmarks.py --only cold --label after  # cold first run (~3 min)
+    python benchmarks/run_benchmarks.py --only bed      # a long erodible bed at rest
     python benchmarks/run_benchmarks.py --render        # re-render the doc from JSON
     python benchmarks/run_benchmarks.py --quick         # smoke run into TMPDIR, ~3 min
 
@@ -38,6 +39,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 sys.path.insert(0, str(ROOT))
 
+import bed_cost  # noqa: E402
 import cold_start  # noqa: E402
 import geometry_cost  # noqa: E402
 import study_scaling  # noqa: E402
@@ -229,7 +231,7 @@ def _best(rows: list[dict[str, Any]], model: str) -> str:
 def render(wp: dict[str, Any] | None, bench: dict[str, Any] | None,
            studies: dict[str, Any] | None = None,
            cold: dict[str, Any] | None = None,
-           geometry: dict[str, Any] | None = None) -> str:
+           geometry: dict[str, Any] | None = None, bed: dict[str, Any] | None = None) -> str:
     """docs/performance.md from the stored measurements."""
     L: list[str] = []
     a = L.append
@@ -278,6 +280,8 @@ def render(wp: dict[str, Any] | None, bench: dict[str, Any] | None,
         a(cold_start.render(cold))
     if geometry:
         a(geometry_cost.render(geometry))
+    if bed:
+        a(bed_cost.render(bed))
     if studies:
         a(f"Studies conditions: {_cond(studies['conditions'])}.\n")
         a(study_scaling.render(studies))
@@ -620,7 +624,7 @@ def _findings(wp: dict[str, Any] | None, b: dict[str, Any] | None) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--only", choices=("wp", "bench", "studies", "cold", "geometry"),
+    p.add_argument("--only", choices=("wp", "bench", "studies", "cold", "geometry", "bed"),
                    default=None)
     p.add_argument("--label", default="after",
                    help="name of the cold-start measurement (e.g. before, after)")
@@ -646,6 +650,7 @@ def main(argv: list[str] | None = None) -> int:
     studies_path = results / "studies.json"
     cold_path = results / "cold_start.json"
     geometry_path = results / "geometry.json"
+    bed_path = results / "bed.json"
     if not args.render:
         import pyclaw_run
 
@@ -667,6 +672,9 @@ def main(argv: list[str] | None = None) -> int:
         if args.only in (None, "geometry"):
             geometry_path.write_text(json.dumps(geometry_cost.measure(max(repeats, 7)),
                                                 indent=1, default=str))
+        if args.only in (None, "bed"):
+            bed_path.write_text(json.dumps(bed_cost.measure(max(repeats, 7)), indent=1,
+                                           default=str))
         if args.only in (None, "wp"):
             w = measure_wp(args.quick, max(3, repeats) if not args.quick else repeats,
                            results)
@@ -676,7 +684,8 @@ def main(argv: list[str] | None = None) -> int:
     studies = json.loads(studies_path.read_text()) if studies_path.exists() else None
     cold = json.loads(cold_path.read_text()) if cold_path.exists() else None
     geometry = json.loads(geometry_path.read_text()) if geometry_path.exists() else None
-    Path(doc).write_text(render(wp, bench, studies, cold, geometry))
+    bed = json.loads(bed_path.read_text()) if bed_path.exists() else None
+    Path(doc).write_text(render(wp, bench, studies, cold, geometry, bed))
     _log(f"written {doc}")
     return 0
 

@@ -29,7 +29,7 @@ import numpy as np
 from numba import njit, types
 
 from . import layout as L
-from .advection import ADVECT_SIGNATURE, advection_kernel, wet_cells
+from .advection import ADVECT_SIGNATURE, advection_kernel
 from .compiled import (
     FIELDS,
     METRIC,
@@ -47,6 +47,8 @@ from .compiled import (
     specialise,
 )
 from .model_kernels import ModelKernels
+from .resting import extend_prefix, extend_suffix, live_cells
+from .resting import reach as reach_of
 
 STATUS_END = 0  #: reached t_end
 STATUS_REST = 1  #: everything at rest: nothing will change any more
@@ -99,10 +101,14 @@ def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
     the blow-up diagnosis runs it in Python with an instrumented ``update``):
 
     ``advect_step(advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
-    P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, lo, hi, b_lo,
-    b_hi)`` advances from the wet cells ``lo..hi`` with the model's kernels (see
-    :func:`stepping_kernel`); ``b_lo..b_hi`` are the cells the step may change, saved in
-    ``backup`` (and, for Strang, the bookkeeping in ``diag_keep``, ``fex_keep``).
+    P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, e_lo, e_hi,
+    b_lo, b_hi, s_rest)`` advances the cells ``b_lo..b_hi`` with the model's kernels (see
+    :func:`stepping_kernel`): the cells the step may change, saved in ``backup`` (and,
+    for Strang, the bookkeeping in ``diag_keep``, ``fex_keep``). The advection stages
+    evaluate the wet cells of ``e_lo..e_hi`` (``b`` widened by one, so that every face
+    of a cell of ``b`` is evaluated) and update only those of ``b``; ``s_rest`` [m/s]
+    is the largest wave speed of the faces at rest they skip
+    (:mod:`pdeflow.numerics.resting`), so that dt is that of a full sweep.
 
     Returns ``(dt, mass_rate, ok, a_lo, a_hi, changed)``: the step [s], the largest mass
     rate, whether the state is finite and non-negative, the cells the update touched and
@@ -112,9 +118,13 @@ def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
 
     def advect_step(advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
                     P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep,
-                    first, lo, hi, b_lo, b_hi):
+                    first, e_lo, e_hi, b_lo, b_hi, s_rest):
         fex = diag[L.N_DIAG:]
-        smax, a_lo, a_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry, lo, hi)
+        smax, a_lo, a_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry,
+                                  e_lo, e_hi)
+        smax = max(smax, s_rest)
+        a_lo = max(a_lo, b_lo)
+        a_hi = min(a_hi, b_hi)
         dt = t_end - t
         if strang:
             # the first half source step may accelerate a layer by up to dt/2 |g_x|
@@ -135,7 +145,10 @@ def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
                 changed = diag[L.D_CHANGED]
                 # (a deposit can lift a cell of sub-dry layers above dry: search wider)
                 smax2, a_lo, a_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry,
-                                           b_lo, b_hi)
+                                           e_lo, e_hi)
+                smax2 = max(smax2, s_rest)
+                a_lo = max(a_lo, b_lo)
+                a_hi = min(a_hi, b_hi)
                 if smax2 * dt <= cfl * dx * (1.0 + 1e-9) or attempt == 39:
                     break
                 # the half source step made the waves faster than dt allows (erosion
@@ -151,8 +164,10 @@ def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
         mass_rate, ok = update(q, q0, rate, dt, 0.0, a_lo, a_hi)
         if ok:
             predictor(q, dt, P, a_lo, a_hi)
-            _, c_lo, c_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry, b_lo,
-                                   b_hi)
+            _, c_lo, c_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry, e_lo,
+                                   e_hi)
+            c_lo = max(c_lo, b_lo)
+            c_hi = min(c_hi, b_hi)
             # cells of the first stage that the second does not reach get rate 0
             for i in range(a_lo, a_hi + 1):
                 if i < c_lo or i > c_hi:
@@ -170,9 +185,10 @@ def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
     return advect_step
 
 
-def stepping_function(ifcp: bool, strang: bool, advect_step: Any) -> Any:
+def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int) -> Any:
     """The stepping loop as a Python closure (compiled by :func:`stepping_kernel`, which
-    documents it); ``advect_step`` is :func:`advect_step_function`."""
+    documents it); ``advect_step`` is :func:`advect_step_function`, ``reach`` that of
+    its reconstruction order (:func:`pdeflow.numerics.resting.reach`)."""
 
     def advance(q, t, t_pause, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag,
                 rate, backup, diag_backup, work, prev, max_steps, stop_at_rest, advect, sources,
@@ -185,36 +201,53 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any) -> Any:
         # to undo a Strang half source step that broke the CFL, or an IFCP step
         diag_keep = diag_backup[:L.N_DIAG]
         fex_keep = diag_backup[L.N_DIAG:]
-        # Cells outside the wet region plus the stencil are dry and at rest, which every
-        # stage leaves unchanged: only the active cells are visited. The first step
-        # visits all cells (the source stage cleans the initial state); the wet region
-        # then grows by at most one cell per advection stage, so the next search window
-        # is the last region widened by two.
-        w_lo = 0
-        w_hi = n - 1
+        # Only the cells a step can change are visited: the live cells (moving, or
+        # changed by the last step) widened by the reach of a step; every other cell is
+        # dry, or at rest with a stencil at rest, and no stage changes it
+        # (pdeflow.numerics.resting). The first step visits all cells (the source stage
+        # cleans the initial state).
+        v_lo = 0
+        v_hi = n - 1
         s_lo = 0
         s_hi = n - 1
+        # running maxima of the wave speed of cells at rest, from the left and right
+        # ends: valid for cells < p_ok and >= s_ok (none has changed since)
+        pre = np.zeros(n)
+        suf = np.zeros(n)
+        p_ok = 0
+        s_ok = n
         first = True
         while t < t_pause and steps < max_steps:
-            # cells a step can change: two advection stages around the wet region
-            lo, hi = wet_cells(q, dry, w_lo, w_hi)
             if first:
                 b_lo = 0
                 b_hi = n - 1
-            elif lo > hi:
+            elif v_lo > v_hi:
                 b_lo = 1
                 b_hi = 0
             else:
-                b_lo = max(lo - 2, 0)
-                b_hi = min(hi + 2, n - 1)
+                b_lo = max(v_lo - reach, 0)
+                b_hi = min(v_hi + reach, n - 1)
+            if b_lo <= b_hi:
+                e_lo = max(b_lo - 1, 0)
+                e_hi = min(b_hi + 1, n - 1)
+            else:
+                e_lo = n  # nothing is evaluated: every cell is at rest or dry
+                e_hi = n - 1
+            s_rest = 0.0
+            if e_lo > 0:
+                p_ok = extend_prefix(pre, q, p_ok, e_lo, g, dry)
+                s_rest = pre[e_lo - 1]
+            if e_hi < n - 1:
+                s_ok = extend_suffix(suf, q, s_ok, e_hi + 1, g, dry)
+                s_rest = max(s_rest, suf[e_hi + 1])
             _copy_cells(backup, q, b_lo, b_hi)
             if strang or ifcp:
                 _copy_range(diag_keep, diag, 0, L.N_DIAG - 1)
                 _copy_range(fex_keep, fex, b_lo, b_hi)
             dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
                 advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right, P,
-                g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, lo,
-                hi, b_lo, b_hi)
+                g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, e_lo,
+                e_hi, b_lo, b_hi, s_rest)
             fell_back = False
             if ifcp and not ok:
                 # IFCP is Roe's linearisation for one layer: not positive where cells
@@ -226,7 +259,7 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any) -> Any:
                 dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
                     fallback, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
                     P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep,
-                    first, lo, hi, b_lo, b_hi)
+                    first, e_lo, e_hi, b_lo, b_hi, s_rest)
             retries = 0
             while not ok and retries < MAX_RETRIES:
                 # safety net: a step that would leave a depth negative is rejected and
@@ -241,7 +274,8 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any) -> Any:
                 dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
                     fallback if fell_back else advect, sources, predictor, q, t,
                     t + 0.5 * dt, dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag,
-                    rate, backup, rec, q0, diag_keep, fex_keep, first, lo, hi, b_lo, b_hi)
+                    rate, backup, rec, q0, diag_keep, fex_keep, first, e_lo, e_hi, b_lo, b_hi,
+                    s_rest)
             if fell_back:
                 diag[L.D_FLUX_FALLBACKS] += 1.0
             diag[L.D_RETRIES] += retries
@@ -265,9 +299,10 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any) -> Any:
             changed = max(changed, diag[L.D_CHANGED])
             s_lo = a_lo
             s_hi = a_hi
-            if lo <= hi:
-                w_lo = max(lo - 2, 0)
-                w_hi = min(hi + 2, n - 1)
+            if b_lo <= b_hi:
+                v_lo, v_hi = live_cells(q, backup, b_lo, b_hi)
+                p_ok = min(p_ok, b_lo)
+                s_ok = max(s_ok, b_hi + 1)
             first = False
             if t_new >= t_pause:
                 # the state before this step, for output at t_pause (interpolated by the
@@ -326,7 +361,7 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
     undone; ``q`` holds the last good state).
     """
     step = njit(inline="always")(advect_step_function(order, strang))
-    return specialise(stepping_function(ifcp, strang, step), STATE, f8, f8, f8, f8,
+    return specialise(stepping_function(ifcp, strang, step, reach_of(order)), STATE, f8, f8, f8, f8,
                       METRIC, i8, i8, PARAMS, f8, f8, f8, f8, VECTOR, FIELDS, FIELDS, VECTOR,
                       WORK, FIELDS, i8, flag,
                       ADVECT, SOURCES, PREDICTOR if order == 2 else types.none,
@@ -403,5 +438,5 @@ def python_stepping(model: ModelKernels, flux: int, order: int, limiter: int,
     with an update that records what it wrote); called as the stepper."""
     compiled = scheme_stepper(model, flux, order, limiter, strang, geometry).ready()
     loop = stepping_function(compiled.ifcp, strang,
-                             advect_step_function(order, strang, update))
+                             advect_step_function(order, strang, update), reach_of(order))
     return functools.partial(compiled.run, loop)
