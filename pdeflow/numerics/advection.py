@@ -17,7 +17,8 @@ face depths between neighbouring averages, hence non-negative.
 Boundaries use one ghost cell: a wall mirrors the state (h -> h, hu -> -hu), an open
 (transmissive) boundary copies it. Only faces next to a wet cell are visited: a face
 between two cells that are dry in every layer carries no fluctuation, so the loops run
-over the wet region plus the stencil (most of the domain is dry for most of a collapse).
+over the wet cells of the window they are given (the stepping loop narrows it further to
+the cells a step can change, :mod:`pdeflow.numerics.resting`).
 
 :func:`advection_kernel` builds this stage for one model, flux, reconstruction and
 limiter (nothing of the others is compiled); :func:`rate_kernel` is the same on the
