@@ -85,3 +85,17 @@ def test_bad_bed_keys_are_one_line_errors(override, message):
     with pytest.raises(ValueError, match=message) as err:
         load_case(CASE, [override])
     assert "\n" not in str(err.value)
+
+
+def test_radial_bed_beyond_the_deposit_is_left_exactly_as_laid():
+    """On py-pde's polar grid the bed is a ring of radius > L0; past the deposit's front
+    it has not moved by a bit."""
+    case = load_case(CASE, ["grid.geometry='axisymmetric'", "output.snapshot_times=[]",
+                            "case.models=['two_layer']"])
+    eq, state = case.make_state("two_layer")
+    res = run_model(case, "two_layer")
+    assert res.summary["at_rest"] and res.summary["geometry"] == "axisymmetric"
+    beyond = res.x > res.summary["front_position"] + 0.05
+    assert beyond.sum() > 100
+    np.testing.assert_array_equal(res.state.data[:, beyond], state.data[:, beyond])
+    assert np.all(state.data[2, beyond] == 0.005)
