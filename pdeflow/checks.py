@@ -16,13 +16,17 @@ After a run, :func:`domain_ends` finds material that reached an end of the domai
 :func:`result_warnings` says what would mislead in the summary: a run still moving at
 t_end, a mass that changed, a front at the end of the domain (its run-out is then only a
 lower bound). ``run_model`` issues these as :class:`RunWarning`; the command line prints
-each as one line ``pdeflow: warning: ...``.
+each as one line ``pdeflow: warning: ...`` and the app shows the same lines on its
+page: both collect them with :func:`run_warnings`.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import warnings
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -49,6 +53,35 @@ SIDES = ("left", "right")
 
 class RunWarning(UserWarning):
     """A run or a result that could mislead (printed by the CLI as one line)."""
+
+
+WARNING_PREFIX = "pdeflow: warning: "
+"""What starts each warning line of the command line and of the app's page."""
+
+
+@contextmanager
+def run_warnings(show: Callable[[str], None]) -> Iterator[None]:
+    """Within the block, pass every :class:`RunWarning` to ``show`` as one line
+    ``pdeflow: warning: <message>``, each message once (the solver's warning, e.g., is
+    issued for every model); other warnings are shown as usual.
+
+    The command line prints the lines to stderr, the app's pages show them; one
+    function, so that both say the same.
+    """
+    original = warnings.showwarning
+    shown: set[str] = set()
+
+    def showwarning(message: Any, category: type, *args: Any, **kwargs: Any) -> None:
+        if not issubclass(category, RunWarning):
+            original(message, category, *args, **kwargs)
+        elif str(message) not in shown:
+            shown.add(str(message))
+            show(f"{WARNING_PREFIX}{message}")
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", RunWarning)
+        warnings.showwarning = showwarning
+        yield
 
 
 @dataclass

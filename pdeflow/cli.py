@@ -10,7 +10,6 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
-import warnings
 from pathlib import Path
 from typing import Any
 
@@ -345,21 +344,9 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """``pdeflow COMMAND ...``: the exit code; warnings about a run or its results
     (:class:`pdeflow.checks.RunWarning`) are printed as one line each, once."""
-    from .checks import RunWarning
+    from .checks import run_warnings
 
-    original = warnings.showwarning
-    shown: set[str] = set()
-
-    def show(message: Any, category: type, *args: Any, **kwargs: Any) -> None:
-        if not issubclass(category, RunWarning):
-            original(message, category, *args, **kwargs)
-        elif str(message) not in shown:  # e.g. the solver's, once for all models
-            shown.add(str(message))
-            print(f"pdeflow: warning: {message}", file=sys.stderr, flush=True)
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("always", RunWarning)
-        warnings.showwarning = show
+    with run_warnings(lambda line: print(line, file=sys.stderr, flush=True)):
         return _main(argv)
 
 

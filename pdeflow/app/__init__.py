@@ -25,11 +25,12 @@ from pathlib import Path
 from typing import Any
 
 
-def create_app(case_dir: str | Path | None = None, page: str | None = None) -> Any:
+def create_app(case_dir: str | Path | None = None, page: str | None = None,
+               present: bool = False) -> Any:
     """The app as a Panel object (see :func:`pdeflow.app.layout.create_app`)."""
     from .layout import create_app as _create_app
 
-    return _create_app(case_dir, page)
+    return _create_app(case_dir, page, present)
 
 
 __all__ = ["create_app"]

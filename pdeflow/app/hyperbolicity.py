@@ -39,6 +39,7 @@ from ..numerics.state import velocity_profile
 from ..plotting import DRY
 from .controls import Slider
 from .dam_break import COLOURS, FRAMES_PER_T_END, DamBreakRun, SharedRun
+from .look import PageLayout, legend_outside, style_figures
 
 G = 9.81
 """g_z of the sliders' state [m/s^2] (a flat bed); a cell of a run brings its own."""
@@ -101,8 +102,9 @@ def cell_state(run: DamBreakRun, frame: int, cell: int) -> dict[str, float]:
 class HyperbolicityPage:
     """The hyperbolicity page of one session; follows ``shared.run``."""
 
-    def __init__(self, shared: SharedRun):
+    def __init__(self, shared: SharedRun, present: bool = False):
         self.shared = shared
+        self.present = present
         self.g = G
         self.sliders = {  # (label, start, end, step, value)
             name: Slider(label=label, start=lo, end=hi, step=step, value=value,
@@ -133,6 +135,7 @@ class HyperbolicityPage:
         self.run: DamBreakRun | None = None
         self._figures()
         self._xt_figure()
+        self.set_present(present)
         self.update()
         shared.param.watch(lambda e: self.show_run(e.new), "run")
         self.show_run(shared.run)
@@ -168,9 +171,9 @@ class HyperbolicityPage:
                             line_dash=dash, line_width=1.5)
                 f.add_layout(span)
                 self.lines.setdefault(name, []).append(span)
-        fs.legend.location = "top_left"
-        fs.legend.label_text_font_size = "9pt"
+        legend_outside(fs)  # never over the curves
         fs.css_classes = ["pdeflow-eigen"]
+        fi.css_classes = ["pdeflow-imag"]
         self.fig_spec, self.fig_im = fs, fi
 
     def update(self) -> None:
@@ -254,6 +257,7 @@ class HyperbolicityPage:
                       Span(dimension="width", line_color=COLOURS["lower"], line_width=1.5))
         for s in self.cross:
             fx.add_layout(s)
+        fx.css_classes = ["pdeflow-fextra-map"]
         self.fig_xt = fx
 
     def show_cell(self) -> None:
@@ -294,11 +298,18 @@ class HyperbolicityPage:
                 w.value = value
             self.update()
 
+    def set_present(self, present: bool) -> None:
+        """Presentation mode: larger fonts and lines."""
+        self.present = present
+        style_figures((self.fig_spec, self.fig_im, self.fig_xt), present)
+
     def panel(self) -> pn.Row:
         left = pn.Column("### a local state", *self.sliders.values(), self.text,
-                         width=360)
+                         sizing_mode="stretch_width")
         right = pn.Column(pn.pane.Bokeh(self.fig_spec), pn.pane.Bokeh(self.fig_im),
                           "### where F_extra acts in the dam-break page's run",
                           pn.pane.Bokeh(self.fig_xt), self.frame, self.cell,
                           self.cell_text, self.take, sizing_mode="stretch_width")
-        return pn.Row(left, right, sizing_mode="stretch_width")
+        # the side bar holds the spectrum's numbers too: presentation mode keeps it
+        self.layout = PageLayout(left, right)
+        return self.layout.row
