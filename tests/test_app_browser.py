@@ -204,7 +204,7 @@ def test_cold_start_says_it_compiles(browser, tmp_path):
 SIZES = [(1024, 768), (1920, 1080)]
 """A projector's 1024x768 and a wide screen."""
 FIGURES = {"dam-break": ("depths", "velocities", "fextra"), "run-out": ("runout",),
-           "hyperbolicity": ("eigen", "imag")}
+           "hyperbolicity": ("eigen", "imag", "fextra-map")}
 """Per page, its figures' CSS classes (pdeflow-<name>)."""
 OTHERS = {"dam-break": ("summary", "player", "sidebar"),
           "run-out": ("fits", "current", "sidebar"),
@@ -277,14 +277,18 @@ def test_presentation_mode_has_larger_fonts_and_fewer_controls(browser, server):
         assert not log.errors, log.errors
     finally:
         page.close()
-    # the URL asks for it too
-    page, _ = open_page(browser, server, "dam-break", viewport=SIZES[0],
-                         query="present=1")
-    try:
-        assert _title(page, "depths")["font_px"] > 1.3 * normal
-        assert not page.locator(".pdeflow-sidebar").first.is_visible()
-    finally:
-        page.close()
+    # the URL asks for it too; every page fits the projector in this mode
+    for name in FIGURES:
+        page, log = open_page(browser, server, name, viewport=SIZES[0],
+                              query="present=1")
+        try:
+            if name == "dam-break":
+                assert _title(page, "depths")["font_px"] > 1.3 * normal
+                assert not page.locator(".pdeflow-sidebar").first.is_visible()
+            assert layout_problems(page, FIGURES[name]) == [], name
+            assert not log.errors, log.errors
+        finally:
+            page.close()
 
 
 def _cli_warnings(overrides: list[str], tmp_path: Path, capsys) -> list[str]:

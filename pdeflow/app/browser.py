@@ -192,20 +192,34 @@ FIGURE_TITLES = """() => {
       if (!m.css_classes || !m.title || m.title.text === undefined) continue;
       const t = m.title;
       ctx.font = `${t.text_font_style} ${t.text_font_size} ${t.text_font}`;
+      const width = ctx.measureText(t.text).width;
+      // the y axis' label, drawn upright along the figure's height
+      let ylabel = 0;
+      for (const axis of m.left || []) {
+        if (!axis.axis_label) continue;
+        ctx.font = `${axis.axis_label_text_font_style} ${axis.axis_label_text_font_size} ` +
+                   `${axis.axis_label_text_font}`;
+        ylabel = Math.max(ylabel, ctx.measureText(String(axis.axis_label)).width);
+      }
       for (const c of m.css_classes)
         out[c] = {text: t.text, font_px: parseFloat(t.text_font_size) *
                   (String(t.text_font_size).endsWith("pt") ? 4 / 3 : 1),
-                  width: ctx.measureText(t.text).width};
+                  width, ylabel};
     }
   }
   return out;
 }"""
-"""Per CSS class of a Bokeh figure: its title, the title's font size [px] and the width
-the browser needs to draw it [px] (a canvas title that does not fit is cut off)."""
+"""Per CSS class of a Bokeh figure: its title, the title's font size [px], the width
+the browser needs to draw it [px] (a canvas title that does not fit is cut off), and
+the length of its y axis' label [px] (upright: it must fit the figure's height)."""
 
 
 TITLE_INDENT_PX = 90
 """Room left of a figure's title: the y axis with its label and tick labels [px]."""
+AXIS_ROOM_PX = 40
+"""Height of a figure its y label cannot use: the x axis' tick labels, the margins
+[px] (the title too, where there is one: a label within the height minus this may
+still reach into the title's row, which is not cut)."""
 
 
 def figure_titles(page: Any) -> dict[str, dict[str, Any]]:
@@ -249,4 +263,8 @@ def layout_problems(page: Any, figures: Sequence[str], others: Sequence[str] = (
         if title and title["width"] + TITLE_INDENT_PX > box["width"]:
             problems.append(f"{name}: its title needs {title['width']:.0f} px, the "
                             f"figure is {box['width']:.0f} px wide")
+        # the y label is centred on the plot area, below the title and above the x axis
+        if title and title["ylabel"] > box["height"] - AXIS_ROOM_PX:
+            problems.append(f"{name}: its y axis' label needs {title['ylabel']:.0f} px, "
+                            f"the figure is {box['height']:.0f} px high")
     return problems

@@ -37,7 +37,7 @@ from ..simulate import Run, RunResult, print_summary, run_model
 from ..solvers.fv_split import SimulationBlowUp
 from ..trackers import FextraStorageTracker
 from .controls import ParameterControls, command_line, list_cases, served
-from .look import PageLayout, legend_outside, style_figures
+from .look import PageLayout, fit_height, legend_outside, style_figures
 
 FRAMES_PER_T_END = 250
 """Frame interval of the animation: t_end / this [s] (5.1: 0.02 s, ~70 frames to rest)."""
@@ -48,6 +48,8 @@ SEND_MS = 40
 (the frames' run would otherwise hold the message back until it is done)."""
 LABELS = {m: systems.get(m).label for m in (PAPER_MODEL, BASELINE_MODEL)}
 """The models as the pages name them."""
+FIGURE_HEIGHT = 240
+"""Height of each of the three profile figures [px] (presentation mode: more)."""
 PLAN_PIXELS = 121
 """Pixels across the plan view of an axisymmetric run (the revolved total depth)."""
 
@@ -212,8 +214,9 @@ class DamBreakPage:
     # --- figures --------------------------------------------------------------------------
     def _figures(self) -> None:
         xr = Range1d(0, 1)  # shared by the panels; set to the domain by each run
-        opts = {"height": 230, "sizing_mode": "stretch_width", "toolbar_location": "right",
-                "tools": "pan,wheel_zoom,box_zoom,reset,save", "x_range": xr}
+        opts = {"height": FIGURE_HEIGHT, "sizing_mode": "stretch_width",
+                "toolbar_location": "right", "tools": "pan,wheel_zoom,box_zoom,reset,save",
+                "x_range": xr}
         zero = np.zeros(2)
         self.src_two = ColumnDataSource({k: zero for k in
                                          ("x", "zero", "h2", "top", "u1", "u2", "f")})
@@ -297,6 +300,8 @@ class DamBreakPage:
         """Presentation mode: larger fonts and lines, the expert choices hidden."""
         self.present = present
         style_figures((self.fig_h, self.fig_u, self.fig_f, self.fig_plan), present)
+        for f in (self.fig_h, self.fig_u, self.fig_f):
+            f.height = fit_height(FIGURE_HEIGHT, present)
         self.controls.set_present(present)
 
     def _animate(self, run: DamBreakRun) -> None:

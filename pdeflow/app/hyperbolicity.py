@@ -39,7 +39,7 @@ from ..numerics.state import velocity_profile
 from ..plotting import DRY
 from .controls import Slider
 from .dam_break import COLOURS, FRAMES_PER_T_END, DamBreakRun, SharedRun
-from .look import PageLayout, legend_outside, style_figures
+from .look import PageLayout, fit_height, legend_outside, style_figures
 
 G = 9.81
 """g_z of the sliders' state [m/s^2] (a flat bed); a cell of a run brings its own."""
@@ -155,7 +155,7 @@ class HyperbolicityPage:
                     else "inner pair λ2, λ3")
         fs.scatter("du", "re", source=self.src_now, size=9, color="#d62728",
                    legend_label="this state")
-        fi = figure(x_range=fs.x_range, height=170, sizing_mode="stretch_width",
+        fi = figure(x_range=fs.x_range, height=200, sizing_mode="stretch_width",
                     x_axis_label="du = u1 - u2 [m/s]", y_axis_label="|Im λ2,3| [m/s]",
                     tools=opts["tools"])
         fi.line("du", "im", source=self.src_curves, color="#d62728", line_width=2)
@@ -231,8 +231,8 @@ class HyperbolicityPage:
         self.mapper.high = max(float(f.max()), 1e-6)
         self.src_xt.data = {"x": run.x[j], "t": run.times[i], "f": f[i, j],
                             "w": np.full(i.size, dx), "h": np.full(i.size, dt)}
-        self.fig_xt.title.text = (f"where F_extra/ρ1 > 0 in the run of {run.case.name} "
-                                  f"({i.size} of {f.size} cells x frames)")
+        # short: it must fit a projector's page in presentation mode
+        self.fig_xt.title.text = f"F_extra > 0 in {i.size} of {f.size} cells × frames"
         self.fig_xt.x_range.start = run.case.x_start
         self.fig_xt.x_range.end = run.case.x_start + run.case.length
         self.fig_xt.y_range.start, self.fig_xt.y_range.end = 0.0, float(run.times[-1])
@@ -302,6 +302,8 @@ class HyperbolicityPage:
         """Presentation mode: larger fonts and lines."""
         self.present = present
         style_figures((self.fig_spec, self.fig_im, self.fig_xt), present)
+        for f, normal in ((self.fig_spec, 260), (self.fig_im, 200), (self.fig_xt, 300)):
+            f.height = fit_height(normal, present)
 
     def panel(self) -> pn.Row:
         left = pn.Column("### a local state", *self.sliders.values(), self.text,

@@ -47,6 +47,12 @@ def look(present: bool) -> Look:
     return PRESENT if present else NORMAL
 
 
+def fit_height(normal_px: int, present: bool) -> int:
+    """A figure's height [px] for the mode: larger fonts need more room for the y
+    axis' label (upright) and the tick labels."""
+    return round(normal_px * PRESENT.axis_pt / NORMAL.axis_pt) if present else normal_px
+
+
 def _scale_line(model: Any, scale: float) -> None:
     """Set ``model.line_width`` to its width as built times ``scale`` (the width as
     built is kept in its tags, so that switching back and forth does not drift)."""
