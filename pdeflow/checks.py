@@ -264,6 +264,11 @@ def _end(case: Any, side: str) -> str:
     return f"the {kind} {side} end ({coordinate} = {x:g} m)"
 
 
+def _percent(p: float) -> str:
+    """A percentage to two digits ('25', '9.8'), and '100' (not '1e+02')."""
+    return f"{p:.2g}" if p < 99.5 else f"{p:.0f}"
+
+
 def result_warnings(case: Any, model: str, summary: dict[str, Any]) -> list[str]:
     """What in a finished run's ``summary`` could mislead, one sentence each."""
     out = []
@@ -271,11 +276,13 @@ def result_warnings(case: Any, model: str, summary: dict[str, Any]) -> list[str]
     ends = summary.get("domain_ends") or {}
     if ends.get("sides"):
         where = " and ".join(_end(case, s) for s in ends["sides"])
-        left = (f", and {100 * ends['outflow']:.2g} % of the mass left the domain"
+        left = (f", and {_percent(100 * ends['outflow'])} % of the mass left the domain"
                 if ends["outflow"] else "")
-        bound = (f": the front ({summary['front_position']:.4g} m) and the run-out are "
-                 "lower bounds, lengthen the domain (grid.length)"
-                 if ends.get("runout_lower_bound") else "")
+        front = summary.get("front_position")
+        # no front when every cell is dry: all the material has left the domain
+        shown = f" ({front:.4g} m)" if front is not None else " (none left)"
+        bound = (f": the front{shown} and the run-out are lower bounds, lengthen the "
+                 "domain (grid.length)" if ends.get("runout_lower_bound") else "")
         out.append(f"{name}: material reached {where}{left}{bound}")
     change = summary.get("mass_change", 0.0)
     explained = (ends.get("outflow") and change < 0) or ends.get("open_through_material")
