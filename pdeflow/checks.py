@@ -16,13 +16,17 @@ After a run, :func:`domain_ends` finds material that reached an end of the domai
 :func:`result_warnings` says what would mislead in the summary: a run still moving at
 t_end, a mass that changed, a front at the end of the domain (its run-out is then only a
 lower bound). ``run_model`` issues these as :class:`RunWarning`; the command line prints
-each as one line ``pdeflow: warning: ...``.
+each as one line ``pdeflow: warning: ...`` and the app shows the same lines on its
+page: both collect them with :func:`run_warnings`.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import warnings
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -50,6 +54,35 @@ SIDES = ("left", "right")
 
 class RunWarning(UserWarning):
     """A run or a result that could mislead (printed by the CLI as one line)."""
+
+
+WARNING_PREFIX = "pdeflow: warning: "
+"""What starts each warning line of the command line and of the app's page."""
+
+
+@contextmanager
+def run_warnings(show: Callable[[str], None]) -> Iterator[None]:
+    """Within the block, pass every :class:`RunWarning` to ``show`` as one line
+    ``pdeflow: warning: <message>``, each message once (the solver's warning, e.g., is
+    issued for every model); other warnings are shown as usual.
+
+    The command line prints the lines to stderr, the app's pages show them; one
+    function, so that both say the same.
+    """
+    original = warnings.showwarning
+    shown: set[str] = set()
+
+    def showwarning(message: Any, category: type, *args: Any, **kwargs: Any) -> None:
+        if not issubclass(category, RunWarning):
+            original(message, category, *args, **kwargs)
+        elif str(message) not in shown:
+            shown.add(str(message))
+            show(f"{WARNING_PREFIX}{message}")
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", RunWarning)
+        warnings.showwarning = showwarning
+        yield
 
 
 @dataclass
@@ -236,6 +269,11 @@ def _end(case: Any, side: str) -> str:
     return f"the {kind} {side} end ({coordinate} = {x:g} m)"
 
 
+def _percent(p: float) -> str:
+    """A percentage to two digits ('25', '9.8'), and '100' (not '1e+02')."""
+    return f"{p:.2g}" if p < 99.5 else f"{p:.0f}"
+
+
 def result_warnings(case: Any, model: str, summary: dict[str, Any]) -> list[str]:
     """What in a finished run's ``summary`` could mislead, one sentence each."""
     out = []
@@ -243,11 +281,13 @@ def result_warnings(case: Any, model: str, summary: dict[str, Any]) -> list[str]
     ends = summary.get("domain_ends") or {}
     if ends.get("sides"):
         where = " and ".join(_end(case, s) for s in ends["sides"])
-        left = (f", and {100 * ends['outflow']:.2g} % of the mass left the domain"
+        left = (f", and {_percent(100 * ends['outflow'])} % of the mass left the domain"
                 if ends["outflow"] else "")
-        bound = (f": the front ({summary['front_position']:.4g} m) and the run-out are "
-                 "lower bounds, lengthen the domain (grid.length)"
-                 if ends.get("runout_lower_bound") else "")
+        front = summary.get("front_position")
+        # no front when every cell is dry: all the material has left the domain
+        shown = f" ({front:.4g} m)" if front is not None else " (none left)"
+        bound = (f": the front{shown} and the run-out are lower bounds, lengthen the "
+                 "domain (grid.length)" if ends.get("runout_lower_bound") else "")
         out.append(f"{name}: material reached {where}{left}{bound}")
     change = summary.get("mass_change", 0.0)
     explained = (ends.get("outflow") and change < 0) or ends.get("open_through_material")

@@ -10,7 +10,6 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
-import warnings
 from pathlib import Path
 from typing import Any
 
@@ -49,14 +48,23 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
     trackers: list[Any] = []
     interval = case.t_end / 100
     progress = args.progress
-    if progress is None:  # default: on a terminal, and for long runs (the bar is stderr)
+    drawing = args.movie or args.frames
+    if progress is None:
+        # default: on a terminal, for long runs, and while frames are drawn (a movie
+        # takes seconds per model, longer than the run; the bar is on stderr)
         from .checks import run_cost
 
-        progress = not args.quiet and (sys.stdout.isatty() or run_cost(case, model).long)
+        progress = not args.quiet and (sys.stdout.isatty() or bool(drawing)
+                                       or run_cost(case, model).long)
     if progress:
         from .trackers import ProgressBar
 
-        trackers.append(ProgressBar(interval, label=model))
+        label = model
+        if drawing:
+            target = (_model_path(args.movie, model, first).name if args.movie
+                      else "frames")
+            label = f"{model}, drawing {target}"
+        trackers.append(ProgressBar(interval, label=label))
     show = args.live and _live_display()  # headless: nothing to show
     if show or args.movie or args.frames:
         from .trackers.live import LayersPlotTracker
@@ -282,7 +290,8 @@ def _add_run(sub: Any) -> None:
     watch = run.add_argument_group("watching the run")
     watch.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                        help="show a progress bar on stderr (default: when stdout is a "
-                       "terminal, or when the run is estimated to be long)")
+                       "terminal, when the run is estimated to be long, or with --movie "
+                       "or --frames)")
     watch.add_argument("--live", action="store_true",
                        help="draw the layers, velocities and F_extra/rho1 in a window "
                        "while the run goes (needs a display; close it to finish)")
@@ -345,21 +354,9 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """``pdeflow COMMAND ...``: the exit code; warnings about a run or its results
     (:class:`pdeflow.checks.RunWarning`) are printed as one line each, once."""
-    from .checks import RunWarning
+    from .checks import run_warnings
 
-    original = warnings.showwarning
-    shown: set[str] = set()
-
-    def show(message: Any, category: type, *args: Any, **kwargs: Any) -> None:
-        if not issubclass(category, RunWarning):
-            original(message, category, *args, **kwargs)
-        elif str(message) not in shown:  # e.g. the solver's, once for all models
-            shown.add(str(message))
-            print(f"pdeflow: warning: {message}", file=sys.stderr, flush=True)
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("always", RunWarning)
-        warnings.showwarning = show
+    with run_warnings(lambda line: print(line, file=sys.stderr, flush=True)):
         return _main(argv)
 
 

@@ -73,7 +73,8 @@ def cmd_plot(args: argparse.Namespace) -> int:
             idx = [r.index(min(t, r.times[-1])) for r in runs]
             frames.append((float(t), [r.data[i] for r, i in zip(runs, idx, strict=True)],
                            [r.fextra[i] for r, i in zip(runs, idx, strict=True)]))
-        written.append(replay(frames, series, args.movie, title=title, fps=args.fps))
+        written.append(replay(frames, series, args.movie, title=title, fps=args.fps,
+                              progress=not args.quiet))
     if args.out or not args.movie:
         idx = [r.index(args.time) for r in runs]
         times = [float(r.times[i]) for r, i in zip(runs, idx, strict=True)]

@@ -308,3 +308,138 @@ def test_friction_law_choice_sets_every_model_and_enables_its_sliders():
     assert "single_layer.friction_law='voellmy'" in over
     case = controls.load()
     assert case.make_pde("single_layer").parameters.friction_law == "voellmy"
+
+
+# --- the lecture hall: warnings, domain length, opening frame, presentation mode ---------
+def _cli_warnings(overrides: list[str], tmp_path: Path, capsys) -> list[str]:
+    """The ``pdeflow: warning:`` lines of ``pdeflow run`` for test 5.1."""
+    capsys.readouterr()
+    argv = ["run", str(CASE_51), "--outdir", str(tmp_path), "--quiet"]
+    for o in overrides:
+        argv += ["--set", o]
+    assert main(argv) == 0
+    return [r for r in capsys.readouterr().err.splitlines()
+            if r.startswith("pdeflow: warning:")]
+
+
+def test_the_page_warns_as_the_command_line_does(tmp_path, capsys):
+    """At 35 deg the 7 m domain loses 25 % (two layers) and 97 % (one layer) of the
+    mass: the page shows the command line's warnings, and a longer domain keeps the
+    two layers' mass (then the page warns that they still move at t_end)."""
+    page = DamBreakPage(CASES)
+    assert page.run.warnings == [] and not page.warnings.visible
+    page.controls.sliders["slope"].value = 35.0
+    page.controls.sliders["slope"].param.trigger("value_throttled")
+    over = page.controls.overrides()
+    assert over == ["two_layer.theta_deg=35", "single_layer.theta_deg=35"]
+    expected = _cli_warnings(over, tmp_path, capsys)
+    assert page.run.warnings == expected and len(expected) == 2
+    assert "25 % of the mass left the domain" in expected[0]
+    assert "97 % of the mass left the domain" in expected[1]
+    assert page.warnings.visible and all(w in page.warnings.object for w in expected)
+    length = page.controls.sliders["length"]
+    assert length.start == 7.0 and length.step == 2.0  # whole cells of dx = 0.05 m
+    length.value = 41.0
+    length.param.trigger("value_throttled")
+    over = page.controls.overrides()
+    assert over[-1] == "grid.length=41"
+    assert page.run.warnings == _cli_warnings(over, tmp_path, capsys)
+    assert not any("two_layer: material reached" in w for w in page.run.warnings)
+    assert page.run.results["two_layer"].summary["mass_change"] == pytest.approx(0,
+                                                                                 abs=1e-9)
+
+
+def test_run_warnings_are_one_line_each_once():
+    import warnings
+
+    from pdeflow.checks import RunWarning, run_warnings
+
+    lines: list[str] = []
+    with run_warnings(lines.append):
+        for _ in range(2):
+            warnings.warn("the same", RunWarning, stacklevel=1)
+        warnings.warn("another", RunWarning, stacklevel=1)
+    assert lines == ["pdeflow: warning: the same", "pdeflow: warning: another"]
+
+
+def test_around_case_sliders_keep_the_cases_value_and_whole_cells():
+    from pdeflow.app.controls import nice_step
+
+    assert [nice_step(v) for v in (1.75, 0.5, 0.3, 7.0, 0.012)] == [2, 0.5, 0.2, 5, 0.01]
+    page = DamBreakPage(CASES)
+    for name, own in (("length", 7.0), ("t_end", 5.0)):
+        s = page.controls.sliders[name]
+        positions = np.arange(s.start, s.end + s.step / 2, s.step)
+        assert np.isclose(positions, own).any() and s.value == own, name
+    dx = page.run.case.dx
+    cells = page.controls.sliders["length"].step / dx
+    assert cells == pytest.approx(round(cells))
+
+
+def test_the_page_opens_on_the_collapse_in_motion():
+    from pdeflow.app.dam_break import opening_frame
+
+    page = DamBreakPage(CASES)
+    last = len(page.run.times) - 1
+    assert page.player.value == opening_frame(page.run) < last
+    assert np.nanmax(np.abs(page.src_two.data["u1"])) > 1.0  # m/s: moving
+    assert np.nanmax(page.src_two.data["f"]) > 0 or np.nanmax(page.run.fextra) > 0
+    assert "final state" not in page.fig_h.title.text
+    page.controls.sliders["phi_b_two"].value = 38.0
+    page.controls.sliders["phi_b_two"].param.trigger("value_throttled")
+    assert page.player.value == len(page.run.times) - 1  # a change: the deposit
+
+
+def _all_figures(dam, runout, hyper):
+    return [dam.fig_h, dam.fig_u, dam.fig_f, runout.fig, hyper.fig_spec]
+
+
+def test_presentation_mode_enlarges_and_hides_and_switches_back():
+    from bokeh.models import GlyphRenderer
+
+    shared = SharedRun()
+    pages = (DamBreakPage(CASES, shared), RunoutPage(CASES, start=False),
+             HyperbolicityPage(shared))
+    figs = _all_figures(*pages)
+
+    def looks():
+        return [(f.title.text_font_size, f.xaxis[0].axis_label_text_font_size,
+                 [r.glyph.line_width for r in f.renderers
+                  if isinstance(r, GlyphRenderer) and hasattr(r.glyph, "line_width")])
+                for f in figs]
+
+    normal = looks()
+    for p in pages:
+        p.set_present(True)
+    big = looks()
+    for (t0, a0, w0), (t1, a1, w1) in zip(normal, big, strict=True):
+        assert float(t1[:-2]) > 1.3 * float(t0[:-2]) and float(a1[:-2]) > float(a0[:-2])
+        assert w1 == pytest.approx([2 * w for w in w0])
+    controls = pages[0].controls
+    controls.panel()
+    assert not controls.scheme.visible and not controls.sliders["k"].visible
+    assert controls.sliders["slope"].visible and controls.sliders["length"].visible
+    for p in pages:
+        p.set_present(False)
+    assert looks() == normal and controls.scheme.visible
+
+
+def test_legends_are_beside_the_data_and_every_line_is_named():
+    from bokeh.models import Legend
+
+    shared = SharedRun()
+    dam, runout = DamBreakPage(CASES, shared), RunoutPage(CASES, start=False)
+    for f in _all_figures(dam, runout, HyperbolicityPage(shared)):
+        assert f.legend, f.css_classes
+        assert not [m for m in f.center if isinstance(m, Legend)], f.css_classes
+    labels = [i.label.value for i in runout.fig.legend[0].items]
+    assert "a of the slider (the current point)" in labels
+    labels = [i.label.value for i in dam.fig_h.legend[0].items]
+    assert "final front, two layers" in labels and "final front, single layer" in labels
+
+
+def test_app_present_option():
+    from pdeflow.cli import build_parser
+
+    assert build_parser().parse_args(["app", "--present"]).present
+    assert not build_parser().parse_args(["app"]).present

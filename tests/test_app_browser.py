@@ -24,8 +24,11 @@ from pdeflow.app.browser import (
     READY,
     app_server,
     chromium,
+    figure_titles,
     key_to_picture,
+    layout_problems,
     open_page,
+    press_slider,
     slider_latency,
     text,
 )
@@ -123,6 +126,8 @@ def test_dam_break_page_answers_a_slider_with_a_new_picture(opened, shots):
     it depends on the machine's load)."""
     page = opened("dam-break")
     assert _shown_rows(page) == _api_rows(CASE_51, [])
+    page.locator(".pdeflow-player button.pause").click()  # it opens playing
+    time.sleep(0.5)
     picture = page.locator(".pdeflow-depths").screenshot()
     times = slider_latency(page, "phi_b_two", lambda i: f"two_layer.phi_b_deg={41 - i}",
                            moves=3, key="ArrowLeft")
@@ -193,3 +198,138 @@ def test_cold_start_says_it_compiles(browser, tmp_path):
         page.locator(READY["dam-break"]).wait_for(timeout=900_000)
         assert _shown_rows(page) == _api_rows(CASE_51, [])
         page.close()
+
+
+# --- the lecture hall: screen sizes, presentation mode, warnings -------------------------
+SIZES = [(1024, 768), (1920, 1080)]
+"""A projector's 1024x768 and a wide screen."""
+FIGURES = {"dam-break": ("depths", "velocities", "fextra"), "run-out": ("runout",),
+           "hyperbolicity": ("eigen", "imag", "fextra-map")}
+"""Per page, its figures' CSS classes (pdeflow-<name>)."""
+OTHERS = {"dam-break": ("summary", "player", "sidebar"),
+          "run-out": ("fits", "current", "sidebar"),
+          "hyperbolicity": ("spectrum", "sidebar")}
+"""Per page, what must fit the viewport too."""
+
+
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+@pytest.mark.parametrize("name", list(FIGURES))
+def test_pages_fit_the_screen(browser, server, shots, name, size):
+    """No figure narrower than half the page, nothing outside the viewport, no title
+    cut off; with the side bar hidden, the figures get wider."""
+    page, log = open_page(browser, server, name, viewport=size)
+    try:
+        if name == "run-out":
+            _wait_for(lambda: "computing" not in text(page, "fits"))
+        assert layout_problems(page, FIGURES[name], OTHERS[name]) == []
+        page.screenshot(path=shots / f"layout_{name}_{size[0]}.png", full_page=True)
+        first = FIGURES[name][0]
+        wide = page.locator(f".pdeflow-{first}").first.bounding_box()["width"]
+        page.locator(".pdeflow-sidebar-toggle button").click()
+        _wait_for(lambda: not page.locator(".pdeflow-sidebar").first.is_visible(), 10)
+        _wait_for(lambda: page.locator(f".pdeflow-{first}").first.bounding_box()["width"]
+                  > wide + 100, 10)
+        assert layout_problems(page, FIGURES[name]) == []
+        assert not log.errors, log.errors
+    finally:
+        page.close()
+
+
+def test_results_go_under_the_figures_on_a_projector(browser, server):
+    boxes = {}
+    for size in SIZES:
+        page, _ = open_page(browser, server, "dam-break", viewport=size)
+        boxes[size] = {n: page.locator(f".pdeflow-{n}").first.bounding_box()
+                       for n in ("depths", "fextra", "summary")}
+        page.close()
+    narrow, wide = boxes[SIZES[0]], boxes[SIZES[1]]
+    assert narrow["summary"]["y"] > narrow["fextra"]["y"] + narrow["fextra"]["height"] - 1
+    assert wide["summary"]["x"] >= wide["depths"]["x"] + wide["depths"]["width"] - 1
+    assert wide["summary"]["y"] < wide["fextra"]["y"]
+
+
+def _title(page, name: str) -> dict:
+    return figure_titles(page)[f"pdeflow-{name}"]
+
+
+def test_dam_break_opens_playing_the_collapse(opened):
+    """Not on the deposit (where velocities and F_extra are zero): the time runs."""
+    page = opened("dam-break")
+    seen = set()
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < 20 and len(seen) < 3:
+        seen.add(_title(page, "depths")["text"])
+        time.sleep(0.2)
+    assert len(seen) >= 3, seen
+    assert not any("final state" in t for t in list(seen)[:2]), seen
+
+
+def test_presentation_mode_has_larger_fonts_and_fewer_controls(browser, server):
+    page, log = open_page(browser, server, "dam-break", viewport=SIZES[0])
+    try:
+        normal = _title(page, "depths")["font_px"]
+        assert page.locator(".pdeflow-k").first.is_visible()
+        page.locator(".pdeflow-present button").click()
+        _wait_for(lambda: _title(page, "depths")["font_px"] > 1.3 * normal, 10)
+        _wait_for(lambda: not page.locator(".pdeflow-k").first.is_visible(), 10)
+        assert not page.locator(".pdeflow-scheme").first.is_visible()
+        assert layout_problems(page, FIGURES["dam-break"], ("summary",)) == []
+        assert not log.errors, log.errors
+    finally:
+        page.close()
+    # the URL asks for it too; every page fits the projector in this mode
+    for name in FIGURES:
+        page, log = open_page(browser, server, name, viewport=SIZES[0],
+                              query="present=1")
+        try:
+            if name == "dam-break":
+                assert _title(page, "depths")["font_px"] > 1.3 * normal
+                assert not page.locator(".pdeflow-sidebar").first.is_visible()
+            assert layout_problems(page, FIGURES[name]) == [], name
+            assert not log.errors, log.errors
+        finally:
+            page.close()
+
+
+def _cli_warnings(overrides: list[str], tmp_path: Path, capsys) -> list[str]:
+    """The warning lines of ``pdeflow run`` for test 5.1 with ``overrides``."""
+    from pdeflow.cli import main
+
+    capsys.readouterr()
+    argv = ["run", str(CASE_51), "--outdir", str(tmp_path), "--quiet"]
+    for o in overrides:
+        argv += ["--set", o]
+    assert main(argv) == 0
+    return [r for r in capsys.readouterr().err.splitlines()
+            if r.startswith("pdeflow: warning:")]
+
+
+def _shown_warnings(page) -> list[str]:
+    box = page.locator(".pdeflow-warnings").first
+    if not box.is_visible():
+        return []
+    return [r.strip() for r in text(page, "warnings").splitlines()
+            if r.strip().startswith("pdeflow: warning:")]
+
+
+def test_the_35_degree_slope_shows_the_command_lines_warnings(opened, tmp_path, capsys):
+    """teaching.md's exercise: at 35 deg a quarter (two layers) and nearly all (one
+    layer) of the mass leave the 7 m domain; the page says so, as the command line
+    does, and the domain-length slider makes the domain long enough."""
+    page = opened("dam-break")
+    assert _shown_warnings(page) == []
+    press_slider(page, "slope", "End")  # 35 deg, the slider's end
+    over = ["two_layer.theta_deg=35", "single_layer.theta_deg=35"]
+    expected = _cli_warnings(over, tmp_path, capsys)
+    assert any("25 % of the mass left the domain" in w for w in expected), expected
+    assert any("97 % of the mass left the domain" in w for w in expected), expected
+    _wait_for(lambda: _shown_warnings(page) == expected, ANSWER_TIMEOUT_S)
+    box = page.locator(".pdeflow-warnings").first.bounding_box()
+    depths = page.locator(".pdeflow-depths").first.bounding_box()
+    assert box["y"] < depths["y"] and box["y"] + box["height"] <= 768  # above, in sight
+    press_slider(page, "length", "End")
+    length = page.locator(".pdeflow-length .noUi-handle").first.get_attribute(
+        "aria-valuenow")
+    longer = _cli_warnings([*over, f"grid.length={float(length):g}"], tmp_path, capsys)
+    assert not any("two_layer: material reached" in w for w in longer), longer
+    _wait_for(lambda: _shown_warnings(page) == longer, ANSWER_TIMEOUT_S)

@@ -148,3 +148,48 @@ def test_progress_bar_only_on_a_terminal_or_asked(monkeypatch):
     assert ProgressTracker in kinds([])
     assert ProgressTracker not in kinds(["--no-progress"])
     assert ProgressTracker not in kinds(["-q"])
+
+
+def test_movie_shows_progress_drawn_once_per_update(tmp_path, capsys, monkeypatch):
+    """``--movie`` draws a frame per interval, seconds in all: the bar is shown without
+    a terminal too, labelled with the movie, every draw with that label (py-pde's own
+    draw with an empty label came first), and it ends at 100 %; the movie and the
+    numbers are those of a run without the bar."""
+    pytest.importorskip("PIL")
+    from pdeflow.cli import main
+
+    monkeypatch.setattr("sys.stdout.isatty", lambda: False)
+    movie = tmp_path / "ritter.gif"
+    common = ["run", str(RITTER), "--set", "grid.cells=40", "--live-every", "0.05"]
+    assert main([*common, "--movie", str(movie), "--summary",
+                 str(tmp_path / "with.json")]) == 0
+    err = capsys.readouterr().err
+    draws = [d.strip() for d in err.replace("\n", "\r").split("\r") if d.strip()]
+    bar = [d for d in draws if "|" in d]
+    assert bar and all(d.startswith("single_layer, drawing ritter.gif") for d in bar), draws
+    assert "100%" in bar[-1]
+    assert len(bar) == len(set(bar))  # each state of the bar drawn once
+    assert movie.is_file()
+    assert main([*common, "--no-progress", "--summary", str(tmp_path / "without.json")]) == 0
+    import json
+
+    def numbers(name):
+        s = json.loads((tmp_path / name).read_text())["models"]["single_layer"]
+        return {k: v for k, v in s.items() if k != "wall_time_s"}
+
+    assert numbers("with.json") == numbers("without.json")
+
+
+def test_replayed_movie_counts_its_frames(tmp_path, capsys):
+    pytest.importorskip("PIL")
+    pytest.importorskip("h5py")
+    from pdeflow.cli import main
+
+    store = tmp_path / "r.h5"
+    assert main(["run", str(RITTER), "--set", "grid.cells=40", "--store", str(store),
+                 "--store-every", "0.1", "--quiet"]) == 0
+    capsys.readouterr()
+    assert main(["plot", str(store), "--movie", str(tmp_path / "r.gif")]) == 0
+    err = capsys.readouterr().err.replace("\n", "\r").split("\r")
+    bar = [d.strip() for d in err if "|" in d]
+    assert bar and bar[-1].startswith("drawing r.gif: 100%"), bar

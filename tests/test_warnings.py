@@ -115,3 +115,18 @@ def test_long_run_is_estimated_warned_and_shows_progress(monkeypatch):
     assert any(isinstance(t, ProgressBar) for t in _run_trackers(args, case, "two_layer",
                                                                  True))
     assert not _run_trackers(args, load_case(CASE_51), "two_layer", True)
+
+
+def test_a_domain_left_by_all_the_material_is_warned_about_without_a_front():
+    """35 deg, t_end = 20 s: the single layer slides out of the 7 m domain completely,
+    the summary has no front (it raised a TypeError in the warning)."""
+    from pdeflow.checks import result_warnings
+
+    case = load_case(Path(__file__).parents[1] / "cases" / "paper_5_1_dam_break.toml")
+    summary = {"domain_ends": {"sides": ["right"], "outflow": 1.0,
+                               "runout_lower_bound": True, "open_through_material": []},
+               "front_position": None, "mass_change": -1.0, "at_rest": True,
+               "t_final": 20.0}
+    (line,) = result_warnings(case, "single_layer", summary)
+    assert "100 % of the mass left the domain" in line
+    assert "the front (none left) and the run-out are lower bounds" in line

@@ -11,10 +11,15 @@ with :mod:`pdeflow.numerics.hyperbolicity`):
 3. hyperbolicity (:mod:`.hyperbolicity`): the eigenvalues of a local state, the band
    where they are complex, and where F_extra acts in the current run.
 
+Each page fits screens from a 1024x768 projector to wide ones, and has a presentation
+mode (larger fonts and lines, fewer controls: :mod:`.look`); the dam-break page shows
+the command line's warnings about its numbers (:func:`pdeflow.checks.run_warnings`).
+
 In Jupyter (after ``pip install ".[app]"``)::
 
     from pdeflow.app import create_app
     create_app()                     # the same app as `pdeflow app`, in the notebook
+    create_app(present=True)         # in presentation mode
 
 Needs panel (``pip install ".[app]"``); nothing here imports it until it is used.
 """
@@ -25,11 +30,12 @@ from pathlib import Path
 from typing import Any
 
 
-def create_app(case_dir: str | Path | None = None, page: str | None = None) -> Any:
+def create_app(case_dir: str | Path | None = None, page: str | None = None,
+               present: bool = False) -> Any:
     """The app as a Panel object (see :func:`pdeflow.app.layout.create_app`)."""
     from .layout import create_app as _create_app
 
-    return _create_app(case_dir, page)
+    return _create_app(case_dir, page, present)
 
 
 __all__ = ["create_app"]

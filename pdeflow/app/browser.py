@@ -14,7 +14,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,14 +33,15 @@ READY = {"dam-break": ".pdeflow-summary pre", "run-out": ".pdeflow-fits ul",
 
 @contextmanager
 def app_server(root: Path, *, timeout: float = 60.0, env: dict[str, str] | None = None,
-               log: Path | None = None) -> Iterator[str]:
+               log: Path | None = None, args: Sequence[str] = ()) -> Iterator[str]:
     """Run ``pdeflow app --no-browser`` of the checkout ``root`` on a free port of
     127.0.0.1; yield the page's URL; stop the server when the block ends, also on an
     error (Ctrl-C, then kill after 10 s).
 
     ``root/pdeflow`` is put first on PYTHONPATH, so the server runs the same code as the
     caller; ``env`` adds variables (e.g. NUMBA_CACHE_DIR); the server's stderr goes to
-    ``log`` (default: discarded).
+    ``log`` (default: discarded); ``args`` are more options of ``pdeflow app`` (e.g.
+    ``--present``).
     """
     full_env = dict(os.environ, **(env or {}))
     full_env["PYTHONPATH"] = os.pathsep.join(
@@ -48,7 +49,7 @@ def app_server(root: Path, *, timeout: float = 60.0, env: dict[str, str] | None 
     err = open(log, "w") if log else subprocess.DEVNULL  # closed in the finally below
     proc = subprocess.Popen(
         [sys.executable, "-m", "pdeflow.cli", "app", "--no-browser", "--host",
-         "127.0.0.1", "--port", "0"], cwd=root, env=full_env, stdout=subprocess.PIPE,
+         "127.0.0.1", "--port", "0", *args], cwd=root, env=full_env, stdout=subprocess.PIPE,
         stderr=err, text=True)
     try:
         yield _read_url(proc, timeout)
@@ -119,13 +120,15 @@ class PageLog:
 
 
 def open_page(browser: Any, url: str, page: str, *, timeout: float = 300.0,
-              viewport: tuple[int, int] = (1500, 1000)) -> tuple[Any, PageLog]:
+              viewport: tuple[int, int] = (1500, 1000), query: str = ""
+              ) -> tuple[Any, PageLog]:
     """Load ``page`` ('dam-break', 'run-out', 'hyperbolicity') and wait for its first
-    result (``timeout`` [s] covers compiling the kernels on a fresh machine)."""
+    result (``timeout`` [s] covers compiling the kernels on a fresh machine); ``query``
+    adds URL arguments (``present=1``)."""
     p = browser.new_page(viewport={"width": viewport[0], "height": viewport[1]})
     log = PageLog(urlparse(url).hostname or "")
     log.attach(p)
-    p.goto(f"{url}?page={page}")
+    p.goto(f"{url}?page={page}" + (f"&{query}" if query else ""))
     p.locator(READY[page]).first.wait_for(timeout=timeout * 1000)
     return p, log
 
@@ -179,3 +182,89 @@ def slider_latency(page: Any, slider: str, marker: Callable[[int], str], moves: 
     """:func:`key_to_picture` for ``moves`` presses on ``slider``; ``marker(i)`` is the
     text the i-th press shows (i = 1, 2, ...), e.g. the override in the summary."""
     return [key_to_picture(page, slider, marker(i), key) for i in range(1, moves + 1)]
+
+
+FIGURE_TITLES = """() => {
+  const ctx = document.createElement("canvas").getContext("2d");
+  const out = {};
+  for (const doc of Bokeh.documents) {
+    for (const m of doc.all_models) {
+      if (!m.css_classes || !m.title || m.title.text === undefined) continue;
+      const t = m.title;
+      ctx.font = `${t.text_font_style} ${t.text_font_size} ${t.text_font}`;
+      const width = ctx.measureText(t.text).width;
+      // the y axis' label, drawn upright along the figure's height
+      let ylabel = 0;
+      for (const axis of m.left || []) {
+        if (!axis.axis_label) continue;
+        ctx.font = `${axis.axis_label_text_font_style} ${axis.axis_label_text_font_size} ` +
+                   `${axis.axis_label_text_font}`;
+        ylabel = Math.max(ylabel, ctx.measureText(String(axis.axis_label)).width);
+      }
+      for (const c of m.css_classes)
+        out[c] = {text: t.text, font_px: parseFloat(t.text_font_size) *
+                  (String(t.text_font_size).endsWith("pt") ? 4 / 3 : 1),
+                  width, ylabel};
+    }
+  }
+  return out;
+}"""
+"""Per CSS class of a Bokeh figure: its title, the title's font size [px], the width
+the browser needs to draw it [px] (a canvas title that does not fit is cut off), and
+the length of its y axis' label [px] (upright: it must fit the figure's height)."""
+
+
+TITLE_INDENT_PX = 90
+"""Room left of a figure's title: the y axis with its label and tick labels [px]."""
+AXIS_ROOM_PX = 40
+"""Height of a figure its y label cannot use: the x axis' tick labels, the margins
+[px] (the title too, where there is one: a label within the height minus this may
+still reach into the title's row, which is not cut)."""
+
+
+def figure_titles(page: Any) -> dict[str, dict[str, Any]]:
+    """:data:`FIGURE_TITLES` of the page (keys ``pdeflow-<name>``)."""
+    return page.evaluate(FIGURE_TITLES)
+
+
+def layout_problems(page: Any, figures: Sequence[str], others: Sequence[str] = ()
+                    ) -> list[str]:
+    """What does not fit the page's viewport, one sentence each ([] if all fits).
+
+    Every figure ``pdeflow-<name>`` of ``figures`` must be visible, at least half as
+    wide as the viewport, inside it left and right, and wide enough for its title;
+    every element of ``others`` inside the viewport left and right; and the page must
+    not scroll sideways (what sticks out on the right would be cut off on a projector).
+    """
+    width = page.viewport_size["width"]
+    problems = []
+    scroll = page.evaluate("() => document.documentElement.scrollWidth")
+    if scroll > width:
+        problems.append(f"the page is {scroll} px wide in a {width} px viewport")
+    titles = figure_titles(page)
+    for name in (*figures, *others):
+        loc = page.locator(f".pdeflow-{name}").first
+        box = loc.bounding_box() if loc.is_visible() else None
+        if box is None:
+            problems.append(f"{name}: not shown")
+            continue
+        left, right = box["x"], box["x"] + box["width"]
+        if left < 0 or right > width + 0.5:
+            problems.append(f"{name}: from {left:.0f} to {right:.0f} px, outside the "
+                            f"{width} px viewport")
+        if name not in figures:
+            continue
+        if box["width"] < width / 2:
+            problems.append(f"{name}: {box['width']:.0f} px wide, less than half the "
+                            f"{width} px viewport")
+        title = titles.get(f"pdeflow-{name}")
+        # the title starts above the plot area, right of the y axis (its labels take
+        # up to TITLE_INDENT_PX)
+        if title and title["width"] + TITLE_INDENT_PX > box["width"]:
+            problems.append(f"{name}: its title needs {title['width']:.0f} px, the "
+                            f"figure is {box['width']:.0f} px wide")
+        # the y label is centred on the plot area, below the title and above the x axis
+        if title and title["ylabel"] > box["height"] - AXIS_ROOM_PX:
+            problems.append(f"{name}: its y axis' label needs {title['ylabel']:.0f} px, "
+                            f"the figure is {box['height']:.0f} px high")
+    return problems

@@ -31,6 +31,9 @@ CLOSURES = ("paper", "relaxed")
 """The exchange closures offered (a case with another one adds it to the choice)."""
 SCHEMES = tuple(v for v in DEFAULT_VARIANTS if not Variant.parse(v).is_mol)
 """fv-split variants offered, by the names of ``pdeflow compare`` (FLUX/REC[/LIM][+SPLIT])."""
+PRESENTED = ("H0", "L0", "slope", "phi_b_two", "phi_b_single", "length", "t_end")
+"""The sliders presentation mode keeps (the others, and the closure, geometry, law and
+scheme choices, are hidden: a lecture needs the physics, not every knob)."""
 MAX_CELLS = 20_000
 """Larger grids would keep the server busy for seconds per slider move: refused."""
 
@@ -63,6 +66,12 @@ class Knob:
     """only for column cases (H0, L0)"""
     laws: tuple[str, ...] = ()
     """enabled only when the chosen basal friction law is one of these (() = any)"""
+    around_case: tuple[float, float] | None = None
+    """(low, high) factors: the slider runs from low to high times the case's own value,
+    in steps of about ``step`` times it (a case of 0.3 m and one of 7 m both get a
+    useful range); None: from ``start`` to ``end`` in steps of ``step``"""
+    in_sweep: bool = True
+    """offered on the run-out page too (a sweep sets its own domain and end time)"""
 
 
 KNOBS = (
@@ -72,6 +81,10 @@ KNOBS = (
          ("two_layer", "single_layer"), column_only=True),
     Knob("slope", "bed slope θ [deg]", ("two_layer.theta_deg", "single_layer.theta_deg"),
          0.0, 35.0, 1.0, ("two_layer", "single_layer")),
+    Knob("length", "domain length [m]", ("grid.length",), 2.0, 60.0, 0.25,
+         ("two_layer", "single_layer"), around_case=(1.0, 8.0), in_sweep=False),
+    Knob("t_end", "end time t_end [s]", ("case.t_end",), 1.0, 20.0, 0.1,
+         ("two_layer", "single_layer"), around_case=(1.0, 4.0), in_sweep=False),
     Knob("density_ratio", "density ratio r = ρ1/ρ2", ("two_layer.density_ratio",),
          0.3, 0.95, 0.01),
     Knob("phi_int", "interface friction φ_int [deg]", ("two_layer.phi_int_deg",),
@@ -225,6 +238,7 @@ class ParameterControls:
         self.on_change = on_change
         self.knobs = list(knobs)
         self._quiet = False
+        self._present = False
         self.case_select = pn.widgets.Select(label="case file", options=list(cases),
                                              value=default, css_classes=["pdeflow-case"])
         self.sliders = {k.name: Slider(
@@ -270,7 +284,9 @@ class ParameterControls:
                 if value is None:
                     continue
                 value = float(value)
-                if k.column_only:  # around the case's own column, inside its domain
+                if k.around_case:
+                    _range_around(s, k, value, case)
+                elif k.column_only:  # around the case's own column, inside its domain
                     s.start = _round_step(min(k.start, value / 4), k.step)
                     end = max(k.end, 2 * value)
                     if k.name == "L0":
@@ -308,7 +324,7 @@ class ParameterControls:
             for key in _keys_of_case(k, case):
                 own = case_value(case, key)
                 if own is None or not math.isclose(s.value, float(own),
-                                                   abs_tol=k.step / 1000):
+                                                   abs_tol=s.step / 1000):
                     out.append(f"{key}={toml_value(float(s.value))}")
         if not self.closure.disabled and self.closure.value != case_value(
                 case, "two_layer.exchange_closure"):
@@ -353,16 +369,53 @@ class ParameterControls:
 
     def panel(self, title: str = "parameters") -> pn.Column:
         """The widgets, for a page's side bar."""
-        return pn.Column(f"### {title}", self.case_select,
-                         *self.sliders.values(), "exchange closure", self.closure,
-                         "geometry", self.geometry, self.law, self.scheme,
-                         sizing_mode="stretch_width")
+        self._expert = [pn.pane.Markdown("exchange closure"), self.closure,
+                        pn.pane.Markdown("geometry"), self.geometry, self.law,
+                        self.scheme]
+        self.set_present(self._present)
+        return pn.Column(f"### {title}", self.case_select, *self.sliders.values(),
+                         *self._expert, sizing_mode="stretch_width")
+
+    def set_present(self, present: bool) -> None:
+        """Presentation mode shows only the sliders of :data:`PRESENTED` (the case's
+        values of the hidden ones still hold)."""
+        self._present = present
+        for name, s in self.sliders.items():
+            s.visible = not present or name in PRESENTED
+        for w in getattr(self, "_expert", []):
+            w.visible = not present
 
 
 def _keys_of_case(knob: Knob, case: Case) -> list[str]:
     """The knob's keys that ``case`` uses: [initial] and the sections of its models (a
     single-layer case on a slope must not get the two-layer model's flat bed)."""
-    return [k for k in knob.keys if k.split(".")[0] in ("initial", *case.models)]
+    return [k for k in knob.keys
+            if k.split(".")[0] in ("initial", "grid", "case", *case.models)]
+
+
+def nice_step(target: float) -> float:
+    """The number 1, 2 or 5 times a power of ten nearest to ``target`` (> 0) on a log
+    scale: slider steps a class can read (2 m, 0.5 s)."""
+    power = 10.0 ** math.floor(math.log10(target))
+    return min((m * power for m in (1, 2, 5, 10)),
+               key=lambda v: abs(math.log(v / target)))
+
+
+def _range_around(s: Slider, knob: Knob, value: float, case: Case) -> None:
+    """Put ``s`` on ``knob.around_case`` times ``value``; a domain length moves in whole
+    cells of the case's dx and stays within :data:`MAX_CELLS` cells."""
+    low, high = knob.around_case or (1.0, 1.0)
+    step = nice_step(knob.step * value)
+    end = high * value
+    if knob.keys == ("grid.length",):
+        dx = case.dx
+        if not math.isclose(step / dx, round(step / dx), rel_tol=1e-9):
+            step = dx * max(1, round(step / dx))
+        end = min(end, MAX_CELLS * dx)
+    # the case's own value is one of the slider's positions
+    s.start = value - step * math.floor((value - low * value) / step + 1e-9)
+    s.end = value + step * math.floor((end - value) / step + 1e-9)
+    s.step = step
 
 
 def _round_step(value: float, step: float) -> float:

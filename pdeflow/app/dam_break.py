@@ -29,6 +29,7 @@ from bokeh.plotting import figure
 
 from .. import systems
 from ..cases import BASELINE_MODEL, PAPER_MODEL, Case, CaseError
+from ..checks import run_warnings
 from ..numerics.geometry import COORDINATES
 from ..numerics.state import velocity_profile
 from ..plotting import DRY
@@ -36,6 +37,7 @@ from ..simulate import Run, RunResult, print_summary, run_model
 from ..solvers.fv_split import SimulationBlowUp
 from ..trackers import FextraStorageTracker
 from .controls import ParameterControls, command_line, list_cases, served
+from .look import PageLayout, fit_height, legend_outside, style_figures
 
 FRAMES_PER_T_END = 250
 """Frame interval of the animation: t_end / this [s] (5.1: 0.02 s, ~70 frames to rest)."""
@@ -46,6 +48,8 @@ SEND_MS = 40
 (the frames' run would otherwise hold the message back until it is done)."""
 LABELS = {m: systems.get(m).label for m in (PAPER_MODEL, BASELINE_MODEL)}
 """The models as the pages name them."""
+FIGURE_HEIGHT = 240
+"""Height of each of the three profile figures [px] (presentation mode: more)."""
 PLAN_PIXELS = 121
 """Pixels across the plan view of an axisymmetric run (the revolved total depth)."""
 
@@ -80,6 +84,9 @@ class DamBreakRun:
     """F_extra/rho1 of the two-layer run at every frame time (frames, cells)"""
     wall_time_s: float = 0.0
     """wall time of the summary's runs of all models [s]"""
+    warnings: list[str] = field(default_factory=list)
+    """the lines ``pdeflow run`` prints as ``pdeflow: warning: ...`` for the same case
+    and overrides (material leaving the domain, still moving at t_end, ...)"""
 
     @property
     def x(self) -> np.ndarray:
@@ -118,9 +125,12 @@ def simulate(case: Case, case_path: Path, overrides: list[str],
              frames: bool = True) -> DamBreakRun:
     """Run every model of ``case`` (loaded with ``overrides``) as ``pdeflow run`` does;
     with ``frames`` also record the animation (:func:`add_frames`)."""
+    lines: list[str] = []
     wall0 = time.perf_counter()
-    results = {m: run_model(case, m) for m in case.models}
-    run = DamBreakRun(case, case_path, list(overrides), results, np.zeros(0))
+    with run_warnings(lines.append):  # what the command line would print
+        results = {m: run_model(case, m) for m in case.models}
+    run = DamBreakRun(case, case_path, list(overrides), results, np.zeros(0),
+                      warnings=lines)
     _set_frames(run, {m: [] for m in results})
     run.wall_time_s = time.perf_counter() - wall0
     if frames:
@@ -153,6 +163,17 @@ def _set_frames(run: DamBreakRun,
             run.fextra = np.array([items[i][2] for i in idx])
 
 
+def opening_frame(run: DamBreakRun) -> int:
+    """The frame a page opens on: the one where the fastest cell of any model is
+    fastest (the collapse in full motion, not the deposit at rest)."""
+    speed = np.zeros(len(run.times))
+    for states in run.states.values():
+        for k in range(0, states.shape[1], 2):
+            u = velocity_profile(states[:, k], states[:, k + 1], fill=0.0)
+            speed = np.maximum(speed, np.abs(u).max(axis=1))
+    return int(np.argmax(speed))
+
+
 class SharedRun(param.Parameterized):
     """The current dam-break run of a session, for the pages that show it too."""
 
@@ -163,7 +184,7 @@ class DamBreakPage:
     """The dam-break page of one session (build it once the kernels are loaded)."""
 
     def __init__(self, case_dir: Path, shared: SharedRun | None = None,
-                 default: str = "paper_5_1_dam_break.toml"):
+                 default: str = "paper_5_1_dam_break.toml", present: bool = False):
         cases = list_cases(case_dir, lambda c: bool(c.models))
         self.shared = shared or SharedRun()
         self.controls = ParameterControls(cases, default if default in cases
@@ -171,9 +192,15 @@ class DamBreakPage:
         self.run: DamBreakRun | None = None
         self.status = pn.pane.HTML("", css_classes=["pdeflow-status"],
                                    sizing_mode="stretch_width")
+        self.warnings = pn.pane.HTML("", css_classes=["pdeflow-warnings"],
+                                     sizing_mode="stretch_width", visible=False,
+                                     styles=WARNING_STYLE)
+        self.present = present
+        self._opened = False  # the first frames open playing, later ones on the deposit
         # a plain Bokeh Div: its text goes out in the same message as the figures' data
         # (a Panel HTML pane sends its first change separately, later)
-        self.summary = Div(text="", css_classes=["pdeflow-summary"], width=380)
+        self.summary = Div(text="", css_classes=["pdeflow-summary"],
+                           sizing_mode="stretch_width")
         self.player = pn.widgets.Player(
             label="time", start=0, end=1, value=0, interval=60, loop_policy="once",
             show_loop_controls=False, css_classes=["pdeflow-player"],
@@ -181,13 +208,15 @@ class DamBreakPage:
             sizing_mode="stretch_width")
         self.player.param.watch(lambda e: self.show_frame(e.new), "value")
         self._figures()
+        self.set_present(present)
         self.rerun()
 
     # --- figures --------------------------------------------------------------------------
     def _figures(self) -> None:
         xr = Range1d(0, 1)  # shared by the panels; set to the domain by each run
-        opts = {"height": 230, "sizing_mode": "stretch_width", "toolbar_location": "right",
-                "tools": "pan,wheel_zoom,box_zoom,reset,save", "x_range": xr}
+        opts = {"height": FIGURE_HEIGHT, "sizing_mode": "stretch_width",
+                "toolbar_location": "right", "tools": "pan,wheel_zoom,box_zoom,reset,save",
+                "x_range": xr}
         zero = np.zeros(2)
         self.src_two = ColumnDataSource({k: zero for k in
                                          ("x", "zero", "h2", "top", "u1", "u2", "f")})
@@ -199,7 +228,7 @@ class DamBreakPage:
         fh.varea("x", "h2", "top", source=self.src_two, color=COLOURS["upper"],
                  alpha=0.5, legend_label="upper layer h1")
         fh.line("x", "h", source=self.src_one, color=COLOURS["single"], line_width=2,
-                legend_label="single layer")
+                legend_label="single layer h")
         fu = figure(y_axis_label="velocity [m/s]", y_range=Range1d(0, 1), **opts)
         fu.line("x", "u1", source=self.src_two, color=COLOURS["upper"], line_width=2,
                 legend_label="u1 (upper)")
@@ -208,20 +237,23 @@ class DamBreakPage:
         fu.line("x", "u", source=self.src_one, color=COLOURS["single"], line_width=2,
                 legend_label="u single layer")
         ff = figure(x_axis_label="x [m]", y_axis_label="F_extra/ρ1 [m²/s²]",
+                    title="momentum exchange keeping the two layers hyperbolic",
                     y_range=Range1d(0, 1), **opts)
         ff.line("x", "f", source=self.src_two, color=COLOURS["fextra"], line_width=2,
-                legend_label="momentum exchange keeping the system hyperbolic")
-        for f in (fh, fu, ff):
-            f.legend.location = "top_right"
-            f.legend.label_text_font_size = "9pt"
-            f.legend.click_policy = "hide"
+                legend_label="F_extra/ρ1")
         self.fronts = {m: Span(location=0, dimension="height", line_dash="dotted",
                                line_width=2, visible=False,
                                line_color=COLOURS["upper" if m == PAPER_MODEL
                                                   else "single"])
                        for m in (PAPER_MODEL, BASELINE_MODEL)}
-        for s in self.fronts.values():
+        for m, s in self.fronts.items():
             fh.add_layout(s)
+            # a Span has no legend entry: an empty line in its style stands for it
+            fh.line([np.nan], [np.nan], line_dash="dotted", line_width=2,
+                    line_color=s.line_color, legend_label=f"final front, {LABELS[m]}")
+        for f in (fh, fu, ff):
+            f.legend.click_policy = "hide"
+            legend_outside(f)  # never over the data
         # an axisymmetric run seen from above: the first model's total depth revolved
         self.src_plan = ColumnDataSource({"image": [np.full((2, 2), np.nan)], "x": [-1.0],
                                           "y": [-1.0], "dw": [2.0], "dh": [2.0]})
@@ -248,6 +280,7 @@ class DamBreakPage:
             self.status.object = f"<b>cannot run this:</b> {escape(str(err))}"
             return
         with pn.io.hold():
+            self.pause()
             self._show_run(run)
         # the final state and the numbers go out first; the animation's frames (a second
         # run, a few times slower: it stops at every frame) follow once they are sent
@@ -255,6 +288,21 @@ class DamBreakPage:
             pn.state.curdoc.add_timeout_callback(lambda: self._animate(run), SEND_MS)
         else:
             self._animate(run)
+
+    def pause(self) -> None:
+        """Stop the animation (a new run must not go on playing the old one's frames).
+        The browser may have started it without the server's value changing: sent
+        again either way."""
+        self.player.direction = 0
+        self.player.param.trigger("direction")
+
+    def set_present(self, present: bool) -> None:
+        """Presentation mode: larger fonts and lines, the expert choices hidden."""
+        self.present = present
+        style_figures((self.fig_h, self.fig_u, self.fig_f, self.fig_plan), present)
+        for f in (self.fig_h, self.fig_u, self.fig_f):
+            f.height = fit_height(FIGURE_HEIGHT, present)
+        self.controls.set_present(present)
 
     def _animate(self, run: DamBreakRun) -> None:
         if run is not self.run:
@@ -289,16 +337,25 @@ class DamBreakPage:
         self.show_frame(len(run.times) - 1)
         self.summary.text = self._summary_html(run)
         self.status.object = ""
+        self.warnings.object = warnings_html(run.warnings)
+        self.warnings.visible = bool(run.warnings)
 
     def _show_frames(self, run: DamBreakRun) -> None:
         """The player's range, the last frame, and the velocity and F_extra limits over
         all frames (fixed, so that the animation does not jitter)."""
         last = len(run.times) - 1
         self.player.end = max(last, 1)
-        if self.player.value == last:
-            self.show_frame(last)
+        # the page opens on the collapse in motion (and plays it, in a browser); after a
+        # change it shows the final state, the deposit the numbers describe
+        target = last if self._opened else opening_frame(run)
+        if self.player.value == target:
+            self.show_frame(target)
         else:
-            self.player.value = last  # the final state, the deposit: watched -> show_frame
+            self.player.value = target  # watched -> show_frame
+        if not self._opened and served():
+            self.player.value = 0
+            self.player.direction = 1  # play
+        self._opened = True
         us = [velocity_profile(s[:, k], s[:, k + 1], fill=np.nan) for s in run.states.values()
               for k in range(0, s.shape[1], 2)]
         lo = min(0.0, *(float(np.nanmin(u)) for u in us if np.isfinite(u).any()))
@@ -333,9 +390,8 @@ class DamBreakPage:
             self.src_one.data = {"x": x, "h": nan, "u": nan}
         if self.fig_plan.visible:
             self._show_plan(run, i)
-        self.fig_h.title.text = (f"{run.case.name}   t = {run.times[i]:.3f} s"
-                                 + ("   (final state)" if i == len(run.times) - 1 else "")
-                                 + "   dotted: the final fronts")
+        self.fig_h.title.text = (f"{run.case.name}: t = {run.times[i]:.2f} s"
+                                 + (" (final state)" if i == len(run.times) - 1 else ""))
 
     def _show_plan(self, run: DamBreakRun, i: int) -> None:
         """The plan view of frame ``i``: the first model's total depth revolved."""
@@ -363,11 +419,26 @@ class DamBreakPage:
                 f"come from a second run that stops at every frame time.</p>")
 
     def panel(self) -> pn.Row:
-        plots = pn.Column(self.status, self.player, pn.pane.Bokeh(self.fig_h),
-                          pn.pane.Bokeh(self.fig_u), pn.pane.Bokeh(self.fig_f),
-                          sizing_mode="stretch_width")
+        plots = pn.Column(self.status, self.warnings, self.player,
+                          pn.pane.Bokeh(self.fig_h), pn.pane.Bokeh(self.fig_u),
+                          pn.pane.Bokeh(self.fig_f), sizing_mode="stretch_width")
         results = pn.Column("### results", pn.pane.Bokeh(self.fig_plan),
-                            pn.pane.Bokeh(self.summary), width=400)
-        return pn.Row(pn.Column(self.controls.panel("dam break"), width=320), plots,
-                      results,
-                      sizing_mode="stretch_width")
+                            pn.pane.Bokeh(self.summary), sizing_mode="stretch_width")
+        self.layout = PageLayout(self.controls.panel("dam break"), plots, results)
+        if self.present:
+            self.layout.show_sidebar(False)
+        return self.layout.row
+
+
+WARNING_STYLE = {"background": "#fff3cd", "border": "2px solid #d62728",
+                 "border-radius": "4px", "padding": "0 0.6em", "font-size": "115%"}
+"""The warnings box: above the figures, where nobody overlooks it."""
+
+
+def warnings_html(lines: list[str]) -> str:
+    """The lines ``pdeflow: warning: ...`` of a run as the page's warning box."""
+    if not lines:
+        return ""
+    items = "".join(f"<li>{escape(line)}</li>" for line in lines)
+    return (f"<p style='margin:0.4em 0'><b>The command line warns about these "
+            f"numbers:</b></p><ul style='margin:0.2em 0 0.5em'>{items}</ul>")

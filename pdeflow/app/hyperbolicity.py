@@ -39,6 +39,7 @@ from ..numerics.state import velocity_profile
 from ..plotting import DRY
 from .controls import Slider
 from .dam_break import COLOURS, FRAMES_PER_T_END, DamBreakRun, SharedRun
+from .look import PageLayout, fit_height, legend_outside, style_figures
 
 G = 9.81
 """g_z of the sliders' state [m/s^2] (a flat bed); a cell of a run brings its own."""
@@ -101,8 +102,9 @@ def cell_state(run: DamBreakRun, frame: int, cell: int) -> dict[str, float]:
 class HyperbolicityPage:
     """The hyperbolicity page of one session; follows ``shared.run``."""
 
-    def __init__(self, shared: SharedRun):
+    def __init__(self, shared: SharedRun, present: bool = False):
         self.shared = shared
+        self.present = present
         self.g = G
         self.sliders = {  # (label, start, end, step, value)
             name: Slider(label=label, start=lo, end=hi, step=step, value=value,
@@ -133,6 +135,7 @@ class HyperbolicityPage:
         self.run: DamBreakRun | None = None
         self._figures()
         self._xt_figure()
+        self.set_present(present)
         self.update()
         shared.param.watch(lambda e: self.show_run(e.new), "run")
         self.show_run(shared.run)
@@ -152,7 +155,7 @@ class HyperbolicityPage:
                     else "inner pair λ2, λ3")
         fs.scatter("du", "re", source=self.src_now, size=9, color="#d62728",
                    legend_label="this state")
-        fi = figure(x_range=fs.x_range, height=170, sizing_mode="stretch_width",
+        fi = figure(x_range=fs.x_range, height=200, sizing_mode="stretch_width",
                     x_axis_label="du = u1 - u2 [m/s]", y_axis_label="|Im λ2,3| [m/s]",
                     tools=opts["tools"])
         fi.line("du", "im", source=self.src_curves, color="#d62728", line_width=2)
@@ -168,9 +171,9 @@ class HyperbolicityPage:
                             line_dash=dash, line_width=1.5)
                 f.add_layout(span)
                 self.lines.setdefault(name, []).append(span)
-        fs.legend.location = "top_left"
-        fs.legend.label_text_font_size = "9pt"
+        legend_outside(fs)  # never over the curves
         fs.css_classes = ["pdeflow-eigen"]
+        fi.css_classes = ["pdeflow-imag"]
         self.fig_spec, self.fig_im = fs, fi
 
     def update(self) -> None:
@@ -228,8 +231,8 @@ class HyperbolicityPage:
         self.mapper.high = max(float(f.max()), 1e-6)
         self.src_xt.data = {"x": run.x[j], "t": run.times[i], "f": f[i, j],
                             "w": np.full(i.size, dx), "h": np.full(i.size, dt)}
-        self.fig_xt.title.text = (f"where F_extra/ρ1 > 0 in the run of {run.case.name} "
-                                  f"({i.size} of {f.size} cells x frames)")
+        # short: it must fit a projector's page in presentation mode
+        self.fig_xt.title.text = f"F_extra > 0 in {i.size} of {f.size} cells × frames"
         self.fig_xt.x_range.start = run.case.x_start
         self.fig_xt.x_range.end = run.case.x_start + run.case.length
         self.fig_xt.y_range.start, self.fig_xt.y_range.end = 0.0, float(run.times[-1])
@@ -254,6 +257,7 @@ class HyperbolicityPage:
                       Span(dimension="width", line_color=COLOURS["lower"], line_width=1.5))
         for s in self.cross:
             fx.add_layout(s)
+        fx.css_classes = ["pdeflow-fextra-map"]
         self.fig_xt = fx
 
     def show_cell(self) -> None:
@@ -294,11 +298,20 @@ class HyperbolicityPage:
                 w.value = value
             self.update()
 
+    def set_present(self, present: bool) -> None:
+        """Presentation mode: larger fonts and lines."""
+        self.present = present
+        style_figures((self.fig_spec, self.fig_im, self.fig_xt), present)
+        for f, normal in ((self.fig_spec, 260), (self.fig_im, 200), (self.fig_xt, 300)):
+            f.height = fit_height(normal, present)
+
     def panel(self) -> pn.Row:
         left = pn.Column("### a local state", *self.sliders.values(), self.text,
-                         width=360)
+                         sizing_mode="stretch_width")
         right = pn.Column(pn.pane.Bokeh(self.fig_spec), pn.pane.Bokeh(self.fig_im),
                           "### where F_extra acts in the dam-break page's run",
                           pn.pane.Bokeh(self.fig_xt), self.frame, self.cell,
                           self.cell_text, self.take, sizing_mode="stretch_width")
-        return pn.Row(left, right, sizing_mode="stretch_width")
+        # the side bar holds the spectrum's numbers too: presentation mode keeps it
+        self.layout = PageLayout(left, right)
+        return self.layout.row

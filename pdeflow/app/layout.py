@@ -1,4 +1,5 @@
-"""The app: the three pages as tabs, built once the numba kernels are loaded."""
+"""The app: the three pages as tabs, built once the numba kernels are loaded, under a
+header with the presentation-mode toggle (:mod:`.look`)."""
 
 from __future__ import annotations
 
@@ -25,22 +26,42 @@ milliseconds for the paper's dam break) and every number shown is what <code>pde
 run</code> prints for the same case and overrides.</p>"""
 
 
-def _requested_page() -> str | None:
-    """The page named by the URL (``?page=run-out``) of a served session, if any."""
+def _url_argument(name: str) -> str | None:
+    """The URL's ``?name=value`` of a served session, if any."""
     if not served():
         return None
-    value = (pn.state.session_args or {}).get("page")
+    value = (pn.state.session_args or {}).get(name)
     return value[0].decode() if value else None
 
 
-def build_pages(case_dir: Path, page: str | None = None) -> pn.Tabs:
-    """The three pages of one session as tabs (``page`` selects the one shown first)."""
+def _requested_present() -> bool | None:
+    """``?present=1`` (or 0) in the URL of a served session; None if not given."""
+    value = _url_argument("present")
+    if value is None:
+        return None
+    return value.lower() not in ("0", "false", "no", "off", "")
+
+
+def build_pages(case_dir: Path, page: str | None = None, present: bool = False,
+                toggle: pn.widgets.Toggle | None = None) -> pn.Tabs:
+    """The three pages of one session as tabs (``page`` selects the one shown first;
+    ``present``: presentation mode, switched by ``toggle`` if given)."""
     shared = SharedRun()
-    dam = DamBreakPage(case_dir, shared)
-    runout = RunoutPage(case_dir, start=page == "run-out")
+    dam = DamBreakPage(case_dir, shared, present=present)
+    runout = RunoutPage(case_dir, start=page == "run-out", present=present)
+    hyper = HyperbolicityPage(shared, present=present)
     tabs = pn.Tabs((PAGES["dam-break"], dam.panel()), (PAGES["run-out"], runout.panel()),
-                   (PAGES["hyperbolicity"], HyperbolicityPage(shared).panel()),
+                   (PAGES["hyperbolicity"], hyper.panel()),
                    dynamic=True, sizing_mode="stretch_width")
+    if toggle is not None:
+        def switch(event: Any) -> None:
+            with pn.io.hold():
+                for p in (dam, runout, hyper):
+                    p.set_present(event.new)
+                for p in (dam, runout):  # the side bar follows the mode
+                    p.layout.show_sidebar(not event.new)
+
+        toggle.param.watch(switch, "value")
     if page in PAGES:
         tabs.active = list(PAGES).index(page)
     run_out = list(PAGES).index("run-out")
@@ -49,32 +70,40 @@ def build_pages(case_dir: Path, page: str | None = None) -> pn.Tabs:
     return tabs
 
 
-def create_app(case_dir: str | Path | None = None, page: str | None = None) -> pn.Column:
+def create_app(case_dir: str | Path | None = None, page: str | None = None,
+               present: bool = False) -> pn.Column:
     """The app as a Panel object: served by ``pdeflow app``, or shown in Jupyter.
 
     Args:
         case_dir: directory of case files (default: ./cases or the repository's).
         page: the page shown first: 'dam-break', 'run-out' or 'hyperbolicity'
             (served, the URL's ``?page=`` chooses it).
+        present: open in presentation mode (larger fonts and lines, fewer controls;
+            served, the URL's ``?present=1`` or ``?present=0`` overrides it).
 
     While the kernels compile (once per machine) a served page shows that, with the
     elapsed time, and builds its pages when they are ready; elsewhere (Jupyter, a
     script) this call prints the same and waits.
     """
     case_dir = find_case_dir(case_dir)
-    page = page or _requested_page()
+    page = page or _url_argument("page")
+    url_present = _requested_present()
+    present = present if url_present is None else url_present
     WARMUP.start()
     status = pn.pane.HTML(WARMUP.message(), css_classes=["pdeflow-kernels"],
                           sizing_mode="stretch_width")
     body = pn.Column(status, sizing_mode="stretch_width")
-    app = pn.Column(pn.pane.HTML(HEADER, sizing_mode="stretch_width"), body,
+    toggle = pn.widgets.Toggle(name="presentation mode", value=present, width=180,
+                               css_classes=["pdeflow-present"], align="center")
+    header = pn.Row(pn.pane.HTML(HEADER, sizing_mode="stretch_width"), toggle,
                     sizing_mode="stretch_width")
+    app = pn.Column(header, body, sizing_mode="stretch_width")
 
     def build() -> None:
         if WARMUP.error is not None:
             status.object = f"<b>{WARMUP.message()}</b>"
             return
-        body.objects = [build_pages(case_dir, page)]
+        body.objects = [build_pages(case_dir, page, toggle.value, toggle)]
 
     if WARMUP.done:
         build()

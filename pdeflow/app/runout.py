@@ -32,6 +32,7 @@ from ..cases import BASELINE_MODEL, PAPER_MODEL, CaseError
 from ..solvers.fv_split import SimulationBlowUp
 from .controls import KNOBS, ParameterControls, Slider, is_column, list_cases, served
 from .dam_break import COLOURS, LABELS
+from .look import PageLayout, style_figure
 
 MODEL_STYLE = {PAPER_MODEL: (COLOURS["upper"], "square", LABELS[PAPER_MODEL]),
                BASELINE_MODEL: (COLOURS["single"], "circle", LABELS[BASELINE_MODEL])}
@@ -50,13 +51,13 @@ class RunoutPage:
     """The run-out law page of one session."""
 
     def __init__(self, case_dir: Path, default: str = "collapse_sweep.toml",
-                 start: bool = True):
+                 start: bool = True, present: bool = False):
         cases = list_cases(case_dir, lambda c: is_column(c) and "sweep" in c.data)
         if not cases:
             raise CaseError(f"{case_dir}: no sweep case (a column case with [sweep])")
         self.controls = ParameterControls(
             cases, default if default in cases else next(iter(cases)), self.recompute,
-            [k for k in KNOBS if not k.column_only])
+            [k for k in KNOBS if not k.column_only and k.in_sweep])
         self.a = Slider(label="aspect ratio a = H0/L0", start=1.0, end=30.0, step=0.5,
                         value=5.0, css_classes=["pdeflow-a"], sizing_mode="stretch_width")
         self.a.param.watch(lambda e: self.add_point(float(e.new)), "value_throttled")
@@ -75,6 +76,8 @@ class RunoutPage:
         self._todo: list[float] = []
         self._generation = 0
         self._figure()
+        self.present = present
+        self.set_present(present)
         self.started = False
         if start:
             self.start()
@@ -143,7 +146,7 @@ class RunoutPage:
 
     # --- figure ---------------------------------------------------------------------------
     def _figure(self) -> None:
-        f = figure(x_axis_type="log", y_axis_type="log", height=520,
+        f = figure(x_axis_type="log", y_axis_type="log", height=620,
                    sizing_mode="stretch_width", x_range=Range1d(*A_RANGE),
                    y_range=Range1d(0.5, 150), x_axis_label="aspect ratio a = H0/L0",
                    y_axis_label="normalised run-out r = (R - L0)/L0",
@@ -173,12 +176,18 @@ class RunoutPage:
             law = f.line(aa, p2 * 2**e2 * (aa / 2) ** e, color=colour,
                          line_dash="dotdash", line_width=1.5)
             items.append((f"{name}: slope {e}", [law]))
-        legend = Legend(items=items, click_policy="hide", label_text_font_size="9pt")
-        f.add_layout(legend, "right")
         self.a_line = Span(location=5.0, dimension="height", line_color="#d62728",
-                           line_dash="dashed")
+                           line_dash="dashed", line_width=1.5)
         f.add_layout(self.a_line)
-        f.css_classes = ["pdeflow-law"]
+        # a Span has no legend entry: an empty line in its style stands for it
+        a_item = f.line([np.nan], [np.nan], line_color="#d62728", line_dash="dashed",
+                        line_width=1.5)
+        items.append(("a of the slider (the current point)", [a_item]))
+        # under the plot, in two columns: it never covers the points, and the plot
+        # keeps the page's width
+        legend = Legend(items=items, click_policy="hide", ncols=2)
+        f.add_layout(legend, "below")
+        f.css_classes = ["pdeflow-runout"]
         self.fig = f
 
     def _draw(self) -> None:
@@ -222,10 +231,19 @@ class RunoutPage:
         todo = f"<p>computing {len(self._todo)} more ...</p>" if self._todo else ""
         return f"<p>fit of the set:</p><ul>{''.join(rows)}</ul>{todo}"
 
+    def set_present(self, present: bool) -> None:
+        """Presentation mode: larger fonts and lines, the expert choices hidden."""
+        self.present = present
+        style_figure(self.fig, present)
+        self.fig.height = 700 if present else 620  # the legend below takes its share
+        self.controls.set_present(present)
+
     def panel(self) -> pn.Row:
-        left = pn.Column(self.controls.panel("run-out law"), width=320)
         main = pn.Column(self.status, self.a, pn.Row(self.reset, self.clear),
-                         pn.pane.Bokeh(self.fig),
-                         sizing_mode="stretch_width")
-        return pn.Row(left, main, pn.Column("### results", self.current, self.fits,
-                                            width=340), sizing_mode="stretch_width")
+                         pn.pane.Bokeh(self.fig), sizing_mode="stretch_width")
+        results = pn.Column("### results", self.current, self.fits,
+                            sizing_mode="stretch_width")
+        self.layout = PageLayout(self.controls.panel("run-out law"), main, results)
+        if self.present:
+            self.layout.show_sidebar(False)
+        return self.layout.row

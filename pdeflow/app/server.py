@@ -2,7 +2,9 @@
 hyperbolicity) where every slider reruns pdeflow in the server.
 
 The page opens in the default browser (unless --no-browser) at http://HOST:PORT/;
-?page=run-out or ?page=hyperbolicity opens another page first. The first start on a
+?page=run-out or ?page=hyperbolicity opens another page first; --present (or
+?present=1) opens in presentation mode, for a projector: larger fonts and lines, fewer
+controls (a toggle in the header switches it). The first start on a
 machine compiles the numerical kernels (the page says so, with the elapsed time); later
 starts load them in under a second. Ctrl-C stops the server.
 
@@ -15,6 +17,7 @@ examples:
   pdeflow app                                  # http://127.0.0.1:5006/ in the browser
   pdeflow app --port 8000 --no-browser
   pdeflow app --host 0.0.0.0                   # a class on the local network
+  pdeflow app --present                        # on a projector
 """
 
 from __future__ import annotations
@@ -39,6 +42,9 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     "0.0.0.0: every network interface)")
     ap.add_argument("--no-browser", action="store_true",
                     help="do not open the page in a browser (print its address only)")
+    ap.add_argument("--present", action="store_true",
+                    help="open in presentation mode: larger fonts and lines, fewer "
+                    "controls (also ?present=1 in the URL)")
     ap.add_argument("--cases", metavar="DIR",
                     help="directory of case files (default: ./cases, else the "
                     "repository's cases/)")
@@ -76,7 +82,7 @@ def cmd_app(args: argparse.Namespace) -> int:
     case_dir = find_case_dir(args.cases)  # CaseError: one line, exit 2 (pdeflow.cli)
     try:
         port = args.port or _free_port(args.host)
-        server = make_server(case_dir, port, args.host)
+        server = make_server(case_dir, port, args.host, present=args.present)
     except OSError as err:  # address in use, unknown host, ...
         print(f"pdeflow: error: cannot serve on --host {args.host} --port {args.port}: "
               f"{err.strerror or err}", file=sys.stderr)
@@ -99,8 +105,9 @@ def cmd_app(args: argparse.Namespace) -> int:
     return 0
 
 
-def make_server(case_dir: Path, port: int, host: str) -> Any:
-    """A Bokeh server (not started) with the app at /, and the kernels loading."""
+def make_server(case_dir: Path, port: int, host: str, present: bool = False) -> Any:
+    """A Bokeh server (not started) with the app at /, and the kernels loading
+    (``present``: pages open in presentation mode)."""
     import panel as pn
 
     from .kernels import WARMUP
@@ -110,7 +117,7 @@ def make_server(case_dir: Path, port: int, host: str) -> Any:
                else ["*"])
 
     def session() -> Any:  # Panel calls a function once per browser session
-        return create_app(case_dir)
+        return create_app(case_dir, present=present)
 
     server = pn.serve(session, port=port, address=host, websocket_origin=origins,
                       show=False, start=False, title="pdeflow", verbose=False)

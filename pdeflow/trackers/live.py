@@ -264,19 +264,27 @@ class LayersPlotTracker(TrackerBase):
 
 def replay(frames: list[tuple[float, list[np.ndarray | None], list[np.ndarray | None]]],
            series: list[Series], path: str | Path, *, title: str = "", fps: float = 10,
-           dpi: int = 100) -> Path:
-    """Write a movie of given frames (t, states, fextras) of one or more runs."""
+           dpi: int = 100, progress: bool = False) -> Path:
+    """Write a movie of given frames (t, states, fextras) of one or more runs; with
+    ``progress`` a bar on stderr counts the frames (tqdm, as py-pde's progress bar:
+    drawing takes tens of milliseconds per frame)."""
+    from tqdm.auto import tqdm
+
     fig = RunFigure(series, title=title)
     movie = MovieFile(path, fig.fig, fps=fps, dpi=dpi)
+    bar = tqdm(total=len(frames), desc=f"drawing {Path(path).name}", unit="frame",
+               disable=not progress, leave=True)
     try:
         for t, states, fextras in frames:
             fig.update(t, states, fextras)
             movie.grab()
+            bar.update(1)
         out = movie.finish()
     except BaseException:
         movie.discard()
         raise
     finally:
+        bar.close()
         fig.close()
     return out
 

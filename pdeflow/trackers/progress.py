@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from pde.tools.output import get_progress_bar_class
 from pde.trackers import ProgressTracker
 from pde.trackers.base import InfoDict, TrackerBase
 
@@ -45,14 +46,19 @@ class ProgressBar(ProgressTracker):
         self._clock_started = False
 
     def initialize(self, field: Any, info: InfoDict | None = None) -> float:
-        result = super().initialize(field, info)
+        # py-pde's initialize draws the bar twice before the first update (empty, then
+        # "Initializing"): the bar is made here instead, with its label, drawn once
+        result = TrackerBase.initialize(self, field, info)
         self._clock_started = False
         solver = (info or {}).get("solver", {}).get("class")
         waiting = ""
         if solver == "FVSplitSolver":
             waiting = _WAITING.get(warmup.status(), "")
         self._waiting = ": ".join(p for p in (self.label, waiting) if p)
-        self.progress_bar.set_description(self._waiting)
+        controller = (info or {}).get("controller", {})
+        self.progress_bar = get_progress_bar_class(self.fancy)(
+            total=controller.get("t_end"), initial=controller.get("t_start", 0),
+            leave=self.leave, desc=self._waiting)
         return result
 
     def handle(self, field: Any, t: float) -> None:

@@ -1,0 +1,130 @@
+"""How the pages look: font sizes and line widths (normal or for a projector), and the
+page layout that works from 1024x768 to wide screens.
+
+A page is a side bar of parameters (collapsible: a button above the figures hides it)
+and a main area in which the figures take the width they need and the results sit
+beside them on a wide screen or wrap under them on a narrow one (a CSS flex box, so the
+browser decides, and nothing waits for the server).
+
+Presentation mode (a toggle in the header, ``?present=1`` in the URL, or ``pdeflow app
+--present``): larger fonts and lines, figure toolbars only on hover, and the controls a
+class does not need (scheme, friction law, the command line) hidden.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+import panel as pn
+from bokeh.models import GlyphRenderer, Span
+
+SIDEBAR_PX = 300
+"""Width of a page's side bar of parameters [px]."""
+RESULTS_PX = 380
+"""Width of a page's results column [px] (beside the figures, or under them)."""
+FIGURES_MIN_PX = 700
+"""The narrowest the figures get before the results wrap under them [px]."""
+
+
+@dataclass(frozen=True)
+class Look:
+    """Font sizes [pt] and the factor on line widths of one mode."""
+
+    title_pt: int
+    axis_pt: int
+    ticks_pt: int
+    legend_pt: int
+    line_scale: float
+
+
+NORMAL = Look(title_pt=13, axis_pt=12, ticks_pt=11, legend_pt=11, line_scale=1.0)
+PRESENT = Look(title_pt=20, axis_pt=17, ticks_pt=15, legend_pt=15, line_scale=2.0)
+
+
+def look(present: bool) -> Look:
+    return PRESENT if present else NORMAL
+
+
+def fit_height(normal_px: int, present: bool) -> int:
+    """A figure's height [px] for the mode: larger fonts need more room for the y
+    axis' label (upright) and the tick labels."""
+    return round(normal_px * PRESENT.axis_pt / NORMAL.axis_pt) if present else normal_px
+
+
+def _scale_line(model: Any, scale: float) -> None:
+    """Set ``model.line_width`` to its width as built times ``scale`` (the width as
+    built is kept in its tags, so that switching back and forth does not drift)."""
+    if not hasattr(model, "line_width"):
+        return
+    if not model.tags:
+        model.tags = [float(model.line_width)]
+    model.line_width = model.tags[0] * scale
+
+
+def style_figure(fig: Any, present: bool) -> None:
+    """Fonts, line widths and toolbar of one Bokeh figure for the mode."""
+    lk = look(present)
+    fig.title.text_font_size = f"{lk.title_pt}pt"
+    for axis in (*fig.xaxis, *fig.yaxis):
+        axis.axis_label_text_font_size = f"{lk.axis_pt}pt"
+        axis.major_label_text_font_size = f"{lk.ticks_pt}pt"
+    for legend in fig.legend:
+        legend.label_text_font_size = f"{lk.legend_pt}pt"
+        legend.glyph_width = round(20 * lk.line_scale)
+    for r in fig.renderers:
+        if isinstance(r, GlyphRenderer):
+            _scale_line(r.glyph, lk.line_scale)
+    for a in fig.center:
+        if isinstance(a, Span):
+            _scale_line(a, lk.line_scale)
+    fig.toolbar.autohide = present
+
+
+def style_figures(figures: Iterable[Any], present: bool) -> None:
+    for f in figures:
+        style_figure(f, present)
+
+
+def legend_outside(fig: Any, place: str = "right") -> None:
+    """Move the figure's legend out of the plot area (``place``: 'right', 'below'), where
+    it cannot cover the data."""
+    for legend in list(fig.legend):
+        if legend in fig.center:
+            fig.center.remove(legend)
+            fig.add_layout(legend, place)
+
+
+class PageLayout:
+    """Side bar | figures + results (results under the figures when space is short).
+
+    Args:
+        sidebar: the page's parameters.
+        figures: the figures and what belongs to them (player, warnings).
+        results: the numbers; beside the figures if both fit, else under them.
+    """
+
+    def __init__(self, sidebar: pn.viewable.Viewable, figures: pn.viewable.Viewable,
+                 results: pn.viewable.Viewable | None = None):
+        self.sidebar = pn.Column(sidebar, width=SIDEBAR_PX, css_classes=["pdeflow-sidebar"])
+        self.toggle = pn.widgets.Toggle(name="◀ hide the parameters", value=True,
+                                        css_classes=["pdeflow-sidebar-toggle"],
+                                        width=220)
+        self.toggle.param.watch(lambda e: self.show_sidebar(e.new), "value")
+        figures.styles = {"flex": f"1 1 {FIGURES_MIN_PX}px", "min-width": "0"}
+        parts = [figures]
+        if results is not None:
+            results.styles = {"flex": f"0 1 {RESULTS_PX}px"}
+            parts.append(results)
+        self.main = pn.FlexBox(*parts, flex_wrap="wrap", align_items="flex-start",
+                               sizing_mode="stretch_width")
+        self.row = pn.Row(self.sidebar, pn.Column(self.toggle, self.main,
+                                                  sizing_mode="stretch_width"),
+                          sizing_mode="stretch_width")
+
+    def show_sidebar(self, shown: bool) -> None:
+        self.sidebar.visible = shown
+        self.toggle.name = "◀ hide the parameters" if shown else "▶ show the parameters"
+        if self.toggle.value != shown:
+            self.toggle.value = shown
