@@ -327,6 +327,7 @@ def print_summary(summary: dict[str, Any], out: Any = None) -> None:
             ("bed deposited", "bed_deposited_volume", " m2"),
             ("erosion depth", "bed_max_erosion_depth", " m"),
             ("  at x", "bed_max_erosion_x", " m"), ("  at t", "bed_max_erosion_time", " s"),
+            ("bed moving max", "bed_moving_volume_max", " m2"),
             ("mass error", "mass_relative_error", ""), ("steps", "steps", ""),
             ("wall time", "wall_time_s", " s")]
     models = summary["models"]

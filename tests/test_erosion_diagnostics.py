@@ -164,3 +164,33 @@ def test_bad_series_options_are_one_line_errors(override, message):
     with pytest.raises(CaseError, match=message) as err:
         load_case(CASE, [override])
     assert "\n" not in str(err.value)
+
+
+def test_moving_bed_volume_counts_moving_bed_cells_only():
+    h2 = BED0.copy()
+    q = np.zeros_like(h2)
+    q[(X > 0.3) & (X < 0.4)] = 1e-3  # 20 cells of the bed pushed along
+    q[:40] = 1e-3  # the column's lower layer: not the bed
+    assert E.moving_bed_volume(h2, q, REGION, DX) == pytest.approx(20 * DX * 0.005)
+
+
+def test_bed_stresses_follow_the_closure_and_the_bed_holds_below_phi_b():
+    """The erosion criterion of bed_stresses is the sign of the kernel's closure rate,
+    and a bed below its friction angle is never driven beyond its basal resistance
+    without pressure gradients (phi_int < phi_B)."""
+    from pdeflow.analysis.bed_stresses import bed_stresses
+    from pdeflow.models import TwoLayerParameters
+    from pdeflow.numerics.sources import closure_rate
+
+    p = TwoLayerParameters(theta_deg=25.0, k=0.8, c=1.0, du_reg=0.05)
+    rng = np.random.default_rng(1)
+    h1, u1 = rng.uniform(0.001, 0.1, 200), rng.uniform(0, 2, 200)
+    h2, u2 = np.full(200, 0.005), np.zeros(200)
+    s = bed_stresses(h1, u1, h2, u2, DX, p)
+    g = p.g * np.cos(np.radians(p.theta_deg))
+    tan_int = np.tan(np.radians(p.phi_int_deg))
+    rate = np.array([closure_rate(a, b, p.density_ratio, g, tan_int, p.k, p.c, p.du_reg)
+                     for a, b in zip(h1, u1, strict=True)])
+    assert np.allclose(s["M"], rate, rtol=1e-12, atol=0)
+    assert np.array_equal(s["erodes"], rate > 0)
+    assert np.all(s["drive_no_pressure"] < s["t_b_max"])

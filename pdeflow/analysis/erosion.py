@@ -96,6 +96,14 @@ def erosion_front(x: np.ndarray, h_bed: np.ndarray, bed0: np.ndarray, region: np
     return float(x[eroded[-1]]) if eroded.size else None
 
 
+def moving_bed_volume(h_bed: np.ndarray, q_bed: np.ndarray, region: np.ndarray,
+                      cells: float | np.ndarray) -> float:
+    """Volume [m^2 per unit width, or m^3] of the bed layer that moves (discharge
+    ``q_bed`` [m^2/s] not 0) in the bed ``region``: the bed pushed along as a whole
+    (and the column's lower layer run onto it), which no erosion volume sees."""
+    return _integral(np.where(region & (q_bed != 0.0), h_bed, 0.0), cells)
+
+
 def final_deposit(data: np.ndarray, bed0: np.ndarray | None) -> np.ndarray:
     """The deposit [m] with the original bed surface subtracted: total depth of the state
     ``data`` minus ``bed0`` (negative where the bed was eroded and not refilled; the
@@ -148,6 +156,8 @@ class ErosionSeries:
     """where it is [m] (NaN where nothing is eroded)"""
     erosion_front: np.ndarray | None = None
     """x [m] of the farthest eroded cell (NaN where none)"""
+    moving_bed: np.ndarray | None = None
+    """bed layer moving in the bed region [m^2] (:func:`moving_bed_volume`)"""
     booked_eroded: np.ndarray | None = None
     """the two-layer exchange's cumulative erosion [m^2] (upper-layer depth x dx)"""
     booked_deposited: np.ndarray | None = None
@@ -185,6 +195,8 @@ def erosion_series(t: Sequence[float], frames: Sequence[np.ndarray], x: np.ndarr
     out.erosion_x = np.array([np.nan if xe is None else xe for _, xe in deep])
     fronts_e = [erosion_front(x, hb, bed0, region) for hb in h]
     out.erosion_front = np.array([np.nan if f is None else f for f in fronts_e])
+    out.moving_bed = np.array([moving_bed_volume(hb, d[bed_row + 1], region, cells)
+                               for hb, d in zip(h, frames, strict=True)])
     if booked is not None:
         out.booked_eroded = np.asarray(booked[:, 0], dtype=float)
         out.booked_deposited = np.asarray(booked[:, 1], dtype=float)
@@ -194,16 +206,18 @@ def erosion_series(t: Sequence[float], frames: Sequence[np.ndarray], x: np.ndarr
 SERIES_KEYS = ("flow_duration", "front_velocity_max")
 """summary keys of every run with a series [s, m/s]"""
 BED_KEYS = ("bed_eroded_volume", "bed_eroded_volume_max", "bed_deposited_volume",
-            "bed_max_erosion_depth", "bed_max_erosion_x", "bed_max_erosion_time")
-"""summary keys of a run with an erodible bed [m^2, m^2, m^2, m, m, s] (None for a model
-that runs the case on the rigid bed)"""
+            "bed_max_erosion_depth", "bed_max_erosion_x", "bed_max_erosion_time",
+            "bed_moving_volume_max")
+"""summary keys of a run with an erodible bed [m^2, m^2, m^2, m, m, s, m^2] (None for a
+model that runs the case on the rigid bed)"""
 
 
 def series_numbers(series: ErosionSeries, erodible: bool) -> dict[str, Any]:
     """The summary's numbers of a series: the flow's duration [s] and the largest front
     velocity [m/s]; with an erodible bed (``erodible``) the final eroded and deposited
     volumes [m^2], the largest eroded volume over the frames, and the deepest erosion
-    of all frames [m] with where [m] and when [s] (None where the run has no bed)."""
+    of all frames [m] with where [m] and when [s], the largest volume of the bed layer
+    moving in the bed region [m^2] (None where the run has no bed)."""
     v = series.front_velocity
     out: dict[str, Any] = {
         "flow_duration": flow_duration(series.t, series.front),
@@ -219,5 +233,6 @@ def series_numbers(series: ErosionSeries, erodible: bool) -> dict[str, Any]:
                 "bed_max_erosion_depth": float(depth[k]),
                 "bed_max_erosion_x": (None if not np.isfinite(series.erosion_x[k])
                                       else float(series.erosion_x[k])),
-                "bed_max_erosion_time": float(series.t[k]) if depth[k] > 0 else None})
+                "bed_max_erosion_time": float(series.t[k]) if depth[k] > 0 else None,
+                "bed_moving_volume_max": float(np.max(series.moving_bed))})
     return out
