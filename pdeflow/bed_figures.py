@@ -66,10 +66,12 @@ def _space_time(ax: Any, fig: Any, x: np.ndarray, t: np.ndarray,
     if bed0 is not None and layer is not None:
         inside = np.ones_like(x, dtype=bool) if region is None else region
         z = np.array([np.where(inside, d[2 * layer] - bed0, np.nan) for d in frames])
-        lim = float(np.nanmax(np.abs(z))) if np.isfinite(z).any() else 0.0
-        lim = lim or 1e-9
+        # the colours span the bed's thickness: erosion (at most e0 deep) uses the whole
+        # red range, deposits deeper than e0 saturate
+        lim = float(np.max(bed0)) or (float(np.nanmax(np.abs(z))) if np.isfinite(z).any()
+                                      else 0.0) or 1e-9
         im = ax.pcolormesh(x, t, z, cmap="RdBu", vmin=-lim, vmax=lim, shading="nearest")
-        label = "bed change h2 - e0 [m] (red: eroded)"
+        label = "bed change h2 - e0 [m] (red: eroded; clipped at ±e0)"
     else:
         z = np.array([np.sum(np.maximum(d[::2], 0), axis=0) for d in frames])
         im = ax.pcolormesh(x, t, z, cmap="Greys", shading="nearest")
