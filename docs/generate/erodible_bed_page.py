@@ -148,8 +148,10 @@ def convergence_numbers(rows: list[dict]) -> list[dict[str, Any]]:
 def page_numbers(rows: list[dict]) -> dict[str, Any]:
     """Every number the page quotes (JSON-ready)."""
     sweep = sweep_numbers(rows)
-    single = {f"{th:g}": (_pick(rows, "single layer", "-", th, 0.0, COARSE) or {}).get(
-        "runout") for th in (*THETAS, *(phi_b("single layer") - d for d in NEAR))}
+    single = {}
+    for th in (*THETAS, *(phi_b("single layer") - d for d in NEAR)):
+        r = _pick(rows, "single layer", "-", th, 0.0, COARSE) or {}
+        single[f"{th:g}"] = (r.get("runout"), bool(r.get("runout_lower_bound")))
     return {"sweep": sweep, "trend": trend_numbers(sweep),
             "convergence": convergence_numbers(rows), "single": single,
             "phi_b": {n: phi_b(n) for n in SETS}, "H0": H0, "du_reg": DU_REG,
