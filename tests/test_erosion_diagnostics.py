@@ -134,6 +134,12 @@ def test_summary_keys_for_bed_cases_only_and_the_printed_rows(eroding_run):
     for key in E.BED_KEYS:
         assert key in res.summary and single.summary[key] is None  # the rigid bed
     assert res.summary["bed_eroded_volume_max"] > 0
+    final = res.final_arrays()
+    assert np.allclose(final["deposit_above_bed"],
+                       final["h1"] + final["h2"] - final["bed0"], atol=0)
+    assert "deposit_above_bed" not in run_model(
+        load_case(CASE_51, ["grid.dx=0.1", "output.snapshot_times=[]"]),
+        "two_layer").final_arrays()
     plain = run_model(load_case(CASE_51, ["grid.dx=0.1", "output.snapshot_times=[]"]),
                       "two_layer")
     assert plain.series is None
