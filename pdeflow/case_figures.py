@@ -120,7 +120,27 @@ def case_figures(results: dict[str, Any], outdir: str | Path, prefix: str = "",
                                   first.case.name, "(" + ", ".join(stop) + ")",
                                   coordinate),
                  outdir / f"{prefix}final_deposits.png"))
+    jobs.extend(bed_jobs(runs, outdir, prefix))
     return draw_all(jobs, parallel)
+
+
+def bed_jobs(runs: Sequence[Any], outdir: Path, prefix: str = "") -> list[tuple]:
+    """The bed figure (:func:`pdeflow.bed_figures.bed_figure`) of every run of a case
+    that lays a bed, as :func:`draw_all` jobs: ``bed_<model>.png``."""
+    from .bed_figures import bed_figure
+
+    jobs = []
+    for res in runs:
+        if res.frames is None or res.series is None or res.case.bed_kind(res.model) is None:
+            continue
+        t, frames = res.frames
+        xs = res.x - res.case.x_start
+        bed0 = res.case.bed(res.model, xs)
+        jobs.append((bed_figure, (res.x, t, frames, res.model, bed0, res.series,
+                                  res.case.name, res.summary.get("flow_duration"),
+                                  res.case.bed_region(xs)),
+                     outdir / f"{prefix}bed_{res.model}.png"))
+    return jobs
 
 
 def draw_all(jobs: Sequence[tuple[Callable, tuple, Path]],

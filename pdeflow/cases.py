@@ -56,6 +56,7 @@ from . import systems
 from .initial_shapes import (
     SHAPES,
     bed_depth,
+    bed_region,
     check_initial,
     has_bed,
     profiles_from_file,
@@ -72,6 +73,11 @@ BASELINE_MODEL = "single_layer"
 DEFAULT_MODELS = [PAPER_MODEL]
 FRAMES = ("interpolate", "step")
 """output.frames choices (see :attr:`Case.frames`)"""
+SERIES = ("auto", "on", "off")
+"""output.erosion_series choices (see :attr:`Case.erosion_series`)"""
+SERIES_FRAMES = 200
+"""frames of the erosion time series by default (output.series_every = t_end / this): the
+memory stays that of 200 states whatever t_end, and a flow of t_end / 4 still gets 50"""
 """case.models when a case names none"""
 
 SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
@@ -90,7 +96,7 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
                  "flux": (str,), "reconstruction": (str,), "limiter": (str,),
                  "splitting": (str,)},
     "output": {"snapshot_times": (list,), "front_threshold": (float, int),
-               "frames": (str,)},
+               "frames": (str,), "erosion_series": (str,), "series_every": (float, int)},
     "sweep": {"aspect_ratios": (list,)},
 }
 
@@ -199,9 +205,14 @@ class Case:
                 check_range("output.snapshot_times", t, 0, self.t_end, unit="s")
             check_range("output.front_threshold", self.front_threshold, 0, math.inf,
                         low_open=True, unit="m")
+            check_range("output.series_every", self.series_every, 0, self.t_end,
+                        low_open=True, unit="s")
         except ValueError as err:
             raise self._err(str(err)) from None
         self._check_geometry()
+        if self._get("output", "erosion_series", "auto") not in SERIES:
+            raise self._err(f"output.erosion_series must be one of {list(SERIES)}, got "
+                            f"{self._get('output', 'erosion_series', 'auto')!r}")
         if self.frames not in FRAMES:
             raise self._err(f"output.frames must be one of {list(FRAMES)}, got "
                             f"{self.frames!r}")
@@ -352,6 +363,28 @@ class Case:
         return float(self._get("output", "front_threshold", 1e-3))
 
     @property
+    def erosion_series(self) -> bool:
+        """Whether the runs record the erosion time series (pdeflow.analysis.erosion):
+        ``output.erosion_series`` 'on', 'off', or 'auto' (the default: on for the cases
+        that lay a bed, so that no other case pays for frames nobody asked for)."""
+        choice = self._get("output", "erosion_series", "auto")
+        return choice == "on" or (choice == "auto" and has_bed(self.initial))
+
+    @property
+    def series_every(self) -> float:
+        """Simulation time between two frames of the erosion series [s] (default
+        t_end / :data:`SERIES_FRAMES`)."""
+        return float(self._get("output", "series_every", self.t_end / SERIES_FRAMES))
+
+    @property
+    def series_frames(self) -> int:
+        """Frames the erosion series keeps (0 without it): every ``series_every`` from
+        t = 0, and the final state."""
+        if not self.erosion_series:
+            return 0
+        return int(math.floor(self.t_end / self.series_every + 1e-9)) + 2
+
+    @property
     def variant(self) -> Variant:
         """How the case is solved: the :class:`~pdeflow.variant.Variant` its
         ``[numerics]`` and the models' ``hyperbolicity`` parameter select."""
@@ -437,6 +470,13 @@ class Case:
         if x is None:
             x = self.make_grid().axes_coords[0] - self.x_start
         return bed_depth(self.initial, x)
+
+    def bed_region(self, x: np.ndarray | None = None) -> np.ndarray | None:
+        """The cells (a mask over ``x`` [m from the domain's start; default: the case's
+        grid]) where the shape lays its bed, None if it lays none."""
+        if x is None:
+            x = self.make_grid().axes_coords[0] - self.x_start
+        return bed_region(self.initial, x)
 
     def bed_kind(self, model: str) -> str | None:
         """'erodible' or 'rigid' if the case lays a bed ('rigid': ``model`` has no

@@ -146,7 +146,8 @@ def memory_bytes(case: Any, model: str) -> float:
     """Peak memory [bytes] of running ``model``: the solver's arrays and the snapshots."""
     system = systems.get(model)
     rows = len(system.field_names)
-    per_cell = system.bytes_per_cell + 8 * (rows + 1) * len(case.snapshot_times)
+    frames = len(case.snapshot_times) + case.series_frames  # snapshots, erosion series
+    per_cell = system.bytes_per_cell + 8 * (rows + 1) * frames
     return float(case.cells * per_cell)
 
 

@@ -187,7 +187,10 @@ def _write_run_outputs(args: argparse.Namespace, case: Any, summary: dict,
 
     written: list[Any] = []
     for model, tracker in stores.items():
-        written.append(tracker.commit({"summary": summary["models"][model]}))
+        extra = {"summary": summary["models"][model]}
+        if results[model].series is not None:  # the erosion series (cases with a bed)
+            extra["erosion_series"] = results[model].series.to_dict()
+        written.append(tracker.commit(extra))
     for t in trackers:
         if getattr(t, "movie", None) is not None:
             written.append(t.movie.path)

@@ -103,9 +103,18 @@ def bed_depth(initial: dict[str, Any], x: np.ndarray) -> np.ndarray | None:
     model without one runs on the rigid bed."""
     if not has_bed(initial):
         return None
+    return np.where(bed_region(initial, x), float(initial["bed_thickness"]), 0.0)
+
+
+def bed_region(initial: dict[str, Any], x: np.ndarray) -> np.ndarray | None:
+    """Where the shape lays its bed (None if it lays none): the cells ``x`` [m] from the
+    column's front over ``bed_length``, also where ``bed_thickness`` is 0, so that the
+    erosion diagnostics of a bed of any thickness look at the same cells."""
+    if not has_bed(initial):
+        return None
     L0 = float(initial["L0"])
     end = L0 + float(initial.get("bed_length", math.inf))
-    return np.where((x >= L0) & (x < end), float(initial["bed_thickness"]), 0.0)
+    return (x >= L0) & (x < end)
 
 
 def profiles_from_file(path: Path, keys: tuple[str, ...], n: int,

@@ -19,6 +19,14 @@ import numpy as np
 from pde import FieldCollection
 
 from . import systems
+from .analysis.erosion import (
+    BED_KEYS,
+    SERIES_KEYS,
+    ErosionSeries,
+    erosion_series,
+    final_deposit,
+    series_numbers,
+)
 from .cases import Case
 from .checks import RunWarning, cost_warning, domain_ends, result_warnings, solver_warning
 from .metrics import front_position, mass
@@ -31,6 +39,7 @@ from .numerics.warmup import prepare
 from .solvers.diagnostics import SplitDiagnostics
 from .solvers.fv_split import SimulationBlowUp, scheme_codes
 from .trackers import FextraStorageTracker
+from .trackers.series import SeriesTracker
 from .variant import Variant
 
 
@@ -49,6 +58,11 @@ class RunResult:
     snapshots: dict[float, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
     """t -> (state data, F_extra/rho1 per cell)"""
     summary: dict[str, Any] = field(default_factory=dict)
+    frames: tuple[np.ndarray, list[np.ndarray]] | None = None
+    """(times [s], state data) of the series' frames, if it records them"""
+    series: ErosionSeries | None = None
+    """the erosion time series (:mod:`pdeflow.analysis.erosion`) of a case that records
+    it (:attr:`pdeflow.cases.Case.erosion_series`), else None"""
 
     @property
     def x(self) -> np.ndarray:
@@ -70,6 +84,11 @@ class RunResult:
             h = d[2 * k]
             out[layer.depth] = h.copy()
             out[layer.velocity] = velocity_profile(h, d[2 * k + 1], dry)
+        if self.case.bed_kind(self.model) is not None:
+            bed0 = self.case.bed(self.model, self.x - self.case.x_start)
+            # the initial bed and the deposit with it subtracted (0: the rigid bed)
+            out["bed0"] = np.zeros_like(self.x) if bed0 is None else bed0
+            out["deposit_above_bed"] = final_deposit(d, bed0)
         return out
 
 
@@ -142,6 +161,9 @@ class Run:
                      self.pde.system.densities(self.pde.parameters))
         snaps = FextraStorageTracker(sorted(case.snapshot_times))
         trackers: list[Any] = [snaps] if case.snapshot_times else []
+        series = SeriesTracker(case.series_every) if case.erosion_series else None
+        if series is not None:
+            trackers.append(series)
         if tracker is not None:
             trackers.extend(tracker if isinstance(tracker, list) else [tracker])
         if not self.variant.is_mol and self.backend == "numba":
@@ -182,10 +204,30 @@ class Run:
             t_final = diag.t
         result = RunResult(model, case, self.pde, final, t_final, diag, info)
         result.snapshots = snaps.snapshots
+        if series is not None:
+            result.frames = series.frames
+            result.series = run_series(result, series)
         result.summary = summarize(result, mass0, wall, self.state.data)
         for message in result.summary["warnings"]:
             warnings.warn(message, RunWarning, stacklevel=2)
         return result
+
+
+def run_series(res: RunResult, tracker: SeriesTracker) -> ErosionSeries:
+    """The erosion series of the run ``res`` from the frames of ``tracker``: fronts above
+    the initial bed and, for a model with an erodible layer, the bed's erosion (booked
+    exchange volumes on a planar grid only, as in the summary)."""
+    case = res.case
+    times, frames = tracker.frames
+    metric = res.pde.metric(res.state.grid)
+    xs = res.x - case.x_start
+    bed0 = case.bed(res.model, xs)
+    layer = res.pde.system.bed_layer
+    booked = tracker.booked * metric.dx if (metric.geometry == "planar"
+                                           and res.pde.system.has_fextra) else None
+    return erosion_series(times, frames, res.x, metric.cells, case.front_threshold,
+                          case.dx, bed0, case.bed_region(xs) if bed0 is not None else None,
+                          bed_row=2 * (layer or 0), booked=booked)
 
 
 def run_model(case: Case, model: str, *, tracker: Any = None,
@@ -201,12 +243,15 @@ _COMMON_KEYS = ("model", "solver", "geometry", "bed", "t_final", "at_rest", "fro
                 "mass_change", "runout_lower_bound", "domain_ends", "warnings")
 
 
-def summary_keys(model: str) -> tuple[str, ...]:
+def summary_keys(model: str, series: bool = False) -> tuple[str, ...]:
     """Keys of :func:`summarize` for ``model`` with the fv-split solver: the common ones
     and the system's own (other py-pde solvers give the common keys; stop times are
-    then None). ``domain_ends`` (a table) and ``warnings`` (a list) are not numbers: a
-    study records them as JSON text."""
-    return (*_COMMON_KEYS, *systems.get(model).summary_keys)
+    then None); with ``series`` also those of a run that records the erosion series
+    (cases with a bed, :data:`SERIES_KEYS` and :data:`BED_KEYS`). ``domain_ends`` (a
+    table) and ``warnings`` (a list) are not numbers: a study records them as JSON
+    text."""
+    extra = (*SERIES_KEYS, *BED_KEYS) if series else ()
+    return (*_COMMON_KEYS, *systems.get(model).summary_keys, *extra)
 
 
 def summarize(res: RunResult, mass0: float, wall: float,
@@ -249,6 +294,8 @@ def summarize(res: RunResult, mass0: float, wall: float,
                                             metric))
     else:
         out.update({"stop_time": None, "max_fextra_over_rho1": None})
+    if res.series is not None:
+        out.update(series_numbers(res.series, case.bed_kind(res.model) == "erodible"))
     if initial is not None:
         out["domain_ends"] = domain_ends(case, initial, d, out["mass_change"], bed)
         out["runout_lower_bound"] = out["domain_ends"]["runout_lower_bound"]
@@ -273,6 +320,14 @@ def print_summary(summary: dict[str, Any], out: Any = None) -> None:
             ("upper stop", "upper_stop_time", " s"), ("front", "front_position", " m"),
             ("run-out", "runout", " m"), ("max F_extra/rho1", "max_fextra_over_rho1",
                                            " m2/s2"),
+            ("flow duration", "flow_duration", " s"),
+            ("front speed max", "front_velocity_max", " m/s"),
+            ("bed eroded", "bed_eroded_volume", " m2"),
+            ("bed eroded max", "bed_eroded_volume_max", " m2"),
+            ("bed deposited", "bed_deposited_volume", " m2"),
+            ("erosion depth", "bed_max_erosion_depth", " m"),
+            ("  at x", "bed_max_erosion_x", " m"), ("  at t", "bed_max_erosion_time", " s"),
+            ("bed moving max", "bed_moving_volume_max", " m2"),
             ("mass error", "mass_relative_error", ""), ("steps", "steps", ""),
             ("wall time", "wall_time_s", " s")]
     models = summary["models"]

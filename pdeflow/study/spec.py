@@ -222,10 +222,10 @@ def _check_quantity(q: str, function: str | None) -> None:
         raise StudyError(f"unknown quantity {q!r}: a sweep quantity is "
                          f"sweep.<{'|'.join(systems.names())}>.<{'|'.join(SWEEP_KEYS)}>")
     if len(parts) == 2 and parts[0] in systems.names():
-        if parts[1] in summary_keys(parts[0]):
+        if parts[1] in summary_keys(parts[0], series=True):
             return
         raise StudyError(f"unknown quantity {q!r}: {parts[0]}'s run summary has "
-                         f"{', '.join(summary_keys(parts[0]))}")
+                         f"{', '.join(summary_keys(parts[0], series=True))}")
     raise StudyError(f"unknown quantity {q!r}: use <model>.<summary key> with model "
                      f"{' or '.join(systems.names())}, or sweep.<model>.exponent")
 

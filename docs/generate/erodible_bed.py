@@ -1,0 +1,244 @@
+"""Regenerate docs/erodible_bed.md: collapses over erodible beds, both models, the slope
+and the bed's thickness swept, against the trend of the channel experiments.
+
+    python docs/generate/erodible_bed.py             # runs what the cache lacks, then the page
+    python docs/generate/erodible_bed.py --runs-only # fill the cache only (resumable)
+    python docs/generate/erodible_bed.py --no-runs   # the page from the cache as it is
+    python docs/generate/erodible_bed.py --rerun     # empty the cache first, run it all
+
+Every point (parameter set, closure, slope theta, bed thickness e_i, grid dx) is one
+run of cases/erodible_bed.toml to rest; its numbers go to docs/erodible_bed/sweep.csv as
+soon as it ends, and a later call runs only the points missing there. The coarse grid
+(dx = 5 mm) covers the whole sweep; the key points (theta = 22 and 25 deg, and 2 deg
+below each set's basal friction angle, at e_i = 0, 5, 14 mm) are refined. The page's
+numbers (docs/erodible_bed/numbers.json) are computed from the CSV by
+:func:`page_numbers`; the side view and the stresses at the erosion front come from two
+runs made every time (seconds).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+import time
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pdeflow.cases import load_case, tomllib
+from pdeflow.checks import RunWarning
+from pdeflow.simulate import run_model
+
+ROOT = Path(__file__).resolve().parents[2]
+CASE = ROOT / "cases" / "erodible_bed.toml"
+LAW_CASE = ROOT / "cases" / "paper_5_2_two_layer_law.toml"
+OUT = ROOT / "docs" / "erodible_bed"
+CSV = OUT / "sweep.csv"
+H0 = 0.14
+"""column height [m] (initial.H0 of the case)"""
+THETAS = (0.0, 10.0, 16.0, 19.0, 22.0, 25.0)
+"""slopes of the sweep [deg]: the experiments' range 0-25 deg"""
+NEAR = (4.0, 2.0, 1.0)
+"""slopes below each set's basal friction angle phi_B [deg]: where the model's bed is
+close to failing, as the experiments' bed is near its repose angle"""
+BEDS = (0.0, 0.002, 0.005, 0.01, 0.014)
+"""bed thicknesses e_i [m]: 0 to H0/10"""
+DU_REG = 0.05
+"""the du_reg bound [m/s] of the 'du_reg' closure: the planar law set's value
+(cases/paper_5_2_two_layer_law.toml), in the converged corner of two_layer_law.md"""
+COARSE = 0.005
+"""dx [m] of the whole sweep (H0/28; the column is 40 cells long)"""
+REFINE = (0.0025, 0.00125, 0.000625)
+"""dx [m] of the key points at 22 and 25 deg (three halvings)"""
+REFINE_NEAR = (0.0025, 0.00125)
+"""dx [m] of the key points 2 deg below phi_B (their runs are long: two halvings)"""
+KEY_BEDS = (0.0, 0.005, 0.014)
+KEY_THETAS = (22.0, 25.0)
+SERIES_EVERY = 0.01
+"""frames of the erosion series [s]: the flow duration is resolved to 10 ms"""
+MAIN = {"length": 3.0, "t_end": 10.0}
+"""domain [m] and end time [s] of the sweep's slopes (every run out < 1.5 m, at rest by 3 s)"""
+NEAR_RUN = {"length": 8.0, "t_end": 30.0}
+"""the same near phi_B, where the flows run metres and last seconds"""
+CLOSURES: dict[str, list[str]] = {
+    "paper": ["two_layer.exchange_closure='paper'", "two_layer.du_reg=0.0"],
+    "du_reg": ["two_layer.exchange_closure='paper'", f"two_layer.du_reg={DU_REG!r}"],
+    "relaxed": ["two_layer.exchange_closure='relaxed'", "two_layer.du_reg=0.0"],
+}
+"""the exchange closures: the paper's (25), the same bounded by du_reg, the relaxed one
+(tau_star 1, its default)"""
+FIELDS = ("set", "closure", "theta", "e_i", "dx", "runout", "flow_duration", "stop_time",
+          "at_rest", "runout_lower_bound", "front_velocity_max", "bed_eroded_volume_max",
+          "bed_eroded_volume", "bed_deposited_volume", "bed_max_erosion_depth",
+          "bed_moving_volume_max", "booked_eroded", "erosion_lead", "max_fextra",
+          "steps", "wall_time_s", "mass_relative_error", "warnings")
+
+
+def law_set_overrides(path: Path = LAW_CASE) -> list[str]:
+    """The planar law set as overrides: its [two_layer] keys but du_reg (the closure's)
+    and its initial.wedge_angle_deg."""
+    data = tomllib.loads(path.read_text())
+    out = [f"two_layer.{k}={v!r}" for k, v in data["two_layer"].items() if k != "du_reg"]
+    out.append(f"initial.wedge_angle_deg={data['initial']['wedge_angle_deg']!r}")
+    return out
+
+
+SETS: dict[str, tuple[str, list[str]]] = {
+    "single layer": ("single_layer", []),
+    "two layers, defaults": ("two_layer", []),
+    "two layers, planar law set": ("two_layer", law_set_overrides()),
+}
+"""name -> (model, overrides): the shipped parameter sets (docs/parameters.md)"""
+
+
+def phi_b(name: str) -> float:
+    """The basal friction angle [deg] of the set ``name``."""
+    model, sets = SETS[name]
+    return float(load_case(CASE, sets).make_pde(model).parameters.phi_b_deg)
+
+
+def point_case(name: str, closure: str, theta: float, e_i: float, dx: float,
+               extra: list[str] | None = None) -> Any:
+    """The case of one point (the single layer takes no closure: ``closure`` '-')."""
+    model, sets = SETS[name]
+    run = NEAR_RUN if theta > max(THETAS) else MAIN
+    over = [*sets, *(CLOSURES[closure] if model == "two_layer" else []),
+            f"{model}.theta_deg={theta!r}", f"initial.bed_thickness={e_i!r}",
+            f"grid.dx={dx!r}", f"grid.length={run['length']!r}",
+            f"case.t_end={run['t_end']!r}", f"case.models=['{model}']",
+            "output.snapshot_times=[]", f"output.series_every={SERIES_EVERY!r}"]
+    return load_case(CASE, [*over, *(extra or [])])
+
+
+def erosion_lead(series: Any) -> float | None:
+    """How far [m] the erosion front ran ahead of the flow front at most (negative:
+    it stayed behind it); None where nothing was eroded."""
+    if series.erosion_front is None or not np.isfinite(series.erosion_front).any():
+        return None
+    return float(np.nanmax(series.erosion_front - series.front))
+
+
+def measure_point(name: str, closure: str, theta: float, e_i: float,
+                  dx: float) -> dict[str, Any]:
+    """Run one point to rest: its summary's numbers and the run warnings, as a CSV row."""
+    case = point_case(name, closure, theta, e_i, dx)
+    model = case.models[0]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RunWarning)
+        res = run_model(case, model)
+    s = res.summary
+    row: dict[str, Any] = {"set": name, "closure": closure, "theta": theta, "e_i": e_i,
+                           "dx": dx, "booked_eroded": s.get("eroded_volume"),
+                           "erosion_lead": erosion_lead(res.series),
+                           "max_fextra": s.get("max_fextra_over_rho1")}
+    for key in FIELDS:
+        if key in s:
+            row[key] = s[key]
+    row["warnings"] = " | ".join(sorted({str(w.message) for w in caught
+                                         if issubclass(w.category, RunWarning)}))
+    return row
+
+
+def _key(row: dict[str, Any]) -> tuple:
+    return (row["set"], row["closure"], float(row["theta"]), float(row["e_i"]),
+            float(row["dx"]))
+
+
+def read_cache(path: Path = CSV) -> list[dict[str, Any]]:
+    """The stored rows, numbers parsed (empty cells: None)."""
+    if not path.is_file():
+        return []
+    rows = []
+    with path.open() as f:
+        for raw in csv.DictReader(f):
+            row: dict[str, Any] = {}
+            for k, v in raw.items():
+                if k in ("set", "closure", "warnings"):
+                    row[k] = v
+                elif k in ("at_rest", "runout_lower_bound"):
+                    row[k] = v == "True"
+                else:
+                    row[k] = float(v) if v not in ("", "None") else None
+            rows.append(row)
+    return rows
+
+
+def fill_cache(points: list[tuple], path: Path = CSV,
+               log: Any = sys.stderr) -> list[dict[str, Any]]:
+    """Run every point not yet in ``path``, appending each row as it ends; all rows."""
+    rows = read_cache(path)
+    done = {_key(r) for r in rows}
+    path.parent.mkdir(parents=True, exist_ok=True)
+    new = not path.is_file()
+    with path.open("a", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=FIELDS)
+        if new:
+            w.writeheader()
+        for p in points:
+            if (p[0], p[1], float(p[2]), float(p[3]), float(p[4])) in done:
+                continue
+            t0 = time.perf_counter()
+            row = measure_point(*p)
+            w.writerow(row)
+            f.flush()
+            rows.append(row)
+            if log:
+                print(f"{p[0]:27} {p[1]:8} theta {p[2]:<4g} e_i {p[3]:<6g} dx {p[4]:<9g} "
+                      f"run-out {row['runout']:.4g} ({time.perf_counter() - t0:.1f} s)",
+                      file=log, flush=True)
+    return rows
+
+
+def sweep_points() -> list[tuple]:
+    """Every (set, closure, theta, e_i, dx) of the page: the coarse sweep, then the
+    refined key points."""
+    pts: list[tuple] = []
+    for name, (model, _) in SETS.items():
+        closures = list(CLOSURES) if model == "two_layer" else ["-"]
+        near = [phi_b(name) - d for d in NEAR]
+        beds = BEDS if model == "two_layer" else (0.0,)  # the single layer has no bed
+        for closure in closures:
+            pts += [(name, closure, th, e, COARSE) for th in (*THETAS, *near) for e in beds]
+    keys = [p for p in pts if p[2] in KEY_THETAS and p[3] in KEY_BEDS]
+    near_keys = [p for p in pts if p[2] == phi_b(p[0]) - 2.0 and p[3] in KEY_BEDS]
+    pts += [(*p[:4], dx) for dx in REFINE for p in keys]
+    pts += [(*p[:4], dx) for dx in REFINE_NEAR for p in near_keys]
+    return pts
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Fill the cache, then (unless --runs-only) write the page, its figures and numbers."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs-only", action="store_true", help="fill the cache, no page")
+    ap.add_argument("--no-runs", action="store_true", help="the page from the cache")
+    ap.add_argument("--rerun", action="store_true", help="empty the cache first")
+    args = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    if args.rerun and CSV.is_file():
+        CSV.unlink()
+    rows = read_cache() if args.no_runs else fill_cache(sweep_points())
+    if args.runs_only:
+        return 0
+    import matplotlib
+
+    matplotlib.use("Agg")  # files only
+    import erodible_bed_page as page
+
+    from pdeflow.io import write_json
+
+    numbers = page.page_numbers(rows)
+    numbers.update(page.figures(rows, numbers, OUT))
+    numbers["generator_wall_s"] = round(time.perf_counter() - t0, 1)
+    numbers["points"] = len(rows)
+    write_json(OUT / "numbers.json", numbers)
+    text = page.render_page(numbers)
+    (ROOT / "docs" / "erodible_bed.md").write_text(text)
+    print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
