@@ -37,7 +37,11 @@ D_HYP_BISECTIONS = 15  #: restorations that needed the bisection fallback (see s
 D_BAD_STEPS = 16  #: steps of a generic py-pde solver that left a non-finite value or a depth
 #: below -1e-12 m, before the post-step hook clipped it (models.base.make_post_step_hook)
 D_RETRIES = 17  #: steps rejected (a depth would turn negative) and retried with dt / 2
-N_DIAG = 18  #: the per-cell F_extra/rho1 of the last step follows at N_DIAG
+D_RESUME = 18  #: 1 if D_LIVE_LO..D_LIVE_HI are the live cells of the state the fv-split
+#: loop left (the next call goes on from them; pdeflow.numerics.resting), else 0
+D_LIVE_LO = 19  #: first live cell after the loop's last step
+D_LIVE_HI = 20  #: last live cell after the loop's last step
+N_DIAG = 21  #: the per-cell F_extra/rho1 of the last step follows at N_DIAG
 
 # --- boundary conditions ---------------------------------------------------------------
 BC_WALL = 0

@@ -204,10 +204,13 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int) ->
         # Only the cells a step can change are visited: the live cells (moving, or
         # changed by the last step) widened by the reach of a step; every other cell is
         # dry, or at rest with a stencil at rest, and no stage changes it
-        # (pdeflow.numerics.resting). The first step visits all cells (the source stage
-        # cleans the initial state).
-        v_lo = 0
-        v_hi = n - 1
+        # (pdeflow.numerics.resting). A call that goes on from the state the last one
+        # left (diag[D_RESUME], which the caller clears otherwise) starts from its live
+        # cells; else the first step visits all cells (the source stage cleans the
+        # initial state).
+        first = diag[L.D_RESUME] != 1.0
+        v_lo = 0 if first else int(diag[L.D_LIVE_LO])
+        v_hi = n - 1 if first else int(diag[L.D_LIVE_HI])
         s_lo = 0
         s_hi = n - 1
         # running maxima of the wave speed of cells at rest, from the left and right
@@ -216,7 +219,6 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int) ->
         suf = np.zeros(n)
         p_ok = 0
         s_ok = n
-        first = True
         while t < t_pause and steps < max_steps:
             if first:
                 b_lo = 0
@@ -303,6 +305,9 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int) ->
                 v_lo, v_hi = live_cells(q, backup, b_lo, b_hi)
                 p_ok = min(p_ok, b_lo)
                 s_ok = max(s_ok, b_hi + 1)
+            diag[L.D_LIVE_LO] = v_lo
+            diag[L.D_LIVE_HI] = v_hi
+            diag[L.D_RESUME] = 1.0
             first = False
             if t_new >= t_pause:
                 # the state before this step, for output at t_pause (interpolated by the
@@ -354,6 +359,10 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
     advection (else Lie, as in the paper). With Strang, dt is chosen before the first
     half source step; if that half step makes the waves faster than dt allows (erosion
     deepens the upper layer), it is undone and the step retried with a shorter dt.
+
+    ``diag[D_RESUME]`` = 1 lets a call go on from the live cells the last call recorded
+    in ``diag`` (:mod:`pdeflow.numerics.resting`); the caller must clear it (0) unless
+    ``q`` is the state that call left.
 
     Returns ``(t, steps, status)``: status :data:`STATUS_END`; :data:`STATUS_REST`
     (everything at rest and unchanged: stationary from ``t`` on); or

@@ -261,16 +261,25 @@ class FVSplitSolver(SolverBase):
 
         if self.backend_name == "numba":
             kernel = scheme_stepper(*scheme)  # compiled (or loaded) at its first call
+            left = np.full_like(state.data, np.nan)  # the state the last call left
 
             def advance(q: np.ndarray, t0: float, t_pause: float, t1: float):
-                return run_kernel(kernel, q, t0, t1, diag, rate, backup, work,
-                                  self.max_steps, t_pause)
+                # the loop goes on from its last live cells only if nobody changed the
+                # state in between (pdeflow.numerics.resting)
+                if not np.array_equal(q, left):
+                    diag[L.D_RESUME] = 0.0
+                out = run_kernel(kernel, q, t0, t1, diag, rate, backup, work,
+                                 self.max_steps, t_pause)
+                np.copyto(left, q)
+                return out
         else:
             advance = self._numpy_loop(state, dx, P, hook, diag, prev)
 
         def replay(q: np.ndarray, t0: float, t1: float, update: Any) -> None:
             # one step of the kernel's own Python code with an instrumented state update
-            run_kernel(python_stepping(*scheme, update), q, t0, t1, diag.copy(),
+            fresh = diag.copy()
+            fresh[L.D_RESUME] = 0.0  # q is the state before the failed step
+            run_kernel(python_stepping(*scheme, update), q, t0, t1, fresh,
                        np.empty_like(q), np.empty_like(q), np.empty_like(work), 1)
 
         ahead: list[StepAhead] = []  # the state past the last output time, if any
