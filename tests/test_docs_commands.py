@@ -140,7 +140,6 @@ def check_static(cmd: list[str], block: Block) -> None:
                 build_parser().parse_args(with_sets(cmd, block))
             except SystemExit as err:  # --help, or an argument the parser rejects
                 assert err.code == 0, f"{where}: the parser rejects it"
-
     else:
         raise AssertionError(f"{where}: not a command the test knows; run it from "
                              "pdeflow/python, or annotate <!-- test: skip REASON -->")
@@ -153,6 +152,8 @@ def run_command(cmd: list[str], block: Block, cwd: Path) -> str:
     if what == "pdeflow":
         code, out = pdeflow(with_sets(cmd, block), cwd)
     else:
+        # a script of the repository (docs/generate, benchmarks) from the root, as typed
+        cwd = ROOT if what == "script" else cwd
         proc = subprocess.run(strip_env(cmd), cwd=cwd, capture_output=True, text=True,
                               env={**os.environ, "PYTHONPATH": str(ROOT)})
         code, out = proc.returncode, proc.stdout + proc.stderr
