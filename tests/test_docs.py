@@ -55,3 +55,16 @@ def test_cases_md_documents_every_key():
         assert f"[{section}]" in text, section
         for key in names:
             assert f"`{key}`" in text, f"{section}.{key} not documented in docs/cases.md"
+
+
+def test_readme_summary_of_the_law_agrees_with_its_page():
+    """The README's line on docs/two_layer_law.md quotes only numbers that the page's
+    question and answer (generated, above "How we know") give."""
+    readme = (ROOT / "README.md").read_text()
+    line = readme.split("[docs/two_layer_law.md](docs/two_layer_law.md)", 1)[1]
+    line = line.split("\n* ", 1)[0]
+    page = (DOCS / "two_layer_law.md").read_text().split("## How we know", 1)[0]
+    numbers = re.findall(r"(?<![\w.])\d+(?:\.\d+)?", line)
+    assert len(numbers) >= 4
+    for number in numbers:
+        assert re.search(rf"(?<![\w.]){re.escape(number)}(?![\d])", page), number

@@ -8,11 +8,16 @@ checked on finer grids, and set against published laws.
 1. Search (the paper's grid dx = 0.01 m, first-order HLL, CFL 0.3): every set of a grid
    over the closure (paper; paper with du_reg; relaxed with tau_star), phi_B, k, c and the
    wedge angle gets test 5.1 (dx = 0.05 m, t_end = 10 s) and the 5.2 sweep
-   (a = 2 .. 30). Targets (issue "The two-layer run-out law, decided", part B): 5.2 fit
-   exponent 0.84 +- 0.05 and prefactor 1.61 +- 15 %; 5.1 at rest with the lower layer
-   first; an upper layer 0.2-1 m thick (its deepest cell) at t = 0.1, 0.25, 0.4, 0.7 s.
-2. Grid convergence of the 5.2 fit for representative sets (dx = 0.01 .. 0.00125 m).
+   (a = 2 .. 30). Criteria: the paper's 5.2 fit, exponent 0.84 +- 0.05 and prefactor
+   1.61 +- 15 %; 5.1 at rest with the lower layer first; an upper layer 0.2-1 m thick
+   (its deepest cell) at t = 0.1, 0.25, 0.4, 0.7 s.
+2. Grid convergence of the 5.2 fit for representative sets (dx = 0.01 .. 0.00125 m), the
+   converged-grid map and the study maps, and the single layer on the same grids
+   (two_layer_law_single.py, cached in docs/two_layer_law_single_layer.csv).
 3. The computed r(a) against the published planar-collapse laws (REFERENCE section 4).
+
+The page opens with the question and the answer (two_layer_law_answer.py), then how
+we know, then the tables as an appendix.
 
 Search and map are plain loops written before pdeflow had a study engine (about 45 min on
 2 cores); the maps over each closure's regularisation (tau_star, du_reg) and the rest of
@@ -39,6 +44,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from two_layer_law_answer import QUESTION, answer, figure_answer  # noqa: E402
 from two_layer_law_maps import (  # noqa: E402
     STUDY_MAPS,
     TARGET_E,
@@ -50,6 +56,12 @@ from two_layer_law_maps import (  # noqa: E402
     set_params,
     stored_check,
     study_map_section,
+)
+from two_layer_law_single import (  # noqa: E402
+    by_scheme,
+    single_layer_rows,
+    single_layer_table,
+    single_layer_words,
 )
 
 from pdeflow.analysis.sweep import (  # noqa: E402
@@ -82,7 +94,7 @@ FULL = {"phi_b_deg": [28, 30, 32, 35, 38, 41, 46], "k": [0.3, 0.5, 0.65, 0.8],
 QUICK = {"phi_b_deg": [30, 35, 41], "k": [0.5, 0.65], "c": [0.03, 0.3, 3.0],
          "wedge": [60, 75]}
 
-# Part C: the fit on converged grids (MUSCL/mc, the issue's grid-study scheme) over a
+# The fit on converged grids (MUSCL/mc, the scheme of the grid studies) over a
 # sub-grid of the space, for the two regularised closures
 MAP = {"closure": ["relaxed, tau* 0.1", "paper, du_reg 0.2"], "phi_b_deg": [30, 41],
        "k": [0.5, 0.8], "c": [0.1, 1.0, 3.0], "wedge": [60]}
@@ -212,7 +224,7 @@ def _run_tasks(tasks: list[tuple[dict, float]], workers: int) -> list[dict]:
 
 
 def converged_map(workers: int, done: list[dict]) -> list[dict]:
-    """Part C: the 5.2 fit of every MAP set on the MAP_DX grids, and on REFINE_DX for the
+    """The converged map: the 5.2 fit of every MAP set on the MAP_DX grids, and on REFINE_DX for the
     sets that are sub-linear but not converged there; sweeps already in ``done`` (rows of
     the map CSV) are not rerun."""
     have = {(_map_key(r), r["dx"]) for r in done}
@@ -329,7 +341,7 @@ def convergence(params: dict, dxs: list[float], muscl: bool) -> list[dict]:
 
 
 def map_answer(groups: dict) -> list[str]:
-    """Part C in numbers: per closure, how many map sets converge (exponent change
+    """The converged map in numbers: per closure, how many map sets converge (exponent change
     < 0.01 between the two finest grids, every run at rest) and how many of those are
     sub-linear (exponent < 0.95 on the finest grid), with the range of exponents."""
     out = ["Per closure, on the finest grid (every sweep at rest):", "",
@@ -351,7 +363,7 @@ def map_answer(groups: dict) -> list[str]:
 
 
 def answers(groups: dict, conv: dict) -> list[str]:
-    """The issue's questions of part C, answered from the numbers above."""
+    """The questions of the converged map, answered from the numbers above."""
     sub, conv_sets = [], []
     for key, lv in groups.items():
         a, b = _finest_two(lv)
@@ -363,7 +375,7 @@ def answers(groups: dict, conv: dict) -> list[str]:
             conv_sets.append((key, b["exponent"]))
         if b["exponent"] < 0.95:
             sub.append((key, b["exponent"], change))
-    out = ["**Answers (from the tables above).**", ""]
+    out = ["**What the map says.**", ""]
     if conv_sets:
         es = [e for _, e in conv_sets]
         out.append("* Converged (exponent change < 0.01 between the two finest grids): "
@@ -481,8 +493,191 @@ def figure_map(rows: list[dict], path: Path) -> None:
         ax.set_xlabel("phi_B [deg]")
     for ax in axes[:, 0]:
         ax.set_ylabel("c")
-    fig.colorbar(im, ax=axes, label="5.2 exponent (k, wedge closest to the targets)")
+    fig.colorbar(im, ax=axes, label="5.2 exponent (k, wedge closest to the paper's fit)")
     save(fig, path)
+
+
+def header(args: argparse.Namespace, n: int, seconds: float) -> list[str]:
+    """The title and how the page was made."""
+    how = (" (from the stored search, map and single-layer sweeps; without `--reuse` the "
+           "full run takes about 45 min on 2 cores, plus about 3 CPU-hours for the studies "
+           "if their directories are empty; the stored tables were computed by earlier "
+           "versions of pdeflow, and the appendix measures how far the current code moves "
+           "them)" if args.reuse else f" ({seconds / 60:.0f} min on this machine)")
+    return ["# The run-out law of collapsing columns: one layer and two layers", "",
+            f"Generated by `python docs/generate/two_layer_law.py"
+            f"{' --quick' if args.quick else ''}{' --reuse' if args.reuse else ''}`{how}; "
+            f"the data: all {n} searched "
+            "two-layer sets with every measured number in "
+            "[two_layer_law_search.csv](two_layer_law_search.csv), the converged-grid map "
+            "in [two_layer_law_map.csv](two_layer_law_map.csv), the single layer in "
+            "[two_layer_law_single_layer.csv](two_layer_law_single_layer.csv), the studies "
+            "in [studies/](studies/).", ""]
+
+
+def search_section(rows: list[dict], space: dict, meet52: list[dict],
+                   meet_all: list[dict]) -> list[str]:
+    """How many sets of the search reproduce the paper's fit at its grid, per closure,
+    and the best of them against the paper's figures of test 5.1."""
+    n = len(rows)
+    lines = [
+        "### The two-layer model at the paper's grid: a search", "",
+        "The paper leaves four two-layer parameters open (its Table 1 is lost). A search "
+        "at the paper's grid (5.2: dx = 0.01 m, a = 2, 3, 4, 6, 8, 10, 14, 18, 24, 30; "
+        "5.1: dx = 0.05 m, t_end = 10 s), first-order HLL, CFL 0.3, over the closure "
+        f"({'; '.join(CLOSURES)}) x phi_B {space['phi_b_deg']} x k {space['k']}"
+        f" x c {space['c']} x wedge {space['wedge']} deg, asks for the paper's fit "
+        f"(exponent {TARGET_E} +- {TOL_E}, prefactor {TARGET_P} +- {TOL_P:.0%}) and for "
+        "what the paper shows of test 5.1: at rest (practical) with the lower layer first, "
+        "the upper layer's deepest cell between 0.2 and 1 m at t = 0.1, 0.25, 0.4 and "
+        "0.7 s (\"the upper layer flow depth ranges between 0.2 m and 1 m during almost "
+        "the whole simulation\").", "",
+        f"* {len(meet52)} of {n} sets give the paper's fit; "
+        f"{sum(1 for r in meet52 if r['rest_ok'])} of those also bring 5.1 to rest with "
+        f"the lower layer first; {len(meet_all)} meet every criterion (the tables of the "
+        "best are in the appendix)."]
+    by_closure: dict = {}
+    for r in rows:
+        d = by_closure.setdefault(r["closure"], [0, 0, 0, 0])
+        d[0] += 1
+        d[1] += r["meets_52"]
+        d[2] += r["meets_52"] and r["rest_ok"]
+        d[3] += r["meets_all"]
+    lines += ["", "| closure | sets | 5.2 fit | + 5.1 at rest, lower first | + upper layer "
+              "0.2-1 m |", "|---|---|---|---|---|"]
+    lines += [f"| {k} | {v[0]} | {v[1]} | {v[2]} | {v[3]} |" for k, v in by_closure.items()]
+    if meet_all:
+        lines += paper_51_figures(meet_all[0], meet52)
+    return lines + ["", "Exponent at dx = 0.01 m over phi_B and c for each closure (at each "
+                    "point the k and wedge angle closest to the paper's fit):", "",
+                    "![5.2 exponent maps](figures/two_layer_law_exponent_map.png)", ""]
+
+
+def _table_row(r: dict) -> str:
+    fit = "-" if r["exponent"] is None else f"{r['prefactor']:.2f} a^{r['exponent']:.3f}"
+    h1 = " / ".join(_fmt(r[f"h1max_{t}"]) for t in TIMES)
+    fr = " / ".join(_fmt(r[f"front_{t}"]) for t in TIMES)
+    return (f"| {_set_name(r)} | {fit} | {_fmt(r['lower_rest'])} / "
+            f"{_fmt(r['upper_rest'])} | {_fmt(r['front_51'])} | {h1} | {fr} | "
+            f"{_fmt(r['fextra'])} |")
+
+
+def search_tables(rows: list[dict], meet_all: list[dict]) -> list[str]:
+    """The appendix's tables of the search: the ten sets closest to the paper's fit and
+    the sets meeting every criterion."""
+    head = ("| set | 5.2 fit | 5.1 lower / upper at rest [s] | front [m] | "
+            "deepest upper cell at 0.1 / 0.25 / 0.4 / 0.7 s [m] | fronts at those times [m]"
+            " | max F_extra/rho1 |")
+    lines = ["### The search at the paper's grid", "",
+             "The ten sets closest to the paper's fit:", "", head,
+             "|---|---|---|---|---|---|---|", *(_table_row(r) for r in rows[:10])]
+    if meet_all:
+        lines += ["", "Sets meeting every criterion (best first):", "", head,
+                  "|---|---|---|---|---|---|---|", *(_table_row(r) for r in meet_all[:10])]
+    return lines
+
+
+def convergence_section(conv: dict, dxs: list[float]) -> list[str]:
+    """The representative sets of the search on finer grids."""
+    lines = ["### The two-layer law on finer grids", "",
+             "The representative sets of the search on finer grids (relaxed closure with "
+             "MUSCL/mc, the paper's closure first order as in the paper; '*': a sweep with "
+             "a run not at rest by t_end = 30 s, left out of the fit). A law counts as "
+             "converged when its exponent changes by < 0.01 between the two finest grids.",
+             "", "| set | " + " | ".join(f"dx {d}" for d in dxs) + " | change, finest two |",
+             "|---|" + "---|" * (len(dxs) + 1)]
+    for label, (muscl, levels) in conv.items():
+        cells = [("-" if lv["exponent"] is None else
+                  f"{lv['prefactor']:.2f} a^{lv['exponent']:.3f}"
+                  + ("" if lv["at_rest"] else "*")) for lv in levels]
+        e = [lv["exponent"] for lv in levels[-2:]]
+        change = "-" if None in e else f"{abs(e[1] - e[0]):.3f}"
+        lines.append(f"| {label}{' (MUSCL)' if muscl else ''} | " + " | ".join(cells)
+                     + f" | {change} |")
+    return lines
+
+
+def _map_fit(r: dict | None) -> str:
+    if r is None:
+        return ""
+    if r["exponent"] is None:
+        return "-"
+    return f"{r['prefactor']:.2f} a^{r['exponent']:.3f}{'' if r['sweep_at_rest'] else '*'}"
+
+
+def map_section(map_rows: list[dict], conv: dict) -> tuple[list[str], list[str]]:
+    """This script's converged-grid map: its summary (for the page) and its full table
+    (for the appendix)."""
+    if not map_rows:
+        return [], []
+    dxs_all = [*MAP_DX, REFINE_DX]
+    groups = _group(map_rows)
+    what = (f"phi_B {MAP['phi_b_deg']} x k {MAP['k']} x c {MAP['c']} (wedge "
+            f"{MAP['wedge'][0]} deg) for the regularised closures, MUSCL/mc on dx = "
+            f"{MAP_DX[0]} and {MAP_DX[1]} m, and on {REFINE_DX} m for the sets that are "
+            "sub-linear there but not converged")
+    table = ["", "### The converged-grid map", "", f"Map over {what} ('*': a sweep with a "
+             "run not at rest by t_end = 30 s; the fit leaves such runs out):", "",
+             "| closure | phi_B | k | c | " + " | ".join(f"fit, dx {d}" for d in dxs_all)
+             + " | change of the exponent, finest two | converged (< 0.01)? | "
+             "sub-linear (< 0.95)? |", "|---|---|---|---|" + "---|" * (len(dxs_all) + 3)]
+    for key, lv in groups.items():
+        d = _change(lv)
+        if d is None:
+            ch, conv_ok, sub = "-", "-", "-"
+        else:
+            ch, conv_ok = f"{d:.3f}", "yes" if d < 0.01 else "no"
+            sub = "yes" if lv[min(lv)]["exponent"] < 0.95 else "no"
+        table.append(f"| {key[0]} | {key[1]} | {key[2]} | {key[3]} | "
+                     + " | ".join(_map_fit(lv.get(dx)) for dx in dxs_all)
+                     + f" | {ch} | {conv_ok} | {sub} |")
+    walls = [r["wall"] for r in map_rows]
+    table += ["", f"({len(map_rows)} sweeps, {sum(walls) / 60:.0f} CPU-minutes.)"]
+    page = ["", f"A map over {what} (the table is in the appendix):", "",
+            *map_answer(groups), "", *answers(groups, conv)]
+    return page, table
+
+
+def map_found(map_rows: list[dict]) -> list[dict]:
+    """The sets of this script's map in the form of the study maps' ``found``."""
+    found = []
+    for key, lv in _group(map_rows).items():
+        d = _change(lv)
+        if d is None:
+            continue
+        fine = lv[min(lv)]
+        case = load_case(CASE_52, overrides(dict(zip(("closure", "phi_b_deg", "k", "c",
+                                                      "wedge"), key, strict=True))))
+        found.append({"closure": key[0], "set": _set_name(dict(zip(
+            ("closure", "phi_b_deg", "k", "c", "wedge"), key, strict=True))),
+            "exponent": fine["exponent"], "prefactor": fine["prefactor"], "change": d,
+            "params": set_params(case),
+            "levels": {dx: r["exponent"] for dx, r in lv.items()}})
+    return found
+
+
+def experiments_section(dist_rows: list[tuple[str, dict]]) -> list[str]:
+    """The computed r(a) against the published laws."""
+    lines = ["", "### Against experiments and DEM", "",
+             "r = (R - L0)/L0 with R the front (last cell deeper than 1 mm) in every "
+             "model; the experiments define R by the farthest grains of the deposit, "
+             "which a 1 mm threshold approximates for these 0.1 m columns. RMS distance "
+             "in log10 over a = 2 .. 30 (0.1 = a factor 1.26), and the fitted exponent "
+             "against the exponent-only laws:", "",
+             "| run | fit | " + " | ".join(LAWS) + " | "
+             + " | ".join(f"{k}: {v[0]}" for k, v in EXPONENTS.items()) + " |",
+             "|---|---|" + "---|" * (len(LAWS) + len(EXPONENTS))]
+    for label, r in dist_rows:
+        if r["exponent"] is None:
+            continue
+        d = law_distances(r["points"])
+        lines.append(f"| {label} | {r['prefactor']:.2f} a^{r['exponent']:.3f} | "
+                     + " | ".join(f"{d[k]:.3f}" for k in LAWS) + " | "
+                     + " | ".join(f"{r['exponent'] - v[0]:+.2f}" for v in
+                                  EXPONENTS.values()) + " |")
+    return lines + ["", "![r(a) against the published laws](figures/two_layer_law_r_of_a.png)",
+                    "", "The dotted lines show only the exponent-only laws' slopes (drawn "
+                    "through the paper's two-layer fit at a = 2).", ""]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -512,7 +707,7 @@ def main(argv: list[str] | None = None) -> int:
     # representative sets for the grid study and the laws
     reps = {"defaults (paper, phi_B 41, k 0.65, c 0.03, wedge 60)":
             {"closure": "paper", "phi_b_deg": 41, "k": 0.65, "c": 0.03, "wedge": 60}}
-    for label, pool in (("best of the search", rows), ("best meeting all targets",
+    for label, pool in (("best of the search", rows), ("best meeting every criterion",
                                                        meet_all)):
         if pool:
             b = pool[0]
@@ -541,10 +736,10 @@ def main(argv: list[str] | None = None) -> int:
         map_rows = converged_map(args.workers, done)
         write_csv(map_rows, map_path)
 
-    single = run_52({}, models="single_layer")
-    curves = {f"one layer (phi_B 30), fit {single['prefactor']:.2f} a^"
-              f"{single['exponent']:.2f}": single["points"]}
-    dist_rows = [("one layer, phi_B 30, dx 0.01", single)]
+    single_01 = run_52({}, models="single_layer")
+    curves = {f"one layer (phi_B 30), fit {single_01['prefactor']:.2f} a^"
+              f"{single_01['exponent']:.2f}": single_01["points"]}
+    dist_rows = [("one layer, phi_B 30, first order, dx 0.01", single_01)]
     for label, (muscl, levels) in conv.items():
         scheme = "MUSCL" if muscl else "first order"
         for lv in (levels[0], levels[-1]):
@@ -557,168 +752,50 @@ def main(argv: list[str] | None = None) -> int:
     figure_map(rows, docs / "figures" / "two_layer_law_exponent_map.png")
     figure_convergence(conv, map_rows, docs / "figures" / "two_layer_law_convergence.png")
 
-    n = len(rows)
-    lines = [
-        "# The two-layer run-out law of test 5.2",
-        "",
-        f"Generated by `python docs/generate/two_layer_law.py{' --quick' if args.quick else ''}`"
-        + (" (this copy from the stored search and map, `--reuse`; the full run takes "
-           "about 45 min on 2 cores, plus about 3 CPU-hours for the studies if their "
-           "directories are empty; the stored tables and the studies were computed by "
-           "earlier versions of pdeflow: how far the current code moves them is measured "
-           "at the end of part C)" if args.reuse else
-           f" ({(time.perf_counter() - t_start) / 60:.0f} min on this machine)")
-        + f"; all {n} "
-        "searched sets with every measured number: "
-        "[two_layer_law_search.csv](two_layer_law_search.csv); the converged-grid map: "
-        "[two_layer_law_map.csv](two_layer_law_map.csv).",
-        "",
-        "## B. Sets that reproduce the paper's fit at its resolution",
-        "",
-        "Search at the paper's grid (5.2: dx = 0.01 m, a = 2, 3, 4, 6, 8, 10, 14, 18, 24, "
-        "30; 5.1: dx = 0.05 m, t_end = 10 s), first-order HLL, CFL 0.3, over the closure "
-        f"({'; '.join(CLOSURES)}) x phi_B {space['phi_b_deg']} x k {space['k']}"
-        f" x c {space['c']} x wedge {space['wedge']} deg. Targets: exponent "
-        f"{TARGET_E} +- {TOL_E}, prefactor {TARGET_P} +- {TOL_P:.0%}; 5.1 at rest "
-        "(practical) with the lower layer first; the upper layer's deepest cell between "
-        "0.2 and 1 m at t = 0.1, 0.25, 0.4 and 0.7 s (the paper: \"the upper layer flow "
-        "depth ranges between 0.2 m and 1 m during almost the whole simulation\").",
-        "",
-        f"* {len(meet52)} of {n} sets meet the 5.2 targets; "
-        f"{sum(1 for r in meet52 if r['rest_ok'])} of those also bring 5.1 to rest with "
-        f"the lower layer first; {len(meet_all)} meet every target.",
-    ]
-    by_closure = {}
-    for r in rows:
-        d = by_closure.setdefault(r["closure"], [0, 0, 0, 0])
-        d[0] += 1
-        d[1] += r["meets_52"]
-        d[2] += r["meets_52"] and r["rest_ok"]
-        d[3] += r["meets_all"]
-    lines += ["", "| closure | sets | 5.2 fit | + 5.1 at rest, lower first | + upper layer "
-              "0.2-1 m |", "|---|---|---|---|---|"]
-    lines += [f"| {k} | {v[0]} | {v[1]} | {v[2]} | {v[3]} |" for k, v in by_closure.items()]
-    head = ("| set | 5.2 fit | 5.1 lower / upper at rest [s] | front [m] | "
-            "deepest upper cell at 0.1 / 0.25 / 0.4 / 0.7 s [m] | fronts at those times [m]"
-            " | max F_extra/rho1 |")
-    lines += ["", "The ten sets closest to the 5.2 targets:", "", head,
-              "|---|---|---|---|---|---|---|"]
-
-    def table_row(r: dict) -> str:
-        fit = ("-" if r["exponent"] is None
-               else f"{r['prefactor']:.2f} a^{r['exponent']:.3f}")
-        h1 = " / ".join(_fmt(r[f"h1max_{t}"]) for t in TIMES)
-        fr = " / ".join(_fmt(r[f"front_{t}"]) for t in TIMES)
-        return (f"| {_set_name(r)} | {fit} | {_fmt(r['lower_rest'])} / "
-                f"{_fmt(r['upper_rest'])} | {_fmt(r['front_51'])} | {h1} | {fr} | "
-                f"{_fmt(r['fextra'])} |")
-
-    lines += [table_row(r) for r in rows[:10]]
-    if meet_all:
-        lines += ["", "Sets meeting every target (best first):", "", head,
-                  "|---|---|---|---|---|---|---|"]
-        lines += [table_row(r) for r in meet_all[:10]]
-    if meet_all:
-        lines += paper_51_figures(meet_all[0], meet52)
-    lines += ["", "Exponent at dx = 0.01 m over phi_B and c for each closure (at each point "
-              "the k and wedge angle closest to the targets):", "",
-              "![5.2 exponent maps](figures/two_layer_law_exponent_map.png)", ""]
-    lines += ["## C. The fit on finer grids", "",
-              "The same sets on finer grids (relaxed closure with MUSCL/mc, the paper's "
-              "closure first order as in the paper; '*': a sweep with a run not at rest by "
-              "t_end = 30 s, left out of the fit). Target of the issue: the exponent "
-              "changes by < 0.01 between the two finest grids.", "",
-              "| set | " + " | ".join(f"dx {d}" for d in dxs) + " | change, finest two |",
-              "|---|" + "---|" * (len(dxs) + 1)]
-    for label, (muscl, levels) in conv.items():
-        cells = [("-" if lv["exponent"] is None else
-                  f"{lv['prefactor']:.2f} a^{lv['exponent']:.3f}"
-                  + ("" if lv["at_rest"] else "*")) for lv in levels]
-        e = [lv["exponent"] for lv in levels[-2:]]
-        change = "-" if None in e else f"{abs(e[1] - e[0]):.3f}"
-        lines.append(f"| {label}{' (MUSCL)' if muscl else ''} | " + " | ".join(cells)
-                     + f" | {change} |")
-    if map_rows:
-        dxs_all = [*MAP_DX, REFINE_DX]
-        lines += ["", f"Map over phi_B {MAP['phi_b_deg']} x k {MAP['k']} x c {MAP['c']} "
-                  f"(wedge {MAP['wedge'][0]} deg) for the regularised closures, MUSCL/mc on "
-                  f"dx = {MAP_DX[0]} and {MAP_DX[1]} m, and on {REFINE_DX} m for the sets "
-                  "that are sub-linear there but not converged ('*': a sweep with a run not "
-                  "at rest by t_end = 30 s; the fit leaves such runs out):", "",
-                  "| closure | phi_B | k | c | "
-                  + " | ".join(f"fit, dx {d}" for d in dxs_all)
-                  + " | change of the exponent, finest two | converged (< 0.01)? | "
-                  "sub-linear (< 0.95)? |", "|---|---|---|---|" + "---|" * (len(dxs_all) + 3)]
-        groups = _group(map_rows)
-
-        def fit(r: dict | None) -> str:
-            if r is None:
-                return ""
-            if r["exponent"] is None:
-                return "-"
-            star = "" if r["sweep_at_rest"] else "*"
-            return f"{r['prefactor']:.2f} a^{r['exponent']:.3f}{star}"
-
-        for key, lv in groups.items():
-            d = _change(lv)
-            finest = lv[min(lv)]
-            if d is None:
-                ch, conv_ok, sub = "-", "-", "-"
-            else:
-                ch, conv_ok = f"{d:.3f}", "yes" if d < 0.01 else "no"
-                sub = "yes" if finest["exponent"] < 0.95 else "no"
-            lines.append(f"| {key[0]} | {key[1]} | {key[2]} | {key[3]} | "
-                         + " | ".join(fit(lv.get(dx)) for dx in dxs_all)
-                         + f" | {ch} | {conv_ok} | {sub} |")
-        walls = [r["wall"] for r in map_rows]
-        lines += ["", f"({len(map_rows)} sweeps, {sum(walls) / 60:.0f} CPU-minutes.)"]
-        lines += ["", *map_answer(groups), "", *answers(groups, conv)]
+    single = single_layer_rows(docs / "two_layer_law_single_layer.csv",
+                               run_missing=not args.quick)
+    mu = by_scheme(single)["MUSCL/mc"][-1]
+    dist_rows.append((f"one layer, phi_B 30, MUSCL/mc, dx {mu['dx']}",
+                      {**mu, "points": [[float(a), float(r)] for a, r in
+                                        (p.split(":") for p in mu["points"].split())]}))
+    lines = header(args, len(rows), time.perf_counter() - t_start) + QUESTION
+    search_lines = search_section(rows, space, meet52, meet_all)
+    conv_lines = convergence_section(conv, dxs)
+    map_lines, appendix_map = map_section(map_rows, conv)
     if not (args.reuse or args.quick):
         run_studies(docs, args.workers)
     found: list[dict] = []
-    for name in STUDY_MAPS:
-        lines += study_map_section(docs, name, found)
+    study_lines = [ln for name in STUDY_MAPS for ln in study_map_section(docs, name, found)]
     if found:
-        lines += overall_answer(found)
         figure_study_convergence(found, docs / "figures" /
                                  "two_layer_law_study_convergence.png")
-    for key, lv in _group(map_rows).items():  # the map of this script
-        d = _change(lv)
-        if d is not None:
-            fine = lv[min(lv)]
-            case = load_case(CASE_52, overrides(dict(zip(("closure", "phi_b_deg", "k", "c",
-                                                          "wedge"), key, strict=True))))
-            found.append({"closure": key[0], "exponent": fine["exponent"],
-                          "prefactor": fine["prefactor"], "change": d,
-                          "params": set_params(case), "levels": {
-                              dx: r["exponent"] for dx, r in lv.items()}})
+    found_studies = list(found)
+    found += map_found(map_rows)
+    figure_answer(single, found, docs / "figures" / "two_layer_law_answer.png")
+    lines += answer(single, found, len(rows), len(meet52))
+    lines += ["## How we know", "", "### The single layer on the same grids", "",
+              "`pdeflow sweep cases/collapse_sweep.toml --set \"case.models=['single_layer']"
+              "\" --set grid.dx=D`, and the same with `--set \"numerics.reconstruction="
+              "'muscl'\" --set \"numerics.limiter='mc'\"` (the scheme of the two-layer maps "
+              "below); cached in [two_layer_law_single_layer.csv](two_layer_law_single_layer"
+              ".csv) ('*': a sweep with a run not at rest by t_end):", "",
+              *single_layer_table(single), "", single_layer_words(single), ""]
+    lines += search_lines + conv_lines + map_lines
+    if found_studies:
+        lines += overall_answer(found_studies)
     lines += law_answer(found)
+    lines += ["", "![the 5.2 exponent against dx](figures/two_layer_law_convergence.png)"]
+    lines += experiments_section(dist_rows)
+    lines += ["## Appendix: the tables", "", *search_tables(rows, meet_all), *appendix_map]
+    if study_lines:
+        lines += ["", "### The study maps", "", "The maps over each closure's "
+                  "regularisation and the other parameters (studies run by `pdeflow "
+                  "study`, read from their results tables):", *study_lines]
     if args.reuse:
         by_name = {_set_name(r): r for r in rows}
-        lines += stored_check(docs, conv, {label: by_name[name] for label in conv
-                                           if (name := label[label.find("(") + 1:-1])
-                                           in by_name})
-    lines += ["", "![the 5.2 exponent against dx](figures/two_layer_law_convergence.png)"]
-    lines += ["", "## D. Against experiments and DEM", "",
-              "r = (R - L0)/L0 with R the front (last cell deeper than 1 mm) in every "
-              "model; the experiments define R by the farthest grains of the deposit, "
-              "which a 1 mm threshold approximates for these 0.1 m columns. RMS distance "
-              "in log10 over a = 2 .. 30 (0.1 = a factor 1.26), and the fitted exponent "
-              "against the exponent-only laws:", "",
-              "| run | fit | " + " | ".join(LAWS) + " | "
-              + " | ".join(f"{k}: {v[0]}" for k, v in EXPONENTS.items()) + " |",
-              "|---|---|" + "---|" * (len(LAWS) + len(EXPONENTS))]
-    for label, r in dist_rows:
-        if r["exponent"] is None:
-            continue
-        d = law_distances(r["points"])
-        lines.append(f"| {label} | {r['prefactor']:.2f} a^{r['exponent']:.3f} | "
-                     + " | ".join(f"{d[k]:.3f}" for k in LAWS) + " | "
-                     + " | ".join(f"{r['exponent'] - v[0]:+.2f}" for v in
-                                  EXPONENTS.values()) + " |")
-    lines += ["", "![r(a) against the published laws](figures/two_layer_law_r_of_a.png)",
-              "", "The dotted lines show only the exponent-only laws' slopes (drawn "
-              "through the paper's two-layer fit at a = 2).", ""]
+        lines += ["", "### Stored results against the current code", *stored_check(
+            docs, conv, {label: by_name[name] for label in conv
+                         if (name := label[label.find("(") + 1:-1]) in by_name})[1:]]
     out = docs / "two_layer_law.md"
     write_text(out, "\n".join(lines))
     print(f"wrote {out}")

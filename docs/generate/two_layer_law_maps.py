@@ -1,6 +1,6 @@
-"""Part C of docs/two_layer_law.md from the study maps: the tables of the studies
+"""The converged maps of docs/two_layer_law.md from the study maps: the tables of the studies
 ``cases/study_two_layer_law_*.toml`` (run by ``pdeflow study``; this module only reads
-their results tables), their summary, the exponent-against-dx figure and the answer to C
+their results tables), their summary, the exponent-against-dx figure and the answer
 in words (used by docs/generate/two_layer_law.py)."""
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from pdeflow.cases import load_case, tomllib
 from pdeflow.plotting import log_ticks, save
 
 ROOT = Path(__file__).resolve().parents[2]
-TARGET_E, TOL_E = 0.84, 0.05  # the paper's two-layer exponent and the issue's tolerance
+TARGET_E, TOL_E = 0.84, 0.05  # the paper's two-layer exponent and the search's tolerance
 
 
 STUDY_MAPS = {  # study name -> (varied keys, what the map above holds, closure, fixed)
@@ -58,7 +58,7 @@ def study_rows(docs: Path, name: str) -> tuple[list[dict], list[Path]]:
 
 
 def study_map_section(docs: Path, name: str, found: list[dict]) -> list[str]:
-    """Part C over one closure's regularisation, from a study's results table; appends
+    """The converged map over one closure's regularisation, from a study's results table; appends
     every set whose finest two grids have a fit to ``found`` (closure, set name, its
     exponent on each grid, on the finest one and the change between the finest two)."""
     keys, held, closure, fixed = STUDY_MAPS[name]
@@ -154,23 +154,44 @@ def set_params(case: Any) -> dict:
                                                     45.0 + p.phi_int_deg / 2))}
 
 
-def _span(values: list[float], unit: str = "") -> str:
+def span(values: list[float], unit: str = "") -> str:
     lo, hi = min(values), max(values)
     return f"{lo:g}{unit}" if lo == hi else f"{lo:g}-{hi:g}{unit}"
 
 
-def law_answer(found: list[dict]) -> list[str]:
-    """Part C's question in words, from every set mapped on two fine grids (the map of
-    this script and the study maps; a set mapped twice counts once, with its finest
-    grids): where the converged law is sub-linear, and with which regularisation."""
+def distinct_sets(found: list[dict]) -> dict:
+    """Every set mapped on two fine grids once (a set of this script's map and of a study
+    map counts once, with its finest grids), by its parameters."""
     sets: dict = {}
     for f in found:
         p = f["params"]
         key = (p["closure"], p["reg"], p["phi_b_deg"], p["k"], p["c"], p["wedge"])
         if key not in sets or min(f["levels"]) < min(sets[key]["levels"]):
             sets[key] = f
+    return sets
+
+
+def law_summary(found: list[dict]) -> dict:
+    """The converged sets per closure ('paper', 'relaxed'): all, sub-linear (< 0.95)
+    and the rest; and how many distinct sets there are."""
+    sets = distinct_sets(found)
     conv = [f for f in sets.values() if f["change"] < 0.01]
-    out = ["", f"**Answer to C.** {len(sets)} distinct sets were mapped on at least two "
+    out: dict = {"sets": len(sets), "converged": len(conv)}
+    for closure in ("paper", "relaxed"):
+        mine = [f for f in conv if f["params"]["closure"] == closure]
+        out[closure] = {"converged": mine,
+                        "sub": [f for f in mine if f["exponent"] < 0.95],
+                        "super": [f for f in mine if f["exponent"] >= 0.95]}
+    return out
+
+
+def law_answer(found: list[dict]) -> list[str]:
+    """The converged maps in words, from every set mapped on two fine grids (the map of
+    this script and the study maps; a set mapped twice counts once, with its finest
+    grids): where the converged law is sub-linear, and with which regularisation."""
+    sets = distinct_sets(found)
+    conv = [f for f in sets.values() if f["change"] < 0.01]
+    out = ["", f"**In words.** {len(sets)} distinct sets were mapped on at least two "
            f"fine grids (MUSCL/mc); the exponent converged (change < 0.01 between the "
            f"finest two) in {len(conv)}."]
     for closure, name in (("paper", "the paper's closure bounded by du_reg"),
@@ -181,19 +202,19 @@ def law_answer(found: list[dict]) -> list[str]:
                   and f["change"] >= 0.01 and f["exponent"] < 0.95]
         text = f"* With {name}: {len(mine)} converged sets"
         if mine:
-            text += f", exponents {_span([round(f['exponent'], 3) for f in mine])}"
+            text += f", exponents {span([round(f['exponent'], 3) for f in mine])}"
         if sub:
             ps = [f["params"] for f in sub]
             reg = ps[0]["reg"][0]
             corner = [f for f in mine if all(
                 f["params"][k] >= min(p[k] for p in ps) for k in ("phi_b_deg", "k", "c"))]
             text += (f"; sub-linear: {len(sub)} of them, all with phi_B "
-                     f"{_span([p['phi_b_deg'] for p in ps], ' deg')}, k "
-                     f"{_span([p['k'] for p in ps])}, c {_span([p['c'] for p in ps])}, "
-                     f"{reg} {_span([p['reg'][1] for p in ps])}, wedge "
-                     f"{_span([p['wedge'] for p in ps], ' deg')}: exponents "
-                     f"{_span([round(f['exponent'], 3) for f in sub])}, prefactors "
-                     f"{_span([round(f['prefactor'], 2) for f in sub])} (the paper at "
+                     f"{span([p['phi_b_deg'] for p in ps], ' deg')}, k "
+                     f"{span([p['k'] for p in ps])}, c {span([p['c'] for p in ps])}, "
+                     f"{reg} {span([p['reg'][1] for p in ps])}, wedge "
+                     f"{span([p['wedge'] for p in ps], ' deg')}: exponents "
+                     f"{span([round(f['exponent'], 3) for f in sub])}, prefactors "
+                     f"{span([round(f['prefactor'], 2) for f in sub])} (the paper at "
                      f"dx = 0.01 m: 1.61 a^0.84); of the converged sets with phi_B, k and "
                      f"c at least those lowest values, {len(sub)} of {len(corner)} are "
                      "sub-linear")
@@ -201,8 +222,8 @@ def law_answer(found: list[dict]) -> list[str]:
             text += "; none sub-linear"
         if moving:
             text += (f". {len(moving)} more are sub-linear on their finest grid but not "
-                     f"converged (exponents {_span([round(f['exponent'], 3) for f in moving])}"
-                     f", changes {_span([round(f['change'], 3) for f in moving])})")
+                     f"converged (exponents {span([round(f['exponent'], 3) for f in moving])}"
+                     f", changes {span([round(f['change'], 3) for f in moving])})")
         out.append(text + ".")
     relapsed = []
     for f in sets.values():
@@ -219,9 +240,9 @@ def law_answer(found: list[dict]) -> list[str]:
 
 
 def overall_answer(found: list[dict]) -> list[str]:
-    """Part C across the study maps: per closure, the sets converged on the finest two
+    """The study maps together: per closure, the sets converged on the finest two
     grids, and which of them are sub-linear."""
-    out = ["", "**Part C across the study maps** (MUSCL/mc; converged: the exponent "
+    out = ["", "**The study maps together** (MUSCL/mc; converged: the exponent "
            "changes by < 0.01 between a set's two finest grids; the fits leave out runs "
            "not at rest by t_end):", "",
            "| closure | sets | converged | converged exponents | converged and "
@@ -270,7 +291,7 @@ STORED_CHECKS = [  # (study, the set's varied values, grids): recomputed by stor
     ("two_layer_law_du_reg", {"two_layer.du_reg": 0.05, "two_layer.phi_b_deg": 41,
                               "two_layer.c": 1.0}, [0.00125, 0.000625]),
 ]
-"""a converged sub-linear set of part C, recomputed with the current code on every run of
+"""a converged sub-linear set of the maps, recomputed with the current code on every run of
 the generator, against its stored study results"""
 
 
