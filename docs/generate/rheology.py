@@ -18,6 +18,7 @@ directory).
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from pathlib import Path
@@ -30,6 +31,7 @@ from rheology_page import render_page
 from pdeflow.io import write_json, write_text
 
 ROOT = Path(__file__).resolve().parents[2]
+BENCH = ROOT / "benchmarks" / "measurements" / "bench.json"
 
 
 def arguments(argv: list[str] | None) -> argparse.Namespace:
@@ -52,6 +54,17 @@ def arguments(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--axisymmetric-length", type=float,
                     default=runs.LENGTH["axisymmetric"], help="radial domain [m]")
     return ap.parse_args(argv)
+
+
+def stored_cost(path: Path = BENCH) -> dict | None:
+    """The friction-law rows of the stored benchmark results (docs/performance.md's
+    section, ``python benchmarks/run_benchmarks.py --only laws``), if measured."""
+    if not path.is_file():
+        return None
+    b = json.loads(path.read_text())
+    if not b.get("friction_laws"):
+        return None
+    return {"rows": b["friction_laws"], "conditions": b.get("friction_laws_conditions")}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -78,6 +91,7 @@ def main(argv: list[str] | None = None) -> int:
     numbers = page_numbers(rows)
     numbers["static_angles"] = {g: runs.static_angles(g) for g in ("planar", "axisymmetric")}
     numbers["static_depth"] = runs.STATIC_DEPTH
+    numbers["cost"] = stored_cost()
     numbers["figures"] = figures(numbers, out)
     numbers["generator_wall_s"] = round(time.perf_counter() - t0, 1)
     write_json(out / "rheology" / "numbers.json", numbers)

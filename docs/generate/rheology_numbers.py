@@ -22,6 +22,8 @@ from pdeflow.analysis.sweep import fit_power_law, published_law
 LUBE_PLANAR = "Lube et al. 2005"
 LUBE_FROM = 2.8
 """a above which the planar law's power-law branch holds (and the planar misfit counts)"""
+COST_NOTE = "time steps to the estimated stop time"
+"""a phrase of the run's cost-estimate warning (not a problem of the run)"""
 CONVERGED = 0.01
 """largest relative change of r(a) per grid halving that counts as converged (the
 threshold of docs/axisymmetric.md)"""
@@ -114,6 +116,23 @@ def stable_from(rankings: list[list[str]], grids: list[float]) -> float | None:
     return grids[k]
 
 
+def close_pairs(per: dict[str, dict[float, dict[str, Any]]], rank: list[str],
+                grids: list[float]) -> list[list[Any]]:
+    """Neighbours of the finest ranking whose misfits differ by less than either moved
+    in the last halving (a pair the next grid could still swap): [law, law, gap,
+    larger last change]."""
+    if len(grids) < 2:
+        return []
+    moved = {law: abs(per[law][grids[-1]]["misfit"] - per[law][grids[-2]]["misfit"])
+             for law in rank}
+    out = []
+    for a, b in zip(rank[:-1], rank[1:], strict=True):
+        gap = per[b][grids[-1]]["misfit"] - per[a][grids[-1]]["misfit"]
+        if gap <= max(moved[a], moved[b]):
+            out.append([a, b, gap, max(moved[a], moved[b])])
+    return out
+
+
 def geometry_numbers(rows: list[dict[str, Any]], geometry: str) -> dict[str, Any]:
     """Every number of one geometry: per model the grids, per law set and grid the
     :func:`grid_numbers`, the :func:`convergence`, and the ranking per grid."""
@@ -134,7 +153,8 @@ def geometry_numbers(rows: list[dict[str, Any]], geometry: str) -> dict[str, Any
             "per_grid": {law: {repr(g): v for g, v in per[law].items()} for law in laws},
             "convergence": {law: convergence(rows, geometry, model, law, grids)
                             for law in laws},
-            "rankings": ranks, "ranking_stable_from": stable_from(ranks, grids)}
+            "rankings": ranks, "ranking_stable_from": stable_from(ranks, grids),
+            "close_pairs": close_pairs(per, ranks[-1], grids)}
     return out
 
 
@@ -143,5 +163,10 @@ def page_numbers(rows: list[dict[str, Any]]) -> dict[str, Any]:
     return {"planar": geometry_numbers(rows, "planar"),
             "axisymmetric": geometry_numbers(rows, "axisymmetric"),
             "runs": len(rows),
+            "all_at_rest": all(x["at_rest"] for x in rows),
+            "max_mass_error": max((x["mass_relative_error"] or 0.0 for x in rows),
+                                  default=0.0),
+            "other_warnings": sorted({w for x in rows for w in x["warnings"].split(" | ")
+                                      if w and COST_NOTE not in w}),
             "wall_s": round(sum(x["wall_time_s"] or 0.0 for x in rows), 1),
             "converged_threshold": CONVERGED}

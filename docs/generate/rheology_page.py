@@ -57,9 +57,12 @@ def summary_lines(numbers: dict[str, Any]) -> list[str]:
                         f"{numbers['converged_threshold']:.0%}: "
                         f"{', '.join(conv) if conv else 'none'}" if worst else
                         "one grid only: convergence not measured")
+            close = "; ".join(f"{a} and {b} differ by {gap:.3g}, less than their last "
+                              f"change {ch:.3g}" for a, b, gap, ch in m["close_pairs"])
             out.append(f"* **{geometry}, {model}**: closest is **{best}** (distance "
                        f"{mis:.3f} on dx = {m['grids'][-1]:g} m); ranking {rank}, "
-                       f"{stable_txt}; {conv_txt}.")
+                       f"{stable_txt}" + (f" (but {close})" if close else "")
+                       + f"; {conv_txt}.")
     return out
 
 
@@ -167,6 +170,24 @@ def lagree_lines(numbers: dict[str, Any]) -> list[str]:
     return out
 
 
+def cost_lines(cost: dict[str, Any] | None) -> list[str]:
+    """The stored friction-law benchmark (docs/performance.md) against issue 23's target."""
+    if not cost:
+        return ["Not measured yet (`python benchmarks/run_benchmarks.py --only laws`)."]
+    c = cost.get("conditions") or {}
+    load = c.get("load_avg_at_start")
+    per = "; ".join(f"{r['model']} {r['law']} {r['ratio']:.2f}x" for r in cost["rows"])
+    met = {r["model"]: r["ratio"] <= 1.2 for r in cost["rows"] if r["law"] == "pouliquen"}
+    verdict = ", ".join(f"{m}: {'met' if ok else 'missed'}" for m, ok in met.items())
+    return [f"Time per cell update against Coulomb's, paired and interleaved in one run "
+            f"(docs/performance.md, `python benchmarks/run_benchmarks.py --only laws`, "
+            f"{c.get('date', '?')}, load average {load[0]:.2f} on {c.get('cores')} shared "
+            f"cores at the start): {per}. Issue 23's target, pouliquen at most 1.2x: "
+            f"{verdict}. On a machine this loaded the ratios differ from run to run (docs/"
+            "model.md lists earlier measurements), so one run decides little."
+            if load else f"Per cell update against Coulomb's: {per}."]
+
+
 def render_page(numbers: dict[str, Any], figs: dict[str, str]) -> str:
     """docs/rheology.md."""
     lines = [
@@ -182,7 +203,10 @@ def render_page(numbers: dict[str, Any], figs: dict[str, str]) -> str:
         "mu(I) constants of Lagree, Staron & Popinet (2011) (`mu_i_lagree`). The laws are "
         "not calibrated to the experiments: this compares their shapes at their papers' "
         "values.\n",
-        "## The answer\n", *summary_lines(numbers), "", *static_lines(numbers),
+        "## The answer\n", *summary_lines(numbers), "",
+        f"Checks: every run ended at rest: {numbers['all_at_rest']}; largest relative mass "
+        f"error {numbers['max_mass_error']:.1e}; run warnings other than the cost "
+        f"estimate: {'; '.join(numbers['other_warnings']) or 'none'}.\n", *static_lines(numbers),
         "\"Distance\" is the planar misfit or the axisymmetric distance of the tables "
         "below. Change per halving: the largest |r_fine/r_coarse - 1| over the aspect "
         "ratios, for each halving of dx, coarse to fine. Tail estimate (Richardson-type, "
@@ -198,7 +222,5 @@ def render_page(numbers: dict[str, Any], figs: dict[str, str]) -> str:
     lines += ["## Ranking and convergence per grid\n", *ranking_lines(numbers), "",
               f"![change per halving]({figs['convergence']})\n", *lagree_lines(numbers),
               PARAMETERS,
-              "## Cost\n", "The cost of a law per cell update is measured by the "
-              "benchmark row in docs/performance.md (`python benchmarks/run_benchmarks.py "
-              "--only bench`), not on this page.", ""]
+              "## Cost\n", *cost_lines(numbers.get("cost")), ""]
     return "\n".join(lines)
