@@ -338,3 +338,43 @@ def test_a_study_over_laws_warms_every_law_bundle(tmp_path):
     system = pdeflow.SingleLayerGranular.system
     assert system.kernels.sources in kernels
     assert system.law_kernels.sources in kernels
+
+
+def _cached_rows():
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    sys.path.insert(0, str(root / "docs" / "generate"))
+    try:
+        import rheology_runs
+    finally:
+        sys.path.remove(str(root / "docs" / "generate"))
+    return rheology_runs, rheology_runs.read_cache(root / "docs" / "rheology" / "sweep.csv")
+
+
+def _check_reruns(points):
+    runs, rows = _cached_rows()
+    cached = {runs.key(r): r for r in rows}
+    for p in points:
+        new = runs.measure(p)
+        old = cached[p]
+        assert new["r"] == old["r"] and new["steps"] == old["steps"], (p, new, old)
+        assert new["at_rest"] and old["at_rest"], p
+
+
+def test_cached_law_sweep_rows_are_what_the_code_gives():
+    """Three points of docs/rheology/sweep.csv (planar and radial, both models, three
+    laws) run again give the cached run-out and step count exactly."""
+    _check_reruns([("planar", "single_layer", "coulomb", 0.01, 2.0),
+                   ("planar", "two_layer", "pouliquen", 0.01, 4.0),
+                   ("axisymmetric", "single_layer", "mu_i", 0.00125, 1.0)])
+
+
+@pytest.mark.slow
+def test_cached_law_sweep_coarsest_grids_rerun():
+    """Every point of the coarsest planar and radial grids of docs/rheology/sweep.csv
+    run again gives the cached run-out exactly (minutes)."""
+    runs, _ = _cached_rows()
+    _check_reruns([p for p in runs.all_points()
+                   if p[3] == runs.GRIDS[p[0]][0]])

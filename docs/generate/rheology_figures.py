@@ -49,10 +49,11 @@ def convergence_figure(numbers: dict[str, Any], path: Path) -> Path:
     for ax, geometry in zip(axes, ("planar", "axisymmetric"), strict=True):
         for model, m in numbers[geometry].items():
             style = "-" if model == "single_layer" else "--"
-            for law in m["laws"]:
+            for k, law in enumerate(m["laws"]):
                 ch = m["convergence"][law]["changes"]
                 if ch:
-                    ax.loglog(m["grids"][1:], ch, "o" + style, ms=3, label=f"{model} {law}")
+                    ax.loglog(m["grids"][1:len(ch) + 1], ch, "o" + style, ms=3,
+                              color=f"C{k}", label=f"{model} {law}")
         ax.axhline(numbers["converged_threshold"], color="k", lw=0.8)
         ax.invert_xaxis()
         ax.set(title=geometry, xlabel="finer dx of the halving [m]",
