@@ -81,7 +81,9 @@ def grid_numbers(rows: list[dict[str, Any]], geometry: str, model: str, law: str
 
 def convergence(rows: list[dict[str, Any]], geometry: str, model: str, law: str,
                 grids: list[float]) -> dict[str, Any]:
-    """Per grid halving the largest relative change of r over a, and a Richardson-type
+    """Per grid halving the largest relative change of r over a; ``converged_from``, the
+    coarsest grid from which on every halving changes r by at most CONVERGED (None: the
+    last one changed it more); and a Richardson-type
     tail: if every point's change keeps shrinking by the factor q of its last two
     changes, the finest grid is off by change * q / (1 - q) (None when q >= 1 at some
     a: not yet in the range where the changes shrink steadily)."""
@@ -96,8 +98,12 @@ def convergence(rows: list[dict[str, Any]], geometry: str, model: str, law: str,
         q[(c1 == 0) & (c2 > 0)] = math.inf
         if np.all(q < 1):
             tail = float(np.max(c2 * q / (1 - q) / np.abs(curves[-1])))
+    k = len(changes)
+    while k > 0 and changes[k - 1] <= CONVERGED:
+        k -= 1
     return {"changes": changes, "tail": tail,
-            "converged": bool(changes) and changes[-1] <= CONVERGED}
+            "converged": bool(changes) and changes[-1] <= CONVERGED,
+            "converged_from": grids[k] if k < len(changes) else None}
 
 
 def ranking(per_grid: dict[str, dict[str, Any]]) -> list[str]:
