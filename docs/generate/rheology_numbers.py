@@ -22,6 +22,10 @@ from pdeflow.analysis.sweep import fit_power_law, published_law
 LUBE_PLANAR = "Lube et al. 2005"
 LUBE_FROM = 2.8
 """a above which the planar law's power-law branch holds (and the planar misfit counts)"""
+Q_MAX = 0.8
+"""largest ratio of successive changes for which the tail estimate is given: nearer 1 the
+geometric tail q/(1 - q) explodes, and a run-out is only resolved to one cell (dx/L0), so
+a ratio of two changes of a cell or two is noise"""
 COST_NOTE = "time steps to the estimated stop time"
 """a phrase of the run's cost-estimate warning (not a problem of the run)"""
 CONVERGED = 0.01
@@ -85,7 +89,7 @@ def convergence(rows: list[dict[str, Any]], geometry: str, model: str, law: str,
     coarsest grid from which on every halving changes r by at most CONVERGED (None: the
     last one changed it more); and a Richardson-type
     tail: if every point's change keeps shrinking by the factor q of its last two
-    changes, the finest grid is off by change * q / (1 - q) (None when q >= 1 at some
+    changes, the finest grid is off by change * q / (1 - q) (None when q > Q_MAX at some
     a: not yet in the range where the changes shrink steadily)."""
     curves = [curve(rows, geometry, model, law, g)[1] for g in grids]
     changes = [float(np.max(np.abs(f - c) / np.abs(f))) for c, f in zip(
@@ -96,7 +100,7 @@ def convergence(rows: list[dict[str, Any]], geometry: str, model: str, law: str,
         c2 = np.abs(curves[-1] - curves[-2])
         q = np.divide(c2, c1, out=np.zeros_like(c2), where=c1 > 0)
         q[(c1 == 0) & (c2 > 0)] = math.inf
-        if np.all(q < 1):
+        if np.all(q <= Q_MAX):
             tail = float(np.max(c2 * q / (1 - q) / np.abs(curves[-1])))
     k = len(changes)
     while k > 0 and changes[k - 1] <= CONVERGED:
@@ -151,11 +155,13 @@ def geometry_numbers(rows: list[dict[str, Any]], geometry: str) -> dict[str, Any
         grids = [g for g in grids if all(  # complete grids only (every law, every a)
             {x["a"] for x in mine if x["law"] == law and x["dx"] == g} == ratios
             for law in laws)]
+        partial = [[g, sum(1 for x in mine if x["dx"] == g), len(laws) * len(ratios)]
+                   for g in sorted({x["dx"] for x in mine}, reverse=True) if g not in grids]
         per = {law: {g: grid_numbers(rows, geometry, model, law, g) for g in grids}
                for law in laws}
         ranks = [ranking({law: per[law][g] for law in laws}) for g in grids]
         out[model] = {
-            "grids": grids, "laws": laws,
+            "grids": grids, "laws": laws, "partial_grids": partial,
             "per_grid": {law: {repr(g): v for g, v in per[law].items()} for law in laws},
             "convergence": {law: convergence(rows, geometry, model, law, grids)
                             for law in laws},
