@@ -135,6 +135,17 @@ def measure_wp(quick: bool, repeats: int, results: Path = RESULTS) -> dict[str, 
     return out
 
 
+def measure_laws(repeats: int) -> dict[str, Any]:
+    """The basal friction laws against Coulomb (suite.friction_law_costs, paired and
+    interleaved in one run), with the machine's load before and after."""
+    _log("basal friction laws against Coulomb ...")
+    before = conditions()
+    rows = suite.friction_law_costs(repeats)
+    return {"friction_laws": rows, "friction_laws_conditions": {
+        **before, "repeats": repeats,
+        "load_avg_at_end": os.getloadavg() if hasattr(os, "getloadavg") else None}}
+
+
 def measure_bench(quick: bool, repeats: int, pyclaw: bool) -> dict[str, Any]:
     """The benchmark suite (see suite.py)."""
     from pdeflow.numerics import compiled
@@ -147,8 +158,7 @@ def measure_bench(quick: bool, repeats: int, pyclaw: bool) -> dict[str, Any]:
     _log("cell update rates ...")
     out["rates"] = suite.cell_update_rates(
         suite.BENCH_VARIANTS[:2] if quick else suite.BENCH_VARIANTS, repeats=repeats)
-    _log("basal friction laws against Coulomb ...")
-    out["friction_laws"] = suite.friction_law_costs(repeats)
+    out.update(measure_laws(repeats))
     _log("5.1 to rest ...")
     out["case_5_1"] = suite.case_5_1_to_rest(repeats)
     _log("10^5 cells, 200 steps ...")
@@ -394,6 +404,10 @@ def _render_wp(wp: dict[str, Any]) -> str:
     return "\n".join(L)
 
 
+def _loads(v: Any) -> str:
+    return "-" if not v else ", ".join(f"{x:.2f}" for x in v)
+
+
 def _render_bench(b: dict[str, Any]) -> str:
     L = ["## Benchmarks\n", "### Cell updates per second (5.1 case, dx = 0.0125 m, "
          "t = 0.4 s, compiled stepper)\n"]
@@ -406,10 +420,21 @@ def _render_bench(b: dict[str, Any]) -> str:
         L += ["", "### Basal friction laws (a dam break onto a wet 30 deg slope, "
               "hll/first-order, interleaved with Coulomb; target for pouliquen: <= "
               "1.2x)\n"]
-        L += _table(["model", "law", "Coulomb ns/update", "law ns/update", "ratio"],
-                    "llrrr", (f"| {r['model']} | {r['law']} | {r['coulomb_ns']:.3g} | "
-                              f"{r['law_ns']:.3g} | {r['ratio']:.2f}x |"
-                              for r in b["friction_laws"]))
+        L += _table(["model", "law", "Coulomb ns/update", "law ns/update", "ratio",
+                     "load avg (1 min)"],
+                    "llrrrr", (f"| {r['model']} | {r['law']} | {r['coulomb_ns']:.3g} | "
+                               f"{r['law_ns']:.3g} | {r['ratio']:.2f}x | "
+                               f"{r.get('load_avg', math.nan):.2f} |"
+                               for r in b["friction_laws"]))
+        c = b.get("friction_laws_conditions")
+        if c:
+            L += ["", f"Measured {c['date']} (`python benchmarks/run_benchmarks.py --only "
+                  f"laws`, medians of {c.get('repeats', '?')} interleaved pairs after a "
+                  f"warm-up), load average (1, 5, 15 min) "
+                  f"{_loads(c.get('load_avg_at_start'))} at the start and "
+                  f"{_loads(c.get('load_avg_at_end'))} at the end on {c.get('cores')} "
+                  "cores shared with other users: the ratio of a pair is what is "
+                  "compared, not the absolute times."]
     c = b["compile"]
     L += ["", "### Compilation (fresh subprocesses, own NUMBA_CACHE_DIR)\n",
           "| | import [s] | single layer 1st run [s] | 2nd run [s] | two layers 1st run "
@@ -624,8 +649,10 @@ def _findings(wp: dict[str, Any] | None, b: dict[str, Any] | None) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--only", choices=("wp", "bench", "studies", "cold", "geometry", "bed"),
-                   default=None)
+    p.add_argument("--only", choices=("wp", "bench", "studies", "cold", "geometry", "bed",
+                                      "laws"),
+                   default=None, help="one part ('laws': only the friction-law rows of the "
+                   "benchmark suite, merged into its stored results)")
     p.add_argument("--label", default="after",
                    help="name of the cold-start measurement (e.g. before, after)")
     p.add_argument("--tree", default=str(ROOT),
@@ -659,6 +686,10 @@ def main(argv: list[str] | None = None) -> int:
         logging.getLogger().setLevel(logging.WARNING)
         if args.only in (None, "bench"):
             b = measure_bench(args.quick, repeats, not args.no_pyclaw)
+            bench_path.write_text(json.dumps(b, indent=1, default=str))
+        if args.only == "laws":
+            b = json.loads(bench_path.read_text()) if bench_path.exists() else {}
+            b.update(measure_laws(repeats))
             bench_path.write_text(json.dumps(b, indent=1, default=str))
         if args.only in (None, "studies"):
             st = study_scaling.measure(args.quick, max(3, repeats // 2 + 1), args.sweeps)

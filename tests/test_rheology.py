@@ -247,23 +247,56 @@ def test_coulomb_runs_compile_none_of_the_laws_code():
 
 
 def test_rheology_report_generator_runs(tmp_path):
-    """docs/generate/rheology.py on a coarse grid and two aspect ratios (a few seconds):
-    the report names the closest law of each model and the figure exists."""
+    """docs/generate/rheology.py on coarse grids and two aspect ratios per geometry: the
+    report names the closest law of each geometry and model, the figures exist, the
+    cache holds one row per point and a second call runs nothing (--no-runs renders the
+    same page)."""
+    import os
     import subprocess
     import sys
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[1]
-    proc = subprocess.run(
-        [sys.executable, str(root / "docs" / "generate" / "rheology.py"), "--out",
-         str(tmp_path), "--dx", "0.05", "--length", "12", "--ratios", "2", "4"],
-        capture_output=True, text=True, timeout=600,
-        env={**__import__("os").environ, "PYTHONPATH": str(root)})
+    cmd = [sys.executable, str(root / "docs" / "generate" / "rheology.py"), "--out",
+           str(tmp_path), "--planar-grids", "0.05", "0.025", "--axisymmetric-grids",
+           "0.02", "0.01", "--planar-ratios", "2", "4", "--axisymmetric-ratios", "1", "2",
+           "--planar-length", "12", "--axisymmetric-length", "1.5"]
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=env)
     assert proc.returncode == 0, proc.stderr[-2000:]
     text = (tmp_path / "rheology.md").read_text()
-    for model in ("two_layer", "single_layer"):
-        assert f"* {model}: closest to Lube et al. is **" in text
-    assert (tmp_path / "figures" / "rheology_runout.png").stat().st_size > 1000
+    for geometry in ("planar", "axisymmetric"):
+        for model in ("single_layer", "two_layer"):
+            assert f"* **{geometry}, {model}**: closest is **" in text
+    for fig in ("rheology_runout", "rheology_axisymmetric", "rheology_convergence"):
+        assert (tmp_path / "figures" / f"{fig}.png").stat().st_size > 1000
+    rows = (tmp_path / "rheology" / "sweep.csv").read_text().splitlines()
+    assert len(rows) == 1 + 2 * 2 * (5 * 2 + 4 * 2)  # header; grids x a x (laws x models)
+    again = subprocess.run([*cmd, "--no-runs"], capture_output=True, text=True,
+                           timeout=600, env=env)
+    assert again.returncode == 0, again.stderr[-2000:]
+    assert (tmp_path / "rheology" / "sweep.csv").read_text().splitlines() == rows
+    assert (tmp_path / "rheology.md").read_text() == text
+
+
+def test_rheology_page_is_the_rendering_of_its_numbers():
+    """docs/rheology.md is rheology_page.render_page of docs/rheology/numbers.json (no
+    hand-typed results), and every figure it shows exists."""
+    import json
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    sys.path.insert(0, str(root / "docs" / "generate"))
+    try:
+        import rheology_page
+    finally:
+        sys.path.remove(str(root / "docs" / "generate"))
+    numbers = json.loads((root / "docs" / "rheology" / "numbers.json").read_text())
+    page = (root / "docs" / "rheology.md").read_text()
+    assert page == rheology_page.render_page(numbers, numbers["figures"])
+    for fig in numbers["figures"].values():
+        assert (root / "docs" / fig).is_file()
 
 
 def test_case_key_reaches_the_run_and_its_stored_variant():
@@ -305,3 +338,43 @@ def test_a_study_over_laws_warms_every_law_bundle(tmp_path):
     system = pdeflow.SingleLayerGranular.system
     assert system.kernels.sources in kernels
     assert system.law_kernels.sources in kernels
+
+
+def _cached_rows():
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    sys.path.insert(0, str(root / "docs" / "generate"))
+    try:
+        import rheology_runs
+    finally:
+        sys.path.remove(str(root / "docs" / "generate"))
+    return rheology_runs, rheology_runs.read_cache(root / "docs" / "rheology" / "sweep.csv")
+
+
+def _check_reruns(points):
+    runs, rows = _cached_rows()
+    cached = {runs.key(r): r for r in rows}
+    for p in points:
+        new = runs.measure(p)
+        old = cached[p]
+        assert new["r"] == old["r"] and new["steps"] == old["steps"], (p, new, old)
+        assert new["at_rest"] and old["at_rest"], p
+
+
+def test_cached_law_sweep_rows_are_what_the_code_gives():
+    """Three points of docs/rheology/sweep.csv (planar and radial, both models, three
+    laws) run again give the cached run-out and step count exactly."""
+    _check_reruns([("planar", "single_layer", "coulomb", 0.01, 2.0),
+                   ("planar", "two_layer", "pouliquen", 0.01, 4.0),
+                   ("axisymmetric", "single_layer", "mu_i", 0.00125, 1.0)])
+
+
+@pytest.mark.slow
+def test_cached_law_sweep_coarsest_grids_rerun():
+    """Every point of the coarsest planar and radial grids of docs/rheology/sweep.csv
+    run again gives the cached run-out exactly (minutes)."""
+    runs, _ = _cached_rows()
+    _check_reruns([p for p in runs.all_points()
+                   if p[3] == runs.GRIDS[p[0]][0]])

@@ -1,142 +1,102 @@
-"""Regenerate docs/rheology.md and its figure: the planar run-out law with each basal law.
+"""Regenerate docs/rheology.md: every basal friction law on the planar and axisymmetric
+collapses, both models, on refined grids, against the experiments and Lagree et al. (2011).
 
-    python docs/generate/rheology.py [--out docs] [--dx 0.01] [--ratios 2 4 8 14 24]
+    python docs/generate/rheology.py            # runs what the cache lacks, then the page
+    python docs/generate/rheology.py --rerun    # runs every point again, then the page
+    python docs/generate/rheology.py --no-runs  # the page from the cache as it is
+    python docs/generate/rheology.py --runs-only  # fill the cache only (resumable)
 
-Runs the planar collapse sweep of test 5.2 (cases/collapse_sweep.toml, both models)
-once per basal friction law (``<model>.friction_law``, every law with its documented
-defaults) through :func:`pdeflow.analysis.sweep.run_sweep`, at the case's dx and at
-dx/2 (is the run-out converged?), and compares the run-outs r = (R - L0)/L0 with the
-experimental planar law of Lube et al. (2005), r = 1.2 a (a < 1.8), 1.9 a^(2/3)
-(a > 2.8), by the mean |log(r / r_Lube)| over the aspect ratios a > 2.8. The domain is
-lengthened to hold every run-out (a run-out that leaves it would be no run-out).
+The points (geometry, model, law set, grid, aspect ratio) are those of
+docs/generate/rheology_runs.py; each is one run to rest whose row goes to
+docs/rheology/sweep.csv as soon as it ends, so an interrupted call resumes. The page's
+numbers (rheology_numbers.page_numbers, only complete grids count) are stored in
+docs/rheology/numbers.json and rendered by rheology_page.render_page. The options below
+the first four shrink the sweep (the tests run it on coarse grids into a temporary
+directory).
 """
 
 from __future__ import annotations
 
 import argparse
-import math
+import json
+import sys
+import time
 from pathlib import Path
-from typing import Any
 
-import matplotlib
+import rheology_runs as runs
+from rheology_figures import figures
+from rheology_numbers import page_numbers
+from rheology_page import render_page
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from pdeflow.analysis.sweep import published_law, run_sweep  # noqa: E402
-from pdeflow.cases import load_case  # noqa: E402
-from pdeflow.io import write_text  # noqa: E402
+from pdeflow.io import write_json, write_text
 
 ROOT = Path(__file__).resolve().parents[2]
-CASE = ROOT / "cases" / "collapse_sweep.toml"
-LAWS = ("coulomb", "pouliquen", "mu_i", "voellmy")
-RATIOS = (2.0, 4.0, 8.0, 14.0, 24.0)
-LUBE = "Lube et al. 2005"  # pdeflow.analysis.sweep.PUBLISHED_LAWS
-LUBE_FROM = 2.8  # its power-law branch holds above this aspect ratio
+BENCH = ROOT / "benchmarks" / "measurements" / "bench.json"
 
 
-def law_sweep(law: str, ratios: list[float], dx: float, length: float) -> dict[str, Any]:
-    """The sweep of every model of the case with basal law ``law`` on a grid of
-    spacing ``dx`` [m] and domain ``length`` [m]."""
-    base = load_case(CASE)
-    sets = [f"{m}.friction_law={law}" for m in base.models]
-    case = load_case(CASE, [*sets, f"grid.dx={dx!r}", f"grid.length={length!r}"])
-    return run_sweep(case, ratios)
+def arguments(argv: list[str] | None) -> argparse.Namespace:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rerun", action="store_true", help="run every point again")
+    ap.add_argument("--no-runs", action="store_true", help="the page from the cache")
+    ap.add_argument("--runs-only", action="store_true", help="fill the cache, no page")
+    ap.add_argument("--out", default=str(ROOT / "docs"),
+                    help="output directory (rheology.md, figures/, rheology/)")
+    ap.add_argument("--planar-grids", type=float, nargs="+",
+                    default=list(runs.GRIDS["planar"]), help="planar dx [m], coarse first")
+    ap.add_argument("--axisymmetric-grids", type=float, nargs="+",
+                    default=list(runs.GRIDS["axisymmetric"]), help="radial dr [m]")
+    ap.add_argument("--planar-ratios", type=float, nargs="+",
+                    default=list(runs.RATIOS["planar"]))
+    ap.add_argument("--axisymmetric-ratios", type=float, nargs="+",
+                    default=list(runs.RATIOS["axisymmetric"]))
+    ap.add_argument("--planar-length", type=float, default=runs.LENGTH["planar"],
+                    help="planar domain [m]")
+    ap.add_argument("--axisymmetric-length", type=float,
+                    default=runs.LENGTH["axisymmetric"], help="radial domain [m]")
+    return ap.parse_args(argv)
 
 
-def misfit(points: list[list[float]]) -> float | None:
-    """Mean |log(r / r_Lube)| over the points with a > LUBE_FROM (None if none)."""
-    pts = [(a, r) for a, r in points if r and a > LUBE_FROM]
-    if not pts:
+def stored_cost(path: Path = BENCH) -> dict | None:
+    """The friction-law rows of the stored benchmark results (docs/performance.md's
+    section, ``python benchmarks/run_benchmarks.py --only laws``), if measured."""
+    if not path.is_file():
         return None
-    a, r = np.array(pts).T
-    return float(np.mean(np.abs(np.log(r / published_law(LUBE, a)))))
-
-
-def measure(ratios: list[float], dx: float, length: float) -> dict[str, Any]:
-    """Sweeps of every law at dx and dx/2: {law: {dx: sweep summary}}."""
-    return {law: {d: law_sweep(law, ratios, d, length) for d in (dx, dx / 2)}
-            for law in LAWS}
-
-
-def figure(results: dict[str, Any], dx: float, path: Path) -> Path:
-    """r against a, one panel per model, each law at dx/2, with Lube et al.'s law."""
-    models = list(next(iter(results.values()))[dx]["models"])
-    fig, axes = plt.subplots(1, len(models), figsize=(5 * len(models), 4), sharey=True)
-    a = np.geomspace(1, 30, 200)
-    for ax, model in zip(np.atleast_1d(axes), models, strict=True):
-        ax.loglog(a, published_law(LUBE, a), "k--", label="Lube et al. 2005")
-        for law, by_dx in results.items():
-            pts = np.array([p for p in by_dx[dx / 2]["models"][model]["points"] if p[1]])
-            ax.loglog(pts[:, 0], pts[:, 1], "o-", label=law)
-        ax.set(title=model, xlabel="a = H0/L0", ylabel="r = (R - L0)/L0")
-        ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
-
-
-def report(results: dict[str, Any], dx: float, length: float, fig: str) -> str:
-    """docs/rheology.md."""
-    models = list(next(iter(results.values()))[dx]["models"])
-    lines = ["# Basal friction laws on the planar collapse (test 5.2)\n",
-             "Generated by `python docs/generate/rheology.py` (do not edit by hand). "
-             "The planar collapse sweep (cases/collapse_sweep.toml) with each basal law "
-             f"at its documented defaults, dx = {dx:g} m and {dx / 2:g} m, a domain of "
-             f"{length:g} m, against the experimental planar law of Lube et al. (2005), "
-             "r = 1.9 a^(2/3) for a > 2.8 (REFERENCE section 4). Misfit: mean "
-             "|log(r/r_Lube)| over a > 2.8, at dx/2; the run-out change from dx to dx/2 "
-             "says whether the grid is converged.\n", f"![run-out law per law]({fig})\n",
-             "| model | law | fit r = p a^e (dx/2) | misfit (dx/2) | max change dx -> dx/2 "
-             "| all at rest |", "|---|---|---|---:|---:|---|"]
-    best: dict[str, tuple[float, str]] = {}
-    worst = 0.0
-    for model in models:
-        for law, by_dx in results.items():
-            fine, coarse = by_dx[dx / 2]["models"][model], by_dx[dx]["models"][model]
-            m = misfit(fine["points"])
-            change = max((abs(f[1] / c[1] - 1) for f, c in zip(
-                fine["points"], coarse["points"], strict=True) if f[1] and c[1]),
-                default=math.nan)
-            worst = max(worst, change) if math.isfinite(change) else worst
-            fit = (f"{fine['prefactor']:.3g} a^{fine['exponent']:.3g}"
-                   if fine["prefactor"] else "-")
-            lines.append(f"| {model} | {law} | {fit} | "
-                         f"{'-' if m is None else format(m, '.3f')} | {change:.1%} | "
-                         f"{fine['all_at_rest'] and coarse['all_at_rest']} |")
-            if m is not None and (model not in best or m < best[model][0]):
-                best[model] = (m, law)
-    lines += ["", f"The run-outs change by up to {worst:.1%} from dx to dx/2: the ranking "
-              "below holds on these grids, the run-outs themselves are converged to no "
-              "better than that.", ""]
-    for model, (m, law) in best.items():
-        lines.append(f"* {model}: closest to Lube et al. is **{law}** (misfit {m:.3f}, "
-                     f"i.e. a factor {math.exp(m):.2f} on average).")
-    lines += ["", "The laws run with their documented defaults (glass beads of 0.5 mm "
-              "for pouliquen and mu_i, snow for voellmy), not calibrated to the "
-              "experiments: this compares the laws' shapes at the values their papers "
-              "give, not fitted laws. Not here yet: the axisymmetric sweep and the "
-              "comparison with Lagree, Staron & Popinet (2011).", ""]
-    return "\n".join(lines)
+    b = json.loads(path.read_text())
+    if not b.get("friction_laws"):
+        return None
+    return {"rows": b["friction_laws"], "conditions": b.get("friction_laws_conditions")}
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=str(ROOT / "docs"), help="output directory")
-    ap.add_argument("--dx", type=float, default=0.01,
-                    help="coarse grid spacing [m] (the case's; dx/2 too)")
-    ap.add_argument("--length", type=float, default=30.0, help="domain length [m]")
-    ap.add_argument("--ratios", type=float, nargs="+", default=list(RATIOS))
-    args = ap.parse_args(argv)
+    """Fill the cache (unless --no-runs), then (unless --runs-only) write the page, its
+    figures and numbers."""
+    args = arguments(argv)
     out = Path(args.out)
-    results = measure(args.ratios, args.dx, args.length)
-    (out / "figures").mkdir(parents=True, exist_ok=True)
-    fig = figure(results, args.dx, out / "figures" / "rheology_runout.png")
-    write_text(out / "rheology.md", report(results, args.dx, args.length,
-                                           f"figures/{fig.name}"))
-    print(f"written: {out / 'rheology.md'}, {fig}")
+    cache = out / "rheology" / "sweep.csv"
+    grids = {"planar": tuple(args.planar_grids),
+             "axisymmetric": tuple(args.axisymmetric_grids)}
+    ratios = {"planar": tuple(args.planar_ratios),
+              "axisymmetric": tuple(args.axisymmetric_ratios)}
+    length = {"planar": args.planar_length, "axisymmetric": args.axisymmetric_length}
+    points = runs.all_points(grids, ratios)
+    t0 = time.perf_counter()
+    if args.no_runs:
+        rows = runs.read_cache(cache)
+    else:
+        rows = runs.fill_cache(points, cache, rerun=args.rerun, length=length)
+    if args.runs_only:
+        return 0
+    wanted = set(points)
+    rows = [r for r in rows if runs.key(r) in wanted]
+    numbers = page_numbers(rows)
+    numbers["static_angles"] = {g: runs.static_angles(g) for g in ("planar", "axisymmetric")}
+    numbers["static_depth"] = runs.STATIC_DEPTH
+    numbers["cost"] = stored_cost()
+    numbers["figures"] = figures(numbers, out)
+    numbers["generator_wall_s"] = round(time.perf_counter() - t0, 1)
+    write_json(out / "rheology" / "numbers.json", numbers)
+    write_text(out / "rheology.md", render_page(numbers, numbers["figures"]))
+    print(f"written: {out / 'rheology.md'} ({len(rows)} runs)", file=sys.stderr)
     return 0
 
 

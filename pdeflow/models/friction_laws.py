@@ -7,7 +7,8 @@ parameter vector (offsets ``layout.LAW_*``), which
 :mod:`pdeflow.numerics.rheology` reads. Coulomb, the default, uses the model's own
 ``phi_b_deg``; the other laws ignore it. Defaults: glass beads of d = 0.5 mm for
 ``pouliquen`` and ``mu_i`` (Forterre & Pouliquen 2003, Jop, Forterre & Pouliquen 2006),
-snow for ``voellmy``; docs/model.md says which of these numbers were confirmed.
+snow for ``voellmy``; docs/rheology.md says which of these numbers could be checked,
+and where (none from the papers themselves).
 """
 
 from __future__ import annotations
