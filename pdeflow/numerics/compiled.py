@@ -49,6 +49,7 @@ from numba.core import config
 from numba.core.caching import FunctionCache
 from numba.core.dispatcher import Dispatcher
 from numba.core.registry import CPUDispatcher
+from numba.core.runtime.nrt import rtsys
 from numba.core.types.function_type import CompileResultWAP
 from numba.core.typing.typeof import typeof_impl
 
@@ -324,6 +325,16 @@ class _CodeKeyedCache(FunctionCache):
         super().__init__(py_func)
         # a helper's twin (see HelperKernel) has entry points the helper lacks
         self._variant = "python twin" if python_twin else ""
+
+    def load_overload(self, sig: Any, target_context: Any) -> Any:
+        """numba's load without its ``target_context.refresh()``: that loads every
+        typing and lowering registry numba has (0.2-0.5 s, most of a warm start's
+        kernel load), which only compiling needs, and numba's compiler refreshes the
+        context itself before it compiles. Loaded machine code needs the runtime (NRT)
+        it links against."""
+        rtsys.initialize(target_context)
+        with self._guard_against_spurious_io_errors():
+            return self._load_overload(sig, target_context)
 
     def _index_key(self, sig: Any, codegen: Any) -> tuple:
         own = repr(_describe_function(self._py_func)).encode()
