@@ -79,7 +79,9 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
 
 
 def _import_plotting() -> None:
-    from . import plotting  # noqa: F401
+    import matplotlib.pyplot  # noqa: F401
+
+    from . import case_figures  # noqa: F401
 
 
 def _load_run_case(args: argparse.Namespace) -> Any:
