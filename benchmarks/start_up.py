@@ -20,17 +20,15 @@ Every process uses one numba cache of its own, filled by one run first.
 
 from __future__ import annotations
 
-import json
 import os
-import resource
 import shutil
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 from typing import Any
+
+import cold_start
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE = "cases/paper_5_1_dam_break.toml"
@@ -47,31 +45,16 @@ steppers = case_steppers(load_case(sys.argv[1]))
 w0, c0 = time.perf_counter(), time.process_time()
 prepare(steppers)
 w1, c1 = time.perf_counter(), time.process_time()
-print("RESULT" + json.dumps({"import_s": t1 - t0, "load_s": w1 - w0, "load_cpu_s": c1 - c0}))
+print("RESULT" + json.dumps({"import_s": t1 - t0, "load_s": w1 - w0, "load_cpu_s": c1 - c0}),
+      file=sys.stderr)
 """
 
 
 def _child(cmd: list[str], cache: str) -> dict[str, Any]:
-    """``cmd`` in a fresh working directory with this checkout first on PYTHONPATH and
-    the numba cache ``cache``: wall and CPU time (user + system) [s], its RESULT line."""
-    work = tempfile.mkdtemp(prefix="pdeflow-start-cwd-")
-    env = {**os.environ, "NUMBA_CACHE_DIR": cache, "PYTHONPATH": str(ROOT)}
-    env.pop("NUMBA_DISABLE_JIT", None)
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    proc = subprocess.run(cmd, cwd=work, env=env, capture_output=True, text=True,
-                          timeout=900)
-    wall = time.perf_counter() - t0
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    shutil.rmtree(work, ignore_errors=True)
-    if proc.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)} failed:\n{proc.stderr[-3000:]}")
-    out: dict[str, Any] = {"wall_s": wall, "cpu_s": (after.ru_utime - before.ru_utime)
-                           + (after.ru_stime - before.ru_stime)}
-    for line in proc.stdout.splitlines():
-        if line.startswith("RESULT"):
-            out.update(json.loads(line[6:]))
-    return out
+    """``cmd`` in a fresh working directory with this checkout on PYTHONPATH and the
+    numba cache ``cache`` (:func:`cold_start._child`): wall and CPU time [s], and what
+    its RESULT line on stderr says."""
+    return cold_start._child(cmd, ROOT, cache)
 
 
 def commands() -> dict[str, list[str]]:
