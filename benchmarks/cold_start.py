@@ -239,6 +239,10 @@ CHANGES = {
     "session5-before": "the code of *session4* (7ae905d), measured again half an hour "
                        "after *session5* on the same day (the machine's speed drifts "
                        "within a day: its CPU time moves with it)",
+    "session7": "kernels loaded without numba's registry refresh, fewer imports (issue "
+                "27); nothing compiled less than in *session6*. Measured at load 3-5 (other "
+                "developers' tests and sweeps on both cores): the wall times are not "
+                "comparable with the rows above, the CPU time is (13.0 s against 13.6 s)",
 }
 """what the code of each measured label changed (rendered under the table)"""
 MECHANISMS = """

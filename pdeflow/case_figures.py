@@ -156,6 +156,11 @@ def draw_all(jobs: Sequence[tuple[Callable, tuple, Path]],
         theirs = pool.map_async(_draw, jobs[1::2])
         mine = [_draw(job) for job in jobs[::2]]
         paths = theirs.get()
+        # the worker leaves on its own: the pool's terminate() at the end of the block
+        # stops it with SIGTERM, which the run's deferred signals (the outputs are
+        # written whole) hold back in the fork, and the join hung, the worker waiting
+        pool.close()
+        pool.join()
     return [mine[i // 2] if i % 2 == 0 else paths[i // 2] for i in range(len(jobs))]
 
 

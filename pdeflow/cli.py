@@ -87,7 +87,9 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
 
 
 def _import_plotting() -> None:
-    from . import plotting  # noqa: F401
+    import matplotlib.pyplot  # noqa: F401
+
+    from . import case_figures  # noqa: F401
 
 
 def _load_run_case(args: argparse.Namespace) -> Any:
@@ -315,31 +317,40 @@ def _add_run(sub: Any) -> None:
     run.set_defaults(func=cmd_run)
 
 
-def _add_module_commands(sub: Any) -> None:
-    """The commands whose module owns its options (``add_arguments``) and body."""
-    from .analysis import convergence, sweep, workprecision
-    from .app import server  # panel is imported only when the app runs
-    from .study import command as study
+MODULE_COMMANDS = (
+    ("sweep", "pdeflow.analysis.sweep", "cmd_sweep",
+     "aspect-ratio sweep and run-out law (paper 5.2)"),
+    ("converge", "pdeflow.analysis.convergence", "cmd_converge",
+     "grid-convergence study of a case"),
+    ("compare", "pdeflow.analysis.workprecision", "cmd_compare",
+     "work-precision study: error against wall time of solver variants (to compare "
+     "runs, use plot)"),
+    ("study", "pdeflow.study.command", "cmd_study",
+     "parameter study, sensitivity or calibration on Dask"),
+    ("app", "pdeflow.app.server", "cmd_app", "teaching app in the browser (needs panel)"))
+"""(command, module, function, help) of the commands whose module owns its options
+(``add_arguments``) and body"""
 
-    for name, module, func, help_ in (
-            ("sweep", sweep, sweep.cmd_sweep,
-             "aspect-ratio sweep and run-out law (paper 5.2)"),
-            ("converge", convergence, convergence.cmd_converge,
-             "grid-convergence study of a case"),
-            ("compare", workprecision, workprecision.cmd_compare,
-             "work-precision study: error against wall time of solver variants (to "
-             "compare runs, use plot)"),
-            ("study", study, study.cmd_study,
-             "parameter study, sensitivity or calibration on Dask"),
-            ("app", server, server.cmd_app, "teaching app in the browser (needs panel)")):
+
+def _add_module_commands(sub: Any, command: str | None = None) -> None:
+    """The commands of :data:`MODULE_COMMANDS`; with ``command`` only that one's module
+    is imported and given its options (the others are listed, for ``--help``)."""
+    import importlib
+
+    for name, module_name, func, help_ in MODULE_COMMANDS:
+        if command is not None and name != command:
+            sub.add_parser(name, help=help_)
+            continue
+        module = importlib.import_module(module_name)  # panel: only when the app runs
         cmd = sub.add_parser(name, help=help_, formatter_class=RAW,
                              description=getattr(module, "HELP", module.__doc__))
         module.add_arguments(cmd)
-        cmd.set_defaults(func=func)
+        cmd.set_defaults(func=getattr(module, func))
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The ``pdeflow`` parser: one subcommand per command."""
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The ``pdeflow`` parser: one subcommand per command; with ``command`` (the one
+    about to run) the modules of the others are not imported."""
     parser = argparse.ArgumentParser(
         prog="pdeflow",
         description="Depth-averaged single- and two-layer granular flow models on py-pde.",
@@ -350,7 +361,7 @@ def build_parser() -> argparse.ArgumentParser:
     from .cli_stored import add_plot_and_export
 
     add_plot_and_export(sub, RAW)
-    _add_module_commands(sub)
+    _add_module_commands(sub, command)
     return parser
 
 
@@ -367,10 +378,10 @@ def _main(argv: list[str] | None = None) -> int:
     from .cases import CaseError
     from .interrupts import RunInterrupted, signals_interrupt
     from .solvers.fv_split import SimulationBlowUp
-    from .storage import StorageError
 
     argv = sys.argv[1:] if argv is None else list(argv)
-    args = build_parser().parse_args(argv)
+    command = next((a for a in argv if not a.startswith("-")), None)
+    args = build_parser(command).parse_args(argv)
     try:
         with signals_interrupt():
             return args.func(args)
@@ -381,7 +392,7 @@ def _main(argv: list[str] | None = None) -> int:
             else "before the results were complete"
         print(f"pdeflow: interrupted {when}; nothing written", file=sys.stderr)
         return 130
-    except (CaseError, StorageError) as err:
+    except CaseError as err:
         print(f"pdeflow: error: {err}", file=sys.stderr)
         return 2
     except SimulationBlowUp as err:
@@ -391,9 +402,12 @@ def _main(argv: list[str] | None = None) -> int:
     except ValueError as err:
         from .io import OutputError
 
-        movie_error = "pdeflow.trackers.live" in sys.modules and isinstance(
-            err, sys.modules["pdeflow.trackers.live"].MovieError)  # only movies raise it
-        if not (movie_error or isinstance(err, OutputError)):
+        # only movies raise a MovieError, only stored runs a StorageError: neither
+        # module is imported for nothing
+        known = [sys.modules[name].__dict__[error] for name, error in (
+            ("pdeflow.trackers.live", "MovieError"), ("pdeflow.storage", "StorageError"))
+            if name in sys.modules]
+        if not isinstance(err, (OutputError, *known)):
             raise
         print(f"pdeflow: error: {err}", file=sys.stderr)
         return 2

@@ -15,7 +15,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from . import systems
@@ -82,6 +81,8 @@ def save(fig: Any, path: str | Path) -> Path:
     path = Path(path)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=110, format=path.suffix.lstrip(".") or "png")
+    import matplotlib.pyplot as plt  # here, not at the top: the app takes DRY only
+
     plt.close(fig)
     return path
 
@@ -156,6 +157,8 @@ class RunFigure:
         self.series = list(series)
         self.title = title
         figsize = figsize or ((7.0, 7.5) if panels == 3 else (7.0, 3.4))
+        if pyplot:
+            import matplotlib.pyplot as plt
         self.fig = (plt.figure(figsize=figsize, layout="constrained") if pyplot
                     else Figure(figsize=figsize, layout="constrained"))
         axes = np.atleast_1d(self.fig.subplots(panels, 1, sharex=True))
@@ -373,4 +376,6 @@ class RunFigure:
 
     def close(self) -> None:
         """Release the figure (and its window, if it was made through pyplot)."""
+        import matplotlib.pyplot as plt
+
         plt.close(self.fig)

@@ -159,6 +159,42 @@ def test_closures_compiled_in_two_processes_load_together(tmp_path):
     assert runs[2] == [[hll, 1], [rusanov, 1]]  # loaded together, each still itself
 
 
+# load a kernel from the disk cache, run it, then compile a new kernel that calls it
+LOAD_THEN_COMPILE = r"""
+import json, sys
+import numba
+import numba.core.base
+calls = []
+refresh = numba.core.base.BaseContext.refresh
+numba.core.base.BaseContext.refresh = lambda self: calls.append(1) or refresh(self)
+from pdeflow.numerics import layout as L
+from pdeflow.numerics.advection import advection_kernel
+from pdeflow.numerics.bundles import SINGLE_LAYER
+from pdeflow.numerics.compiled import ready
+k = ready(advection_kernel(SINGLE_LAYER, L.FLUX_HLL, 1, L.LIMITER_MINMOD,
+                           L.GEOMETRY_PLANAR))
+loaded = sum(k.stats.cache_hits.values())
+refreshed_by_load = len(calls)
+from pdeflow.numerics.state import velocity
+twice = numba.njit(lambda h, hu: 2.0 * velocity(h, hu, 1e-6))
+print("STATS" + json.dumps([loaded, refreshed_by_load, twice(2.0, 3.0), len(calls) > 0]))
+"""
+
+
+def test_a_kernel_loaded_without_numbas_refresh_runs_and_compiling_still_works(tmp_path):
+    """Loading from the disk cache skips numba's refresh of its typing and lowering
+    registries (compiled._CodeKeyedCache.load_overload); a kernel compiled afterwards in
+    the same process, calling a pdeflow kernel, is typed and runs (numba's compiler
+    refreshes the context itself)."""
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path), "PYTHONPATH": str(ROOT)}
+    for _ in range(2):
+        proc = subprocess.run([sys.executable, "-c", LOAD_THEN_COMPILE], env=env,
+                              cwd=ROOT, capture_output=True, text=True, timeout=900)
+        assert proc.returncode == 0, proc.stderr[-3000:]
+    line = [x for x in proc.stdout.splitlines() if x.startswith("STATS")][0]
+    assert json.loads(line[len("STATS"):]) == [1, 0, 3.0, True]
+
+
 @pytest.mark.skipif(config.DISABLE_JIT, reason="no cache without the JIT")
 def test_cache_key_follows_the_code_of_every_called_kernel(monkeypatch):
     """A kernel's disk-cache key changes when a kernel it calls, in another file and

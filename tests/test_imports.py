@@ -13,7 +13,12 @@ ROOT = Path(__file__).resolve().parents[1]
 CASE = ROOT / "cases" / "paper_5_1_dam_break.toml"
 NOT_NEEDED = ("matplotlib", "panel", "bokeh", "dask", "distributed", "pandas", "h5py",
               "xarray", "optuna", "SALib", "imageio_ffmpeg", "pdeflow.plotting",
-              "pdeflow.case_figures", "pdeflow.trackers.live", "pdeflow.app.dam_break")
+              "pdeflow.case_figures", "pdeflow.trackers.live", "pdeflow.app.dam_break",
+              # the other commands' modules and the stored runs' (pdeflow.cli builds
+              # only the options of the command it runs)
+              "pdeflow.analysis.convergence", "pdeflow.analysis.workprecision",
+              "pdeflow.analysis.sweep", "pdeflow.study", "pdeflow.app.server",
+              "pdeflow.storage")
 
 SCRIPT = """
 import json, sys

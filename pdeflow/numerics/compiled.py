@@ -38,6 +38,7 @@ listed and checked by ``tests/test_numba_internals.py``.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import sys
 from collections.abc import Callable, Iterable, Iterator
@@ -49,6 +50,7 @@ from numba.core import config
 from numba.core.caching import FunctionCache
 from numba.core.dispatcher import Dispatcher
 from numba.core.registry import CPUDispatcher
+from numba.core.runtime.nrt import rtsys
 from numba.core.types.function_type import CompileResultWAP
 from numba.core.typing.typeof import typeof_impl
 
@@ -263,13 +265,25 @@ def in_disk_cache(compiled: Any) -> bool:
         return False
 
 
+@functools.cache
 def _code_digest(code: CodeType) -> str:
-    """Digest of a function's bytecode and constants (nested code objects included)."""
+    """Digest of a function's bytecode and constants (nested code objects included);
+    memoised (code objects are immutable)."""
     h = hashlib.sha256(code.co_code)
     for const in code.co_consts:
         h.update(_code_digest(const).encode() if isinstance(const, CodeType)
                  else repr(const).encode())
     return h.hexdigest()
+
+
+@functools.cache
+def _names(code: CodeType) -> frozenset[str]:
+    """The global and attribute names a function's code reads, nested code included."""
+    names = set(code.co_names)
+    for const in code.co_consts:
+        if isinstance(const, CodeType):
+            names |= _names(const)
+    return frozenset(names)
 
 
 def _describe_function(func: Callable, depth: int = 0) -> tuple:
@@ -283,18 +297,20 @@ def _describe_function(func: Callable, depth: int = 0) -> tuple:
 
 
 def _constants_read(func: Callable) -> tuple:
-    """The global numbers a kernel's code reads, by name, and the numbers of the modules
-    it reads attributes of (``L.N_DIAG``): numba compiles them in as constants, so a
-    kernel must be recompiled when one changes although its code did not."""
+    """The global numbers a kernel's code reads, by name, and the numbers it reads as
+    attributes of modules (``L.N_DIAG``): numba compiles them in as constants, so a
+    kernel must be recompiled when one changes although its code did not. (Read
+    values, not memoised: a constant may change within a process.)"""
     out = []
-    for name in func.__code__.co_names:
+    names = _names(func.__code__)
+    for name in sorted(names):
         value = func.__globals__.get(name)
         if isinstance(value, (bool, int, float)):
             out.append((name, repr(value)))
         elif isinstance(value, ModuleType):
-            numbers = tuple(sorted((k, repr(v)) for k, v in vars(value).items()
-                                   if not k.startswith("_")
-                                   and isinstance(v, (bool, int, float))))
+            attributes = vars(value)
+            numbers = tuple(sorted((k, repr(attributes[k])) for k in names
+                                   if isinstance(attributes.get(k), (bool, int, float))))
             if numbers:
                 out.append((name, value.__name__, numbers))
     return tuple(out)
@@ -324,6 +340,16 @@ class _CodeKeyedCache(FunctionCache):
         super().__init__(py_func)
         # a helper's twin (see HelperKernel) has entry points the helper lacks
         self._variant = "python twin" if python_twin else ""
+
+    def load_overload(self, sig: Any, target_context: Any) -> Any:
+        """numba's load without its ``target_context.refresh()``: that loads every
+        typing and lowering registry numba has (0.2-0.5 s, most of a warm start's
+        kernel load), which only compiling needs, and numba's compiler refreshes the
+        context itself before it compiles. Loaded machine code needs the runtime (NRT)
+        it links against."""
+        rtsys.initialize(target_context)
+        with self._guard_against_spurious_io_errors():
+            return self._load_overload(sig, target_context)
 
     def _index_key(self, sig: Any, codegen: Any) -> tuple:
         own = repr(_describe_function(self._py_func)).encode()
