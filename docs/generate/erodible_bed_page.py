@@ -152,6 +152,7 @@ def convergence_numbers(rows: list[dict]) -> list[dict[str, Any]]:
                     out.append({"set": name, "closure": closure, "theta": th, "e_i": e,
                                 "dx": [dx for dx, _ in have], "runout": r,
                                 "duration": [x["flow_duration"] for _, x in have],
+                                "at_rest": [bool(x["at_rest"]) for _, x in have],
                                 "lower_bound": any(x["runout_lower_bound"] for _, x in have),
                                 "dr": [_change(rows, name, closure, th, e, "runout", dx)
                                        for dx, _ in have],
@@ -351,7 +352,13 @@ def _answer(n: dict[str, Any]) -> list[str]:
     top = max(BEDS) * 1e3
     verdict = ("**No.**" if not grows else
                "**Only in part.**" if len(grows) < len(tr) else "**Yes.**")
-    lines = [f"{verdict} With Coulomb's basal friction, over slopes of 0-25 deg, a bed of "
+    lead = ""
+    if grows and not grows_c:
+        lead = ("The run-out grows with e_i above ~16 deg only with a rate-dependent law "
+                "for the bed (" + ", ".join(sorted({_short(k.split("|")[0]) for k in grows}))
+                + "; last sentences), and only on the slopes of the sweep below the law's "
+                "static angle. ")
+    lines = [f"{verdict} {lead}With Coulomb's basal friction, over slopes of 0-25 deg, a bed of "
              f"e_i = {top:g} mm (H0/10) changes the two-layer run-out by {_range(steep)} at "
              f"theta >= {SMALL:g} deg and by {_range(small)} below, over both shipped "
              "parameter sets and all three closures (paper, du_reg = "
@@ -416,7 +423,8 @@ def law_numbers(n: dict[str, Any], name: str) -> dict[str, Any]:
             "dt": [c["dt"] for c in cells if c.get("dt") is not None],
             "dr_fine": [c["dr"][-1] for c in fine if c["dr"][-1] is not None],
             "dr_all_grids": [d for c in fine for d in c["dr"] if d is not None],
-            "dx_fine": min((c["dx"][-1] for c in fine), default=None)}
+            "dx_fine": min((c["dx"][-1] for c in fine), default=None),
+            "dt_unsettled": _unsettled(n, name, th)}
     halving = [c["halving"][-1] for c in n["convergence"] if c["set"] == name
                and not c["lower_bound"] and c["halving"]]
     cut = sorted({th for k in keys for th in n["trend"][k]["domain_end"]})
@@ -425,6 +433,22 @@ def law_numbers(n: dict[str, Any], name: str) -> dict[str, Any]:
                       if v["runout_lower_bound"] and v["runout"] <= 1e-9})
     return {"thetas": thetas, "per": per, "small": small, "halving": halving,
             "domain_end": cut, "drained": drained}
+
+
+def _unsettled(n: dict[str, Any], name: str, theta: float) -> list[dict[str, Any]]:
+    """The refined points of ``name`` at ``theta`` whose flow duration is not settled:
+    a run still moving at t_end, or a duration changing by more than 10 % in the last
+    halving (a front creeping for seconds)."""
+    out = []
+    for c in n["convergence"]:
+        if c["set"] != name or not math.isclose(c["theta"], theta) or c["lower_bound"]:
+            continue
+        d = c["duration"]
+        moved = None not in d[-2:] and abs(d[-1] - d[-2]) > 0.1 * abs(d[-1])
+        if moved or not all(c["at_rest"]):
+            out.append({"e_i": c["e_i"], "duration": d, "at_rest": c["at_rest"][-1],
+                        "closure": c["closure"]})
+    return out
 
 
 def _law_answer(n: dict[str, Any], name: str) -> list[str]:
@@ -436,7 +460,9 @@ def _law_answer(n: dict[str, Any], name: str) -> list[str]:
         return [f"With {law}'s law no slope >= {SMALL:g} deg was measured yet."]
     per = ln["per"]
     meas = ", ".join(f"{th} deg {_spread(v['dr'])}" for th, v in per.items())
-    durs = ", ".join(f"{th} deg {_spread(v['dt'])}" for th, v in per.items())
+    durs = ", ".join(f"{th} deg {_spread(v['dt'])}"
+                     + (" (not settled, below)" if v["dt_unsettled"] else "")
+                     for th, v in per.items())
     fine = [(th, v) for th, v in per.items() if v["dr_fine"]]
     out = [f"**With {law}'s rate-dependent law for the bed** (the defaults otherwise; its "
            f"static angle is {n['phi_b'][name]:g} deg for a bed of {top:g} mm, "
@@ -456,8 +482,9 @@ def _law_answer(n: dict[str, Any], name: str) -> list[str]:
                       "grid."))
     if ln["domain_end"]:
         msg = (f"At {', '.join(f'{t:g}' for t in ln['domain_end'])} deg, above the law's "
-               "static angle, the flows leave the 3 m channel (lower bounds on every grid: "
-               "no trend measured there)")
+               "static angle, flows leave the 3 m channel (of each pair e_i = 0 and "
+               f"{top:g} mm at least one run, on every grid: lower bounds, so no trend "
+               "measured there)")
         if ln["drained"]:
             where = sorted({th for th, _ in ln["drained"]})
             beds = sorted({e for _, e in ln["drained"]})
@@ -465,12 +492,26 @@ def _law_answer(n: dict[str, Any], name: str) -> list[str]:
                     f"{min(beds) * 1e3:g} mm and thicker, steeper than their own static "
                     "angle, slide out of the channel as a whole and leave no front")
         out.append(msg + ".")
+    for th, v in per.items():
+        u = v["dt_unsettled"]
+        if u:
+            beds = sorted({x["e_i"] * 1e3 for x in u})
+            span = [f"{x['duration'][0]:.2f} → {x['duration'][-1]:.2f} s" for x in u]
+            moving = sum(not x["at_rest"] for x in u)
+            out.append(f"The flow durations at {th} deg are not settled on refinement: at "
+                       "e_i = " + ", ".join(f"{b:g}" for b in beds) + " mm the slowing "
+                       f"front keeps creeping, {span[0]} to {span[-1]} from dx = "
+                       f"{COARSE * 1e3:g} mm to the finest grid (over the closures)"
+                       + (f", {moving} of these runs still moving at the end (10 s)"
+                          if moving else "")
+                       + "; the duration change there is not a result (the run-out's is).")
     grow = [th for th, v in per.items() if v["dr"] and min(v["dr"]) > 0]
-    longer = [th for th, v in per.items() if v["dt"] and min(v["dt"]) > 0]
+    longer = [th for th, v in per.items() if v["dt"] and min(v["dt"]) > 0
+              and not v["dt_unsettled"]]
     if grow:
         out.append(f"So with {law}'s law the run-out grows with e_i at "
-                   f"{', '.join(grow)} deg and the flow lasts longer at "
-                   f"{', '.join(longer) or 'none of them'}: "
+                   f"{', '.join(grow)} deg (on every grid) and the flow lasts measurably "
+                   f"longer at {', '.join(longer) + ' deg' if longer else 'none of them'}: "
                    + ("the experiments' trend, on the slopes where it could be measured, "
                       "where Coulomb's friction gives the opposite."
                       if grow == list(per) and longer == list(per) else
