@@ -189,11 +189,15 @@ def _against_bed(rows: list[dict], key: str, label: str, path: Path) -> Path:
         for j, closure in enumerate(CLOSURES):
             ax = axes[i, j]
             for th, col in zip(THETAS, colours, strict=True):
-                pts = [(e * 1e3, r[key]) for e in BEDS
-                       if (r := _pick(rows, name, closure, th, e, COARSE)) and r[key] is not None]
+                pts = [(e * 1e3, r[key], r["runout_lower_bound"]) for e in BEDS
+                       if (r := _pick(rows, name, closure, th, e, COARSE)) and r[key] is not None
+                       and not (r["runout_lower_bound"] and r["runout"] <= 1e-9)]
                 if pts:
-                    ax.plot(*zip(*pts, strict=True), "o-", color=col, ms=3,
+                    ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color=col, ms=3,
                             label=f"{th:g} deg")
+                    low = [p for p in pts if p[2]]
+                    ax.plot([p[0] for p in low], [p[1] for p in low], "^", color=col, ms=7,
+                            mfc="none")
             ax.set_title(f"{name.replace('two layers, ', '')}, {closure}", fontsize=9)
             ax.grid(alpha=0.3)
             if i == len(TWO) - 1:
@@ -202,7 +206,8 @@ def _against_bed(rows: list[dict], key: str, label: str, path: Path) -> Path:
                 ax.set_ylabel(label)
     axes[0, 0].legend(fontsize=7, title="theta", title_fontsize=7)
     fig.suptitle(f"two layers, dx = {COARSE * 1e3:g} mm: {label} against the bed's "
-                 "thickness", fontsize=10)
+                 "thickness\n(open triangles: the run reached the domain's end; runs whose "
+                 "bed slid out whole, leaving no front, not drawn)", fontsize=9)
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
