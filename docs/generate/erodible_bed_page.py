@@ -359,10 +359,14 @@ def _answer(n: dict[str, Any]) -> list[str]:
                "**Only in part.**" if len(grows) < len(tr) else "**Yes.**")
     lead = ""
     if grows and not grows_c:
+        below = all(th < n["phi_b"][k.split("|")[0]] for k in grows
+                    for th, dr in zip(tr[k]["steep_thetas"], tr[k]["dr_steep"], strict=True)
+                    if dr > 0)
         lead = ("The run-out grows with e_i above ~16 deg only with a rate-dependent law "
                 "for the bed (" + ", ".join(sorted({_short(k.split("|")[0]) for k in grows}))
-                + "; last sentences), and only on the slopes of the sweep below the law's "
-                "static angle. ")
+                + "; last sentences)"
+                + (", on the slopes of the sweep below the law's static angle (above it "
+                   "the flows leave the channel)" if below else "") + ". ")
     lines = [f"{verdict} {lead}With Coulomb's basal friction, over slopes of 0-25 deg, a bed of "
              f"e_i = {top:g} mm (H0/10) changes the two-layer run-out by {_range(steep)} at "
              f"theta >= {SMALL:g} deg and by {_range(small)} below, over both shipped "
