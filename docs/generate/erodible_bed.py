@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import math
 import sys
 import time
 import warnings
@@ -90,14 +91,50 @@ SETS: dict[str, tuple[str, list[str]]] = {
     "single layer": ("single_layer", []),
     "two layers, defaults": ("two_layer", []),
     "two layers, planar law set": ("two_layer", law_set_overrides()),
+    "two layers, pouliquen": ("two_layer", ["two_layer.friction_law='pouliquen'"]),
+    "two layers, mu_i": ("two_layer", ["two_layer.friction_law='mu_i'"]),
 }
-"""name -> (model, overrides): the shipped parameter sets (docs/parameters.md)"""
+"""name -> (model, overrides): the shipped parameter sets (docs/parameters.md), and the
+defaults with a rate-dependent law for the lower layer's bed, Pouliquen's mu(h, Fr) and
+the depth-averaged mu(I) (pdeflow/models/friction_laws.py at their glass-bead defaults;
+docs/rheology.md)"""
+LAW_SETS = ("two layers, pouliquen", "two layers, mu_i")
+"""the sets with a rate-dependent bed law. Their static angle depends on the depth
+(pouliquen) or is tan d1 (mu_i), so their phi_B is the angle at which the thickest bed of
+the sweep stands on its own (:func:`phi_b`). Their coarse sweep has no near-phi_B slopes:
+that angle is 21-22 deg, so the sweep's 19 and 22 deg already bracket it (and the near
+runs would need the 8 m channel). Their key points are refined twice (LAW_REFINE), at
+e_i = 0 and H0/10 only (LAW_KEY_BEDS), and at LAW_KEY_THETAS: 22 and 25 deg as for the
+other sets, and 16 and 19 deg, the steepest slopes below the law's static angle, where
+their flows stop inside the channel"""
+LAW_KEY_BEDS = (0.0, 0.014)
+LAW_KEY_THETAS = (16.0, 19.0, 22.0, 25.0)
+LAW_REFINE = (0.0025, 0.00125)
+
+
+def static_angle(name: str, depth: float) -> float:
+    """The bed law's static friction angle [deg] of the set ``name`` for a layer
+    ``depth`` [m] deep: Pouliquen's mu_stop(h) = tan d1 + (tan d2 - tan d1)/(1 + h/L)
+    (the inverse of h_stop; pdeflow.numerics.rheology.static_mu), mu_i's tan d1, and
+    Coulomb's phi_b_deg."""
+    model, sets = SETS[name]
+    p = load_case(CASE, sets).make_pde(model).parameters
+    if p.friction_law == "coulomb":
+        return float(p.phi_b_deg)
+    t1 = math.tan(math.radians(p.delta1_deg))
+    t2 = math.tan(math.radians(p.delta2_deg))
+    mu = t1 + (t2 - t1) / (1.0 + depth / p.pouliquen_L) if p.friction_law == "pouliquen" \
+        else t1
+    return math.degrees(math.atan(mu))
 
 
 def phi_b(name: str) -> float:
-    """The basal friction angle [deg] of the set ``name``."""
-    model, sets = SETS[name]
-    return float(load_case(CASE, sets).make_pde(model).parameters.phi_b_deg)
+    """The basal friction angle [deg] of the set ``name``: Coulomb's phi_b_deg, or for a
+    rate-dependent law its static angle for the thickest bed, e_i = H0/10 (the steepest
+    slope on which every bed of the sweep stands on its own), to 0.01 deg."""
+    if name in LAW_SETS:
+        return round(static_angle(name, max(BEDS)), 2)
+    return static_angle(name, 0.0)
 
 
 def point_case(name: str, closure: str, theta: float, e_i: float, dx: float,
@@ -200,12 +237,18 @@ def sweep_points() -> list[tuple]:
         closures = list(CLOSURES) if model == "two_layer" else ["-"]
         near = [phi_b(name) - d for d in NEAR]
         beds = BEDS if model == "two_layer" else (0.0,)  # the single layer has no bed
+        if name in LAW_SETS:
+            near = []
         for closure in closures:
             pts += [(name, closure, th, e, COARSE) for th in (*THETAS, *near) for e in beds]
-    keys = [p for p in pts if p[2] in KEY_THETAS and p[3] in KEY_BEDS]
+    keys = [p for p in pts if p[2] in KEY_THETAS and p[3] in KEY_BEDS
+            and p[0] not in LAW_SETS]
     near_keys = [p for p in pts if p[2] == phi_b(p[0]) - 2.0 and p[3] in KEY_BEDS]
+    law_keys = [p for p in pts if p[0] in LAW_SETS and p[2] in LAW_KEY_THETAS
+                and p[3] in LAW_KEY_BEDS]
     pts += [(*p[:4], dx) for dx in REFINE for p in keys]
     pts += [(*p[:4], dx) for dx in REFINE_NEAR for p in near_keys]
+    pts += [(*p[:4], dx) for dx in LAW_REFINE for p in law_keys]
     return pts
 
 

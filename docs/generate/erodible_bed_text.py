@@ -5,7 +5,19 @@ from __future__ import annotations
 
 from typing import Any
 
-from erodible_bed import BEDS, COARSE, DU_REG, H0, KEY_THETAS, NEAR, REFINE, THETAS
+from erodible_bed import (
+    BEDS,
+    COARSE,
+    DU_REG,
+    H0,
+    KEY_THETAS,
+    LAW_KEY_THETAS,
+    LAW_REFINE,
+    LAW_SETS,
+    NEAR,
+    REFINE,
+    THETAS,
+)
 
 SOURCES = """## Sources, and what could be confirmed
 
@@ -57,7 +69,9 @@ def _runs(n: dict[str, Any]) -> str:
             "`cases/paper_5_2_two_layer_law.toml` (phi_B "
             f"{phi['two layers, planar law set']:g} deg, k 0.8, c 1, 75 deg wedge), each "
             f"with three closures: the paper's (25), the same bounded by du_reg = {DU_REG:g} "
-            "m/s, and the relaxed one (tau_star = 1). First-order HLL, CFL 0.3, each run "
+            "m/s, and the relaxed one (tau_star = 1). "
+            + _law_sets(n)
+            + " First-order HLL, CFL 0.3, each run "
             f"to rest; coarse grid dx = {COARSE * 1e3:g} mm for the whole sweep. Run-out = "
             "front - L0, the front being the downstream face of the last cell deeper than "
             "1 mm above the initial bed; flow duration = the first time from which the "
@@ -66,6 +80,32 @@ def _runs(n: dict[str, Any]) -> str:
             f"{n['domain_end_runs']} of them let material (at least a thin film) out of the "
             "channel's open end, and their run-outs are lower bounds (marked ≥); the "
             f"others conserve mass to {n['max_mass_error']:.1e}.")
+
+
+def _law_sets(n: dict[str, Any]) -> str:
+    """The rate-dependent sets and what their phi_B means."""
+    phi = n["phi_b"]
+    from erodible_bed import static_angle
+
+    names = [k for k in phi if k in LAW_SETS]
+    if not names:
+        return ""
+    thin = min(e for e in BEDS if e > 0)
+    lo, hi = min(phi[k] for k in names), max(phi[k] for k in names)
+    return ("The defaults with a rate-dependent law for the lower layer's bed friction "
+            "(`two_layer.friction_law`, glass-bead constants, docs/rheology.md), the same "
+            "three closures: " + ", ".join(
+                f"{k.replace('two layers, ', '')} (phi_B {phi[k]:g} deg)" for k in names)
+            + ". Their static angle depends on the depth the law sees (pouliquen: "
+            "tan d1 + (tan d2 - tan d1)/(1 + h/L), the inverse of h_stop; mu_i: tan d1 at "
+            "any depth); their phi_B is the angle at which the thickest bed, e_i = "
+            f"{max(BEDS) * 1e3:g} mm, stands on its own"
+            + "".join(f" ({k.replace('two layers, ', '')}: thinner beds stand steeper, "
+                      f"the {thin * 1e3:g} mm bed to {static_angle(k, thin):.1f} deg)"
+                      for k in names if static_angle(k, thin) > phi[k] + 0.05)
+            + ". Their sweep has no slopes near phi_B: it lies between "
+            f"{max(t for t in THETAS if t < lo):g} and {min(t for t in THETAS if t > hi):g} "
+            "deg of the sweep (and their near runs would need the 8 m channel).")
 
 
 def _depths(n: dict[str, Any], name: str) -> str:
@@ -128,15 +168,16 @@ def _why(n: dict[str, Any]) -> str:
         "Fernandez-Nieto et al. 2016; hysteresis, as Edwards et al. 2021) for the lower "
         "layer with phi_B near the beads' angles, or an erosion criterion that involves the "
         "bed's own stress balance. The two-layer model has such laws for its lower layer "
-        "(`two_layer.friction_law`, [model.md](model.md)); they are not part of this "
-        "sweep.")
+        "(`two_layer.friction_law`, [model.md](model.md)); the sets with pouliquen's and "
+        "mu_i's law above (the answer) put its bed's static angle near the beads' "
+        "angles.")
 
 
 def _distance(n: dict[str, Any]) -> str:
     """The distance to the two confirmed statements, from the sweep's numbers."""
     from erodible_bed_page import near_growth
 
-    tr = n["trend"]
+    tr = {k: t for k, t in n["trend"].items() if k.split("|")[0] not in LAW_SETS}
     grows = sorted({(k, th) for k, t in tr.items() for th, dr in
                     zip([x for x in THETAS if x >= 16], t["dr_steep"], strict=False)
                     if dr > 0})
@@ -145,7 +186,8 @@ def _distance(n: dict[str, Any]) -> str:
                        f"{n['phi_b'][k.split('|')[0]] - d:g} deg" for k, d, _, _ in near)
              or "nowhere")
     dts = [v for t in tr.values() for v in t["dt_steep"]]
-    return ("**Distance to the numbers that could be confirmed.** (1) The critical slope "
+    return ("**Distance to the numbers that could be confirmed** (Coulomb's sets; the "
+            "rate-dependent laws in the answer). (1) The critical slope "
             "(~16 deg) above which the run-out grows with e_i: "
             + ("the model has none in 0-25 deg, its run-out never grows with e_i there"
                if not grows else f"the model's run-out grows at {grows}")
@@ -204,12 +246,15 @@ def render(n: dict[str, Any], answer: list[str], trend: list[str],
         "\n".join(trend) + "\n",
         f"The single layer on the rigid bed (no e_i dependence by construction): {single}.\n",
         "![flow duration against e_i](erodible_bed/duration.png)\n",
-        "Near each set's basal friction angle (du_reg closure):\n",
+        "Near each Coulomb set's basal friction angle (du_reg closure):\n",
         "![near phi_B](erodible_bed/near_phi_b.png)\n",
         "**Convergence** (key points at "
         + ", ".join(f"{t:g}" for t in KEY_THETAS)
         + f" deg on dx = {COARSE * 1e3:g} mm and {', '.join(f'{d * 1e3:g}' for d in REFINE)}"
-        " mm; 2 deg below phi_B on two halvings):\n",
+        " mm; 2 deg below phi_B on two halvings; the rate-dependent laws at "
+        + ", ".join(f"{t:g}" for t in LAW_KEY_THETAS)
+        + " deg, e_i = 0 and " + f"{max(BEDS) * 1e3:g}" + " mm, on dx = "
+        + ", ".join(f"{d * 1e3:g}" for d in (COARSE, *LAW_REFINE)) + " mm):\n",
         "\n".join(convergence) + "\n",
         _distance(n) + "\n",
         "**The side view** (planar law set, du_reg, theta 22 deg, e_i 5 mm, dx 1.25 mm): "
