@@ -49,6 +49,14 @@ import study_scaling  # noqa: E402
 import suite  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "measurements"  # not "results/": git-ignored
+SECTIONS: dict[str, tuple[Any, str, int]] = {
+    "start": (start_up, "start_up.json", 9),
+    "geometry": (geometry_cost, "geometry.json", 7),
+    "bed": (bed_cost, "bed.json", 7),
+}
+"""the parts that are one module each: ``--only NAME`` -> (the module, with
+``measure(repeats)`` and ``render(data)``; its stored results; the least repeats), in
+the order of the doc's sections after the cold first run"""
 FIGURES = ROOT / "docs" / "figures"
 DOC = ROOT / "docs" / "performance.md"
 
@@ -244,9 +252,11 @@ def _best(rows: list[dict[str, Any]], model: str) -> str:
 def render(wp: dict[str, Any] | None, bench: dict[str, Any] | None,
            studies: dict[str, Any] | None = None,
            cold: dict[str, Any] | None = None,
-           geometry: dict[str, Any] | None = None, bed: dict[str, Any] | None = None,
-           start: dict[str, Any] | None = None) -> str:
-    """docs/performance.md from the stored measurements."""
+           sections: dict[str, dict[str, Any]] | None = None) -> str:
+    """docs/performance.md from the stored measurements (``sections``: those of
+    :data:`SECTIONS` by name)."""
+    sections = sections or {}
+    start = sections.get("start")
     L: list[str] = []
     a = L.append
     a("# Performance: work precision and benchmarks\n")
@@ -292,12 +302,9 @@ def render(wp: dict[str, Any] | None, bench: dict[str, Any] | None,
         a(_render_bench(bench))
     if cold:
         a(cold_start.render(cold))
-    if start:
-        a(start_up.render(start))
-    if geometry:
-        a(geometry_cost.render(geometry))
-    if bed:
-        a(bed_cost.render(bed))
+    for name, (module, _, _) in SECTIONS.items():
+        if sections.get(name):
+            a(module.render(sections[name]))
     if studies:
         a(f"Studies conditions: {_cond(studies['conditions'])}.\n")
         a(study_scaling.render(studies))
@@ -660,8 +667,7 @@ def _findings(wp: dict[str, Any] | None, b: dict[str, Any] | None) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--only", choices=("wp", "bench", "studies", "cold", "geometry", "bed",
-                                      "laws", "start"),
+    p.add_argument("--only", choices=("wp", "bench", "studies", "cold", "laws", *SECTIONS),
                    default=None, help="one part ('laws': only the friction-law rows of the "
                    "benchmark suite, merged into its stored results)")
     p.add_argument("--label", default="after",
@@ -687,9 +693,7 @@ def main(argv: list[str] | None = None) -> int:
     wp_path, bench_path = results / "workprecision.json", results / "bench.json"
     studies_path = results / "studies.json"
     cold_path = results / "cold_start.json"
-    geometry_path = results / "geometry.json"
-    bed_path = results / "bed.json"
-    start_path = results / "start_up.json"
+    paths = {name: results / file for name, (_, file, _) in SECTIONS.items()}
     if not args.render:
         import pyclaw_run
 
@@ -712,16 +716,10 @@ def main(argv: list[str] | None = None) -> int:
             c[args.label] = cold_start.measure(max(3, repeats // 2 + 1), Path(args.tree),
                                                log=sys.stderr, commit_id=args.commit)
             cold_path.write_text(json.dumps(c, indent=1, default=str))
-        if args.only in (None, "geometry"):
-            geometry_path.write_text(json.dumps(geometry_cost.measure(max(repeats, 7)),
-                                                indent=1, default=str))
-        if args.only in (None, "bed"):
-            bed_path.write_text(json.dumps(bed_cost.measure(max(repeats, 7)), indent=1,
-                                           default=str))
-        if args.only in (None, "start"):
-            start_path.write_text(json.dumps(start_up.measure(max(repeats, 9),
-                                                              log=sys.stderr),
-                                             indent=1, default=str))
+        for name, (module, _, least) in SECTIONS.items():
+            if args.only in (None, name):
+                paths[name].write_text(json.dumps(module.measure(max(repeats, least)),
+                                                  indent=1, default=str))
         if args.only in (None, "wp"):
             w = measure_wp(args.quick, max(3, repeats) if not args.quick else repeats,
                            results)
@@ -730,10 +728,9 @@ def main(argv: list[str] | None = None) -> int:
     bench = json.loads(bench_path.read_text()) if bench_path.exists() else None
     studies = json.loads(studies_path.read_text()) if studies_path.exists() else None
     cold = json.loads(cold_path.read_text()) if cold_path.exists() else None
-    geometry = json.loads(geometry_path.read_text()) if geometry_path.exists() else None
-    bed = json.loads(bed_path.read_text()) if bed_path.exists() else None
-    start = json.loads(start_path.read_text()) if start_path.exists() else None
-    Path(doc).write_text(render(wp, bench, studies, cold, geometry, bed, start))
+    sections = {name: json.loads(path.read_text()) for name, path in paths.items()
+                if path.exists()}
+    Path(doc).write_text(render(wp, bench, studies, cold, sections))
     _log(f"written {doc}")
     return 0
 

@@ -66,8 +66,9 @@ def commands() -> dict[str, list[str]]:
             "import pde": [sys.executable, "-c", "import pde"]}
 
 
-def measure(repeats: int = 9, app: bool = True, log: Any = None) -> dict[str, Any]:
-    """Kernel loads and the commands of the module docstring, ``repeats`` each."""
+def measure(repeats: int = 9, app: bool = True, log: Any = sys.stderr) -> dict[str, Any]:
+    """Kernel loads and the commands of the module docstring, ``repeats`` each (each
+    round's times printed to ``log``; None: quiet)."""
     load = os.getloadavg()
     cache = tempfile.mkdtemp(prefix="pdeflow-start-numba-")
     try:

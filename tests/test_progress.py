@@ -193,3 +193,32 @@ def test_replayed_movie_counts_its_frames(tmp_path, capsys):
     err = capsys.readouterr().err.replace("\n", "\r").split("\r")
     bar = [d.strip() for d in err if "|" in d]
     assert bar and bar[-1].startswith("drawing r.gif: 100%"), bar
+
+
+def test_sweep_and_convergence_show_a_bar_over_their_runs(capsys):
+    """A sweep counts its runs, a convergence study its grid levels, on stderr; the
+    numbers are those of a run without the bar."""
+    from pdeflow.analysis.convergence import converge
+    from pdeflow.analysis.sweep import run_sweep
+
+    case = load_case(ROOT / "cases" / "collapse_sweep.toml",
+                     ["sweep.aspect_ratios=[2, 4]", "grid.dx=0.05",
+                      "case.models=['single_layer']"])
+    quiet = run_sweep(case)
+    capsys.readouterr()
+    shown = run_sweep(case, progress=True)
+    err = capsys.readouterr().err
+    assert "sweep" in err and "2/2" in err
+    assert [r["r"] for r in shown["models"]["single_layer"]["runs"]] == \
+        [r["r"] for r in quiet["models"]["single_layer"]["runs"]]
+    converge(load_case(RITTER, ["grid.dx=0.05"]), 2, "single_layer", progress=True)
+    assert "grid levels" in capsys.readouterr().err
+
+
+def test_commands_draw_the_bar_only_on_a_terminal(tmp_path, capsys):
+    """``pdeflow sweep`` into a pipe (a test, a script) prints no bar."""
+    from pdeflow.cli import main
+
+    main(["sweep", str(ROOT / "cases" / "collapse_sweep.toml"), "--set",
+          "sweep.aspect_ratios=[2]", "--set", "grid.dx=0.05"])
+    assert "sweep:" not in capsys.readouterr().err

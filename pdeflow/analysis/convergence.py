@@ -72,15 +72,17 @@ def qoi_row(point: Point, volume_times: tuple[float, ...]) -> dict[str, Any]:
 
 def converge(case: Case, levels: int, model: str = PAPER_MODEL,
              volume_times: tuple[float, ...] = (0.01, 0.1, 0.25, 0.5, 1.0),
-             executor: Executor = serial) -> dict[str, Any]:
-    """Run ``model`` of ``case`` on ``levels`` halvings of dx; QoIs per level."""
+             executor: Executor = serial, progress: bool = False) -> dict[str, Any]:
+    """Run ``model`` of ``case`` on ``levels`` halvings of dx; QoIs per level
+    (``progress``: a bar over the levels on stderr)."""
     points = []
     for level in range(levels):
         c = refined(case, level)
         c.data.setdefault("output", {})["snapshot_times"] = [
             t for t in volume_times if t <= c.t_end]
         points.append(Point(c, model))
-    rows = Study(points, partial(qoi_row, volume_times=volume_times)).execute(executor)
+    rows = Study(points, partial(qoi_row, volume_times=volume_times)).execute(
+        executor, "grid levels" if progress else None)
     qois = [k for k in rows[0] if k not in ("dx", "cells", "steps", "wall_time_s",
                                              "max_fextra_x", "max_fextra_time")]
     return {"case": case.name, "model": model, "levels": rows,
@@ -162,10 +164,11 @@ def fit_row(point: Point) -> dict[str, Any]:
 
 
 def converge_sweep(case: Case, levels: int, model: str = PAPER_MODEL,
-                   executor: Executor = serial) -> dict[str, Any]:
-    """Refine a sweep case; fitted prefactor and exponent per level."""
+                   executor: Executor = serial, progress: bool = False) -> dict[str, Any]:
+    """Refine a sweep case; fitted prefactor and exponent per level (``progress``: a
+    bar over the levels on stderr)."""
     points = [Point(refined(case, level), model) for level in range(levels)]
-    rows = Study(points, fit_row).execute(executor)
+    rows = Study(points, fit_row).execute(executor, "grid levels" if progress else None)
     return {"case": case.name, "model": model, "levels": rows,
             "analysis": {k: richardson([r[k] for r in rows])
                          for k in ("prefactor", "exponent")}}
@@ -253,11 +256,12 @@ def cmd_converge(args: argparse.Namespace) -> int:
             raise CaseError(f"{err}; {remedy}") from None
         check_size(finest, args.force, remedy)
     prepare(case_steppers(case), log=sys.stderr)
+    progress = sys.stderr.isatty()
     if case.data.get("sweep"):
-        res = converge_sweep(case, args.levels, args.model)
+        res = converge_sweep(case, args.levels, args.model, progress=progress)
         print(table(res, SWEEP_VIEW))
     else:
-        res = converge(case, args.levels, args.model)
+        res = converge(case, args.levels, args.model, progress=progress)
         keys = None if args.all else [k for k in SHORT_VIEW if k in res["levels"][0]
                                       and any(r[k] is not None for r in res["levels"])]
         print(table(res, keys))

@@ -118,8 +118,9 @@ def deposit_row(point: Point) -> dict[str, Any]:
 
 def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
               models: list[str] | None = None,
-              executor: Executor = serial) -> dict[str, Any]:
-    """Run every model at every aspect ratio; return the sweep summary.
+              executor: Executor = serial, progress: bool = False) -> dict[str, Any]:
+    """Run every model at every aspect ratio; return the sweep summary (``progress``: a
+    bar over the runs on stderr).
 
     A :class:`~pdeflow.study.core.Study`: one point per model and aspect ratio a
     (the case with H0 = a L0, no snapshots), measured by :func:`runout_row` (on an
@@ -138,7 +139,7 @@ def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
               for model in models for a in ratios]
     wall0 = time.perf_counter()
     measure = deposit_row if case.geometry == "axisymmetric" else runout_row
-    table = Study(points, measure).execute(executor)
+    table = Study(points, measure).execute(executor, "sweep" if progress else None)
     for model in models:
         rows = [{k: v for k, v in row.items() if k != "model"} for row in table
                 if row["model"] == model]
@@ -225,7 +226,7 @@ def cmd_sweep(args: Any) -> int:
     case = load_case(args.case, args.set)
     sweep_ratios(case)  # before any run
     prepare(case_steppers(case), log=None if args.quiet else sys.stderr)
-    summary = run_sweep(case)
+    summary = run_sweep(case, progress=not args.quiet and sys.stderr.isatty())
     if args.summary:
         io.write_json(args.summary, summary)
     if args.plot:

@@ -200,9 +200,19 @@ class Study:
     """the row of each point of a batch that raised (e.g. its worker died): a study of
     thousands of points goes on; None: the error ends the study"""
 
-    def execute(self, executor: Executor = serial) -> list[Row]:
-        """The rows ``{**point.labels, **measure(point)}``, in the order of the points."""
-        return self.run(executor).rows
+    def execute(self, executor: Executor = serial, progress: str | None = None
+                ) -> list[Row]:
+        """The rows ``{**point.labels, **measure(point)}``, in the order of the points;
+        ``progress``: the label of a bar over the points on stderr (None: no bar)."""
+        if progress is None or not isinstance(self.points, Sequence):
+            return self.run(executor).rows
+        from ..trackers.progress import PointsBar
+
+        bar = PointsBar(len(self.points), progress)
+        try:
+            return self.run(executor, on_rows=bar).rows
+        finally:
+            bar.close()
 
     def run(self, executor: Executor = serial,
             on_rows: Callable[[list[Row]], Any] | None = None,

@@ -94,4 +94,28 @@ class ProgressBar(ProgressTracker):
         bar.close()
 
 
-__all__ = ["ProgressBar"]
+class PointsBar:
+    """A bar over the points of a study, a sweep or a convergence study: it advances as
+    each batch of rows arrives (``bar(rows)``, the ``on_rows`` of
+    :meth:`pdeflow.study.core.Study.run`), drawn once per batch; :meth:`close` ends it.
+    It only counts rows: the results do not depend on it.
+
+    Args:
+        total: number of points.
+        label: text in front of the bar (e.g. 'sweep').
+    """
+
+    def __init__(self, total: int, label: str):
+        import sys
+
+        self.bar = get_progress_bar_class()(total=total, desc=label, unit="run",
+                                            leave=True, file=sys.stderr)
+
+    def __call__(self, rows: list[Any]) -> None:
+        self.bar.update(len(rows))
+
+    def close(self) -> None:
+        self.bar.close()
+
+
+__all__ = ["PointsBar", "ProgressBar"]
