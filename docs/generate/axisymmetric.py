@@ -17,7 +17,6 @@ checks that the page is that rendering of those numbers.
 from __future__ import annotations
 
 import argparse
-import csv
 import sys
 import time
 import warnings
@@ -25,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import run_cache
 
 from pdeflow.analysis.sweep import deposit_numbers, fit_power_law
 from pdeflow.cases import load_case, tomllib
@@ -103,47 +103,18 @@ def measure_point(name: str, dx: float, a: float,
 
 def read_cache(path: Path = CSV) -> list[dict[str, Any]]:
     """The stored rows, numbers parsed (empty cells: None)."""
-    if not path.is_file():
-        return []
-    rows = []
-    with path.open() as f:
-        for raw in csv.DictReader(f):
-            row: dict[str, Any] = {}
-            for k, v in raw.items():
-                if k in ("set", "warnings"):
-                    row[k] = v
-                elif k == "at_rest":
-                    row[k] = v == "True"
-                else:
-                    row[k] = float(v) if v not in ("", "None") else None
-            rows.append(row)
-    return rows
+    return run_cache.read_rows(path, ("set", "warnings"))
 
 
 def fill_cache(points: list[tuple[str, float, float]], path: Path = CSV,
                log: Any = sys.stderr) -> list[dict[str, Any]]:
     """Run every (set, dx, a) of ``points`` not yet in ``path``, appending each row as it
     ends (an interrupted call loses at most the run under way); return all rows."""
-    rows = read_cache(path)
-    done = {(r["set"], r["dx"], r["a"]) for r in rows}
-    path.parent.mkdir(parents=True, exist_ok=True)
-    new = not path.is_file()
-    with path.open("a", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=FIELDS)
-        if new:
-            w.writeheader()
-        for p in points:
-            if p in done:
-                continue
-            t0 = time.perf_counter()
-            row = measure_point(*p)
-            w.writerow(row)
-            f.flush()
-            rows.append(row)
-            if log:
-                print(f"{p[0]:28} dr {p[1]:<10g} a {p[2]:<5g} r {row['r']:.4g}  "
-                      f"({time.perf_counter() - t0:.1f} s)", file=log)
-    return rows
+    return run_cache.fill_rows(
+        points, path, FIELDS, read_cache(path), key=tuple,
+        row_key=lambda r: (r["set"], r["dx"], r["a"]), measure=lambda p: measure_point(*p),
+        describe=lambda p, row, s: f"{p[0]:28} dr {p[1]:<10g} a {p[2]:<5g} "
+                                   f"r {row['r']:.4g}  ({s:.1f} s)", log=log)
 
 
 def sweep_points(grids: tuple[float, ...] = GRIDS) -> list[tuple[str, float, float]]:

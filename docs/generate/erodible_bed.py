@@ -19,7 +19,6 @@ runs made every time (seconds).
 from __future__ import annotations
 
 import argparse
-import csv
 import math
 import sys
 import time
@@ -28,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import run_cache
 
 from pdeflow.cases import load_case, tomllib
 from pdeflow.checks import RunWarning
@@ -186,47 +186,20 @@ def _key(row: dict[str, Any]) -> tuple:
 
 def read_cache(path: Path = CSV) -> list[dict[str, Any]]:
     """The stored rows, numbers parsed (empty cells: None)."""
-    if not path.is_file():
-        return []
-    rows = []
-    with path.open() as f:
-        for raw in csv.DictReader(f):
-            row: dict[str, Any] = {}
-            for k, v in raw.items():
-                if k in ("set", "closure", "warnings"):
-                    row[k] = v
-                elif k in ("at_rest", "runout_lower_bound"):
-                    row[k] = v == "True"
-                else:
-                    row[k] = float(v) if v not in ("", "None") else None
-            rows.append(row)
-    return rows
+    return run_cache.read_rows(path, ("set", "closure", "warnings"),
+                               ("at_rest", "runout_lower_bound"))
 
 
 def fill_cache(points: list[tuple], path: Path = CSV,
                log: Any = sys.stderr) -> list[dict[str, Any]]:
     """Run every point not yet in ``path``, appending each row as it ends; all rows."""
-    rows = read_cache(path)
-    done = {_key(r) for r in rows}
-    path.parent.mkdir(parents=True, exist_ok=True)
-    new = not path.is_file()
-    with path.open("a", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=FIELDS)
-        if new:
-            w.writeheader()
-        for p in points:
-            if (p[0], p[1], float(p[2]), float(p[3]), float(p[4])) in done:
-                continue
-            t0 = time.perf_counter()
-            row = measure_point(*p)
-            w.writerow(row)
-            f.flush()
-            rows.append(row)
-            if log:
-                print(f"{p[0]:27} {p[1]:8} theta {p[2]:<4g} e_i {p[3]:<6g} dx {p[4]:<9g} "
-                      f"run-out {row['runout']:.4g} ({time.perf_counter() - t0:.1f} s)",
-                      file=log, flush=True)
-    return rows
+    return run_cache.fill_rows(
+        points, path, FIELDS, read_cache(path),
+        key=lambda p: (p[0], p[1], float(p[2]), float(p[3]), float(p[4])), row_key=_key,
+        measure=lambda p: measure_point(*p),
+        describe=lambda p, row, s: f"{p[0]:27} {p[1]:8} theta {p[2]:<4g} e_i {p[3]:<6g} "
+                                   f"dx {p[4]:<9g} run-out {row['runout']:.4g} ({s:.1f} s)",
+        log=log)
 
 
 def sweep_points() -> list[tuple]:

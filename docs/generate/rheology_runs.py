@@ -10,13 +10,13 @@ only the points missing from the cache; ``fill_cache(..., rerun=True)`` runs the
 
 from __future__ import annotations
 
-import csv
 import math
 import sys
-import time
 import warnings
 from pathlib import Path
 from typing import Any
+
+import run_cache
 
 from pdeflow.analysis.sweep import run_sweep
 from pdeflow.cases import load_case
@@ -97,21 +97,7 @@ def measure(point: Point, length: float | None = None) -> dict[str, Any]:
 
 def read_cache(path: Path) -> list[dict[str, Any]]:
     """The stored rows, numbers parsed (empty cells: None)."""
-    if not path.is_file():
-        return []
-    rows = []
-    with path.open() as f:
-        for raw in csv.DictReader(f):
-            row: dict[str, Any] = {}
-            for k, v in raw.items():
-                if k in TEXT:
-                    row[k] = v
-                elif k == "at_rest":
-                    row[k] = v == "True"
-                else:
-                    row[k] = float(v) if v not in ("", "None") else None
-            rows.append(row)
-    return rows
+    return run_cache.read_rows(path, TEXT)
 
 
 def key(row: dict[str, Any]) -> Point:
@@ -128,35 +114,12 @@ def fill_cache(points: list[Point], path: Path, rerun: bool = False,
     if rerun:
         todo = set(points)
         rows = [r for r in rows if key(r) not in todo]
-        _write(path, rows)
-    done = {key(r) for r in rows}
-    path.parent.mkdir(parents=True, exist_ok=True)
-    new = not path.is_file()
-    with path.open("a", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=FIELDS)
-        if new:
-            w.writeheader()
-        for p in points:
-            if p in done:
-                continue
-            t0 = time.perf_counter()
-            row = measure(p, (length or {}).get(p[0]))
-            w.writerow(row)
-            f.flush()
-            rows.append(row)
-            done.add(p)
-            if log:
-                print(f"{p[0]:12} {p[1]:12} {p[2]:10} dx {p[3]:<10g} a {p[4]:<5g} "
-                      f"r {row['r']}  ({time.perf_counter() - t0:.1f} s)", file=log)
-    return rows
-
-
-def _write(path: Path, rows: list[dict[str, Any]]) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with path.open("w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=FIELDS)
-        w.writeheader()
-        w.writerows(rows)
+        run_cache.write_rows(path, FIELDS, rows)
+    return run_cache.fill_rows(
+        points, path, FIELDS, rows, key=tuple, row_key=key,
+        measure=lambda p: measure(p, (length or {}).get(p[0])),
+        describe=lambda p, row, s: f"{p[0]:12} {p[1]:12} {p[2]:10} dx {p[3]:<10g} "
+                                   f"a {p[4]:<5g} r {row['r']}  ({s:.1f} s)", log=log)
 
 
 COST_WEIGHT = {"planar": 1.0, "axisymmetric": 8.0}

@@ -260,18 +260,8 @@ class FVSplitSolver(SolverBase):
                           max_steps, stop, t_pause, prev)
 
         if self.backend_name == "numba":
-            kernel = scheme_stepper(*scheme)  # compiled (or loaded) at its first call
-            left = np.full_like(state.data, np.nan)  # the state the last call left
-
-            def advance(q: np.ndarray, t0: float, t_pause: float, t1: float):
-                # the loop goes on from its last live cells only if nobody changed the
-                # state in between (pdeflow.numerics.resting)
-                if not np.array_equal(q, left):
-                    diag[L.D_RESUME] = 0.0
-                out = run_kernel(kernel, q, t0, t1, diag, rate, backup, work,
-                                 self.max_steps, t_pause)
-                np.copyto(left, q)
-                return out
+            advance = self._compiled_loop(scheme_stepper(*scheme), run_kernel, diag, rate,
+                                          backup, work)
         else:
             advance = self._numpy_loop(state, dx, P, hook, diag, prev)
 
@@ -377,6 +367,24 @@ class FVSplitSolver(SolverBase):
                "pde.diagnostics['last_state'].")
         self.info["blowup"] = report
         raise SimulationBlowUp(msg, report=report, state=state.data.copy())
+
+    def _compiled_loop(self, kernel: Any, run_kernel: Any, diag: np.ndarray,
+                       rate: np.ndarray, backup: np.ndarray, work: np.ndarray) -> Any:
+        """``advance(q, t0, t_pause, t1)`` with the compiled ``kernel`` (compiled or
+        loaded at its first call): it goes on from the live cells of the state its last
+        call left only if nobody changed that state in between
+        (:mod:`pdeflow.numerics.resting`)."""
+        left = np.full_like(rate, np.nan)  # the state the last call left
+
+        def advance(q: np.ndarray, t0: float, t_pause: float, t1: float):
+            if not np.array_equal(q, left):
+                diag[L.D_RESUME] = 0.0
+            out = run_kernel(kernel, q, t0, t1, diag, rate, backup, work, self.max_steps,
+                             t_pause)
+            np.copyto(left, q)
+            return out
+
+        return advance
 
     def _numpy_loop(self, state: Any, dx: float, P: np.ndarray, hook: Any,
                     diag: np.ndarray, prev: np.ndarray):
