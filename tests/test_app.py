@@ -443,3 +443,36 @@ def test_app_present_option():
 
     assert build_parser().parse_args(["app", "--present"]).present
     assert not build_parser().parse_args(["app"]).present
+
+
+def test_pages_not_shown_are_built_when_their_tab_opens():
+    """Only the dam-break page is built at start; the run-out and hyperbolicity pages
+    when their tab is first opened (then in the mode of that moment)."""
+    from pdeflow.app.layout import SessionPages, build_pages
+
+    toggle = pn.widgets.Toggle(value=False)
+    pages = SessionPages(CASES)
+    tabs = build_pages(CASES, toggle=toggle, pages=pages)
+    assert list(pages.pages) == ["dam-break"]
+    assert [len(t.objects) for t in tabs.objects] == [1, 0, 0]
+    toggle.value = True  # presentation mode before the others exist
+    tabs.active = 2
+    assert [len(t.objects) for t in tabs.objects] == [1, 0, 1]
+    tabs.active = 1
+    assert [len(t.objects) for t in tabs.objects] == [1, 1, 1]
+    runout = pages.pages["run-out"]
+    assert runout.started and runout.present and pages.pages["hyperbolicity"].present
+    shown = tabs.objects[1].objects[0]
+    tabs.active = 0
+    tabs.active = 1  # built once
+    assert tabs.objects[1].objects[0] is shown and pages.pages["run-out"] is runout
+    toggle.value = False
+    assert not any(p.present for p in pages.pages.values())
+
+
+def test_the_page_asked_for_is_built_at_start():
+    from pdeflow.app.layout import build_pages
+
+    tabs = build_pages(CASES, page="hyperbolicity")
+    assert tabs.active == 2
+    assert [len(t.objects) for t in tabs.objects] == [1, 0, 1]

@@ -42,31 +42,67 @@ def _requested_present() -> bool | None:
     return value.lower() not in ("0", "false", "no", "off", "")
 
 
+class SessionPages:
+    """The three pages of one session, each built when its tab is first shown: the
+    dam-break page at once (the hyperbolicity page shows its run), the others on
+    demand, so the first picture does not wait for pages nobody looks at yet."""
+
+    def __init__(self, case_dir: Path, page: str | None = None, present: bool = False):
+        self.case_dir = case_dir
+        self.first = page
+        self.present = present
+        self.shared = SharedRun()
+        self.pages: dict[str, Any] = {}
+        self.holders = {key: pn.Column(sizing_mode="stretch_width") for key in PAGES}
+
+    def build(self, key: str) -> Any:
+        """The page ``key``, built (in the current mode) and put in its tab if new."""
+        if key not in self.pages:
+            if key == "dam-break":
+                page: Any = DamBreakPage(self.case_dir, self.shared, present=self.present)
+            elif key == "run-out":
+                page = RunoutPage(self.case_dir, start=self.first == "run-out",
+                                  present=self.present)
+            else:
+                page = HyperbolicityPage(self.shared, present=self.present)
+            self.pages[key] = page
+            self.holders[key].objects = [page.panel()]
+        return self.pages[key]
+
+    def show(self, key: str) -> None:
+        """The tab ``key`` opened: build its page; the run-out set starts computing."""
+        page = self.build(key)
+        if key == "run-out":
+            page.start()  # the run-out set (about 20 runs): when first shown
+
+    def set_present(self, present: bool) -> None:
+        """Presentation mode on or off, for the pages built and those to come."""
+        self.present = present
+        with pn.io.hold():
+            for key, p in self.pages.items():
+                p.set_present(present)
+                if key != "hyperbolicity":  # the side bar follows the mode
+                    p.layout.show_sidebar(not present)
+
+
 def build_pages(case_dir: Path, page: str | None = None, present: bool = False,
-                toggle: pn.widgets.Toggle | None = None) -> pn.Tabs:
+                toggle: pn.widgets.Toggle | None = None,
+                pages: SessionPages | None = None) -> pn.Tabs:
     """The three pages of one session as tabs (``page`` selects the one shown first;
-    ``present``: presentation mode, switched by ``toggle`` if given)."""
-    shared = SharedRun()
-    dam = DamBreakPage(case_dir, shared, present=present)
-    runout = RunoutPage(case_dir, start=page == "run-out", present=present)
-    hyper = HyperbolicityPage(shared, present=present)
-    tabs = pn.Tabs((PAGES["dam-break"], dam.panel()), (PAGES["run-out"], runout.panel()),
-                   (PAGES["hyperbolicity"], hyper.panel()),
+    ``present``: presentation mode, switched by ``toggle`` if given). Only the
+    dam-break page and the one shown first are built now, the others when their tab
+    is first opened (``pages``: the session's pages, default new ones)."""
+    pages = pages or SessionPages(case_dir, page, present)
+    pages.build("dam-break")
+    keys = list(PAGES)
+    tabs = pn.Tabs(*((PAGES[k], pages.holders[k]) for k in keys),
                    dynamic=True, sizing_mode="stretch_width")
     if toggle is not None:
-        def switch(event: Any) -> None:
-            with pn.io.hold():
-                for p in (dam, runout, hyper):
-                    p.set_present(event.new)
-                for p in (dam, runout):  # the side bar follows the mode
-                    p.layout.show_sidebar(not event.new)
-
-        toggle.param.watch(switch, "value")
+        toggle.param.watch(lambda e: pages.set_present(e.new), "value")
     if page in PAGES:
-        tabs.active = list(PAGES).index(page)
-    run_out = list(PAGES).index("run-out")
-    # the run-out set (about 20 runs) is computed when its page is first shown
-    tabs.param.watch(lambda e: runout.start() if e.new == run_out else None, "active")
+        pages.show(page)
+        tabs.active = keys.index(page)
+    tabs.param.watch(lambda e: pages.show(keys[e.new]), "active")
     return tabs
 
 
