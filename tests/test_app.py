@@ -7,6 +7,7 @@ from __future__ import annotations
 import io
 import socket
 import threading
+from html import escape
 from pathlib import Path
 
 import numpy as np
@@ -476,3 +477,46 @@ def test_the_page_asked_for_is_built_at_start():
     tabs = build_pages(CASES, page="hyperbolicity")
     assert tabs.active == 2
     assert [len(t.objects) for t in tabs.objects] == [1, 0, 1]
+
+
+def _short_sweep(tmp_path: Path, t_end: float, length: float) -> Path:
+    """cases/collapse_sweep.toml with its a values 2 and 3, ``t_end`` and ``length``."""
+    text = (CASES / "collapse_sweep.toml").read_text()
+    text = text.replace("t_end = 30.0", f"t_end = {t_end}")
+    text = text.replace("length = 12.0", f"length = {length}")
+    text = text.replace("aspect_ratios = [2, 3, 4, 6, 8, 10, 14, 18, 24, 30]",
+                        "aspect_ratios = [2, 3]")
+    (tmp_path / "collapse_sweep.toml").write_text(text)
+    return tmp_path / "collapse_sweep.toml"
+
+
+@pytest.mark.parametrize("t_end, length, says", [
+    (0.3, 12.0, "still moving at the end of the run"),
+    (30.0, 0.4, "material reached"),
+])
+def test_the_runout_page_warns_as_the_command_line_does(tmp_path, capsys, t_end, length,
+                                                        says):
+    """Runs still moving at t_end, material at the domain's end: the run-out page shows
+    the lines ``pdeflow sweep`` prints for the same points, in a box, each with its a."""
+    case = _short_sweep(tmp_path, t_end, length)
+    page = RunoutPage(tmp_path)  # a = 2, 3 and the slider's 5
+    capsys.readouterr()
+    assert main(["sweep", str(case), "--quiet", "--set",
+                 "sweep.aspect_ratios=[2, 3, 5]"]) == 0
+    cli = [r for r in capsys.readouterr().err.splitlines()
+           if r.startswith("pdeflow: warning:")]
+    shown = page.warning_lines()
+    assert cli and any(says in line for line in cli)
+    assert {line.split(": ", 1)[1] for line in shown} == set(cli)
+    assert {line.split(":")[0] for line in shown} == {"a = 2", "a = 3", "a = 5"}
+    assert page.warnings.visible and all(escape(w) in page.warnings.object
+                                         for w in shown)
+    page.recompute([])  # an empty set: no warnings
+    assert page.warning_lines() == [] and not page.warnings.visible
+
+
+def test_the_runout_page_shows_no_warnings_box_for_runs_at_rest(tmp_path):
+    _short_sweep(tmp_path, 30.0, 12.0)
+    page = RunoutPage(tmp_path)
+    assert len(page.points["two_layer"]) == 3 and page.warning_lines() == []
+    assert not page.warnings.visible

@@ -29,9 +29,10 @@ from ..analysis.sweep import (
     run_sweep,
 )
 from ..cases import BASELINE_MODEL, PAPER_MODEL, CaseError
+from ..checks import run_warnings
 from ..solvers.fv_split import SimulationBlowUp
 from .controls import KNOBS, ParameterControls, Slider, is_column, list_cases, served
-from .dam_break import COLOURS, LABELS
+from .dam_break import COLOURS, LABELS, WARNING_STYLE
 from .look import PageLayout, style_figure
 
 MODEL_STYLE = {PAPER_MODEL: (COLOURS["upper"], "square", LABELS[PAPER_MODEL]),
@@ -72,7 +73,12 @@ class RunoutPage:
                                     sizing_mode="stretch_width")
         self.fits = pn.pane.HTML("", css_classes=["pdeflow-fits"],
                                  sizing_mode="stretch_width")
+        self.warnings = pn.pane.HTML("", css_classes=["pdeflow-warnings"],
+                                     sizing_mode="stretch_width", visible=False,
+                                     styles=WARNING_STYLE)
         self.points: dict[str, dict[float, dict[str, Any]]] = {}
+        self.point_warnings: dict[float, list[str]] = {}
+        """per a of the set, the command line's warning lines of its runs"""
         self._todo: list[float] = []
         self._generation = 0
         self._figure()
@@ -99,6 +105,7 @@ class RunoutPage:
                             | set(self._todo) | {float(self.a.value)})
         self._generation += 1
         self.points = {}
+        self.point_warnings = {}
         self._todo = sorted(set(ratios))
         self._draw()
         if served():
@@ -124,15 +131,18 @@ class RunoutPage:
 
     def _compute(self, a: float) -> bool:
         """Both models at ``a``; False (with the error shown) if the case cannot run."""
+        lines: list[str] = []
         try:
             case = self.controls.load()
-            out = run_sweep(case, [a])
+            with run_warnings(lines.append):  # what the command line would print
+                out = run_sweep(case, [a])
         except (CaseError, SimulationBlowUp, ValueError) as err:
             self.status.object = f"<b>cannot run this:</b> {escape(str(err))}"
             self._todo = []
             return False
         for model, res in out["models"].items():
             self.points.setdefault(model, {})[a] = res["runs"][0]
+        self.point_warnings[a] = lines
         self.status.object = ""
         return True
 
@@ -205,6 +215,8 @@ class RunoutPage:
             self.a_line.location = a_now
             self.current.object = self._current_html(a_now)
             self.fits.object = self._fits_html()
+            self.warnings.object = self._warnings_html()
+            self.warnings.visible = any(self.point_warnings.values())
 
     def _current_html(self, a: float) -> str:
         parts = []
@@ -231,6 +243,19 @@ class RunoutPage:
         todo = f"<p>computing {len(self._todo)} more ...</p>" if self._todo else ""
         return f"<p>fit of the set:</p><ul>{''.join(rows)}</ul>{todo}"
 
+    def warning_lines(self) -> list[str]:
+        """The command line's warnings about the set's runs, each prefixed by its a."""
+        return [f"a = {a:g}: {line}" for a, lines in sorted(self.point_warnings.items())
+                for line in lines]
+
+    def _warnings_html(self) -> str:
+        lines = self.warning_lines()
+        if not lines:
+            return ""
+        items = "".join(f"<li>{escape(line)}</li>" for line in lines)
+        return (f"<p style='margin:0.4em 0'><b>The command line warns about these "
+                f"points:</b></p><ul style='margin:0.2em 0 0.5em'>{items}</ul>")
+
     def set_present(self, present: bool) -> None:
         """Presentation mode: larger fonts and lines, the expert choices hidden."""
         self.present = present
@@ -239,7 +264,7 @@ class RunoutPage:
         self.controls.set_present(present)
 
     def panel(self) -> pn.Row:
-        main = pn.Column(self.status, self.a, pn.Row(self.reset, self.clear),
+        main = pn.Column(self.status, self.warnings, self.a, pn.Row(self.reset, self.clear),
                          pn.pane.Bokeh(self.fig), sizing_mode="stretch_width")
         results = pn.Column("### results", self.current, self.fits,
                             sizing_mode="stretch_width")
