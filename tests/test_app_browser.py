@@ -162,6 +162,18 @@ def test_runout_page_shows_the_sweep(opened):
         assert f"r = {res['prefactor']:.3g} a^{res['exponent']:.3f}" in shown, shown
 
 
+def test_the_other_pages_open_from_their_tabs(opened):
+    """Built when their tab is first clicked (not at start): each shows its first
+    result, and the hyperbolicity page the dam-break page's run."""
+    page = opened("dam-break")
+    assert page.locator(READY["run-out"]).count() == 0
+    for name, title in (("hyperbolicity", "Hyperbolicity"), ("run-out", "Run-out law")):
+        page.get_by_text(title, exact=True).first.click()
+        page.locator(READY[name]).first.wait_for(timeout=ANSWER_TIMEOUT_S * 1000)
+    _wait_for(lambda: "computing" not in text(page, "fits"))
+    assert "points" in text(page, "fits")
+
+
 def test_hyperbolicity_page_shows_the_eigenvalues(opened):
     from pdeflow.app.hyperbolicity import G, format_eigenvalue
     from pdeflow.numerics.hyperbolicity import eigenvalues
