@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import contextlib
+import importlib
 import os
+import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -76,3 +80,18 @@ def assert_no_temporaries(folder: Path) -> None:
     written (outputs are written under a temporary name and renamed when complete)."""
     left = [p.name for p in folder.rglob("*") if ".part" in p.name]
     assert not left, f"temporary files left behind: {left}"
+
+
+GENERATE = Path(__file__).resolve().parents[1] / "docs" / "generate"
+"""the docs' generators (a directory of scripts, not a package)"""
+
+
+@contextlib.contextmanager
+def generator_modules(*names: str) -> Iterator[tuple]:
+    """The modules ``names`` of docs/generate, with that directory on the path while the
+    block runs (they import each other, some when called)."""
+    sys.path.insert(0, str(GENERATE))
+    try:
+        yield tuple(importlib.import_module(n) for n in names)
+    finally:
+        sys.path.remove(str(GENERATE))

@@ -5,26 +5,20 @@ the generator computed from its cached runs (no hand-typed results)."""
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 import pytest
 
+from tests.helpers import generator_modules
+
 ROOT = Path(__file__).resolve().parents[1]
-GENERATE = ROOT / "docs" / "generate"
 
 
 @pytest.fixture(scope="module")
 def gen():
-    """The generator's modules (docs/generate is not a package)."""
-    sys.path.insert(0, str(GENERATE))
-    try:
-        import axisymmetric
-        import axisymmetric_page
-
-        yield axisymmetric, axisymmetric_page
-    finally:
-        sys.path.remove(str(GENERATE))
+    """The generator's modules, importable while the tests run."""
+    with generator_modules("axisymmetric", "axisymmetric_page") as modules:
+        yield modules
 
 
 def test_generator_core_on_a_tiny_grid(gen, tmp_path):

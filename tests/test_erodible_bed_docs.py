@@ -5,26 +5,20 @@ generator computed from its cached runs (no hand-typed results)."""
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 import pytest
 
+from tests.helpers import generator_modules
+
 ROOT = Path(__file__).resolve().parents[1]
-GENERATE = ROOT / "docs" / "generate"
 
 
 @pytest.fixture(scope="module")
 def gen():
-    """The generator's modules (docs/generate is not a package)."""
-    sys.path.insert(0, str(GENERATE))
-    try:
-        import erodible_bed
-        import erodible_bed_page
-
-        yield erodible_bed, erodible_bed_page
-    finally:
-        sys.path.remove(str(GENERATE))
+    """The generator's modules, importable while the tests run."""
+    with generator_modules("erodible_bed", "erodible_bed_page") as modules:
+        yield modules
 
 
 def test_generator_point_and_resumable_cache(gen, tmp_path):

@@ -283,18 +283,15 @@ def test_rheology_page_is_the_rendering_of_its_numbers():
     """docs/rheology.md is rheology_page.render_page of docs/rheology/numbers.json (no
     hand-typed results), and every figure it shows exists."""
     import json
-    import sys
     from pathlib import Path
 
+    from tests.helpers import generator_modules
+
     root = Path(__file__).resolve().parents[1]
-    sys.path.insert(0, str(root / "docs" / "generate"))
-    try:
-        import rheology_page
-    finally:
-        sys.path.remove(str(root / "docs" / "generate"))
     numbers = json.loads((root / "docs" / "rheology" / "numbers.json").read_text())
     page = (root / "docs" / "rheology.md").read_text()
-    assert page == rheology_page.render_page(numbers, numbers["figures"])
+    with generator_modules("rheology_page") as (rheology_page,):
+        assert page == rheology_page.render_page(numbers, numbers["figures"])
     for fig in numbers["figures"].values():
         assert (root / "docs" / fig).is_file()
 
@@ -341,16 +338,13 @@ def test_a_study_over_laws_warms_every_law_bundle(tmp_path):
 
 
 def _cached_rows():
-    import sys
     from pathlib import Path
 
+    from tests.helpers import generator_modules
+
     root = Path(__file__).resolve().parents[1]
-    sys.path.insert(0, str(root / "docs" / "generate"))
-    try:
-        import rheology_runs
-    finally:
-        sys.path.remove(str(root / "docs" / "generate"))
-    return rheology_runs, rheology_runs.read_cache(root / "docs" / "rheology" / "sweep.csv")
+    with generator_modules("rheology_runs") as (runs,):
+        return runs, runs.read_cache(root / "docs" / "rheology" / "sweep.csv")
 
 
 def _check_reruns(points):

@@ -246,18 +246,13 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     import axisymmetric_page as page
 
-    from pdeflow.io import write_json
-
     numbers = page_numbers(rows)
     numbers["planar_law"] = page.planar_law_check()
     profiles = profile_runs()
     numbers["profiles"] = page.profile_numbers(profiles)
     page.figures(rows, numbers, profiles, OUT)
-    numbers["generator_wall_s"] = round(time.perf_counter() - t0, 1)
-    write_json(OUT / "numbers.json", numbers)
-    text = page.render_page(numbers)
-    (ROOT / "docs" / "axisymmetric.md").write_text(text)
-    print(text)
+    print(run_cache.publish(numbers, t0, OUT / "numbers.json",
+                            ROOT / "docs" / "axisymmetric.md", page.render_page))
     return 0
 
 

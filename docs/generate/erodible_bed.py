@@ -243,16 +243,11 @@ def main(argv: list[str] | None = None) -> int:
     matplotlib.use("Agg")  # files only
     import erodible_bed_page as page
 
-    from pdeflow.io import write_json
-
     numbers = page.page_numbers(rows)
     numbers.update(page.figures(rows, numbers, OUT))
-    numbers["generator_wall_s"] = round(time.perf_counter() - t0, 1)
     numbers["points"] = len(rows)
-    write_json(OUT / "numbers.json", numbers)
-    text = page.render_page(numbers)
-    (ROOT / "docs" / "erodible_bed.md").write_text(text)
-    print(text)
+    print(run_cache.publish(numbers, t0, OUT / "numbers.json",
+                            ROOT / "docs" / "erodible_bed.md", page.render_page))
     return 0
 
 

@@ -24,11 +24,10 @@ import time
 from pathlib import Path
 
 import rheology_runs as runs
+import run_cache
 from rheology_figures import figures
 from rheology_numbers import page_numbers
 from rheology_page import render_page
-
-from pdeflow.io import write_json, write_text
 
 ROOT = Path(__file__).resolve().parents[2]
 BENCH = ROOT / "benchmarks" / "measurements" / "bench.json"
@@ -93,9 +92,8 @@ def main(argv: list[str] | None = None) -> int:
     numbers["static_depth"] = runs.STATIC_DEPTH
     numbers["cost"] = stored_cost()
     numbers["figures"] = figures(numbers, out)
-    numbers["generator_wall_s"] = round(time.perf_counter() - t0, 1)
-    write_json(out / "rheology" / "numbers.json", numbers)
-    write_text(out / "rheology.md", render_page(numbers, numbers["figures"]))
+    run_cache.publish(numbers, t0, out / "rheology" / "numbers.json", out / "rheology.md",
+                      lambda n: render_page(n, n["figures"]))
     print(f"written: {out / 'rheology.md'} ({len(rows)} runs)", file=sys.stderr)
     return 0
 

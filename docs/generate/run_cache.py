@@ -49,6 +49,20 @@ def write_rows(path: Path, fields: Sequence[str], rows: list[Row]) -> None:
         w.writerows(rows)
 
 
+def publish(numbers: dict[str, Any], t0: float, numbers_path: Path, page_path: Path,
+            render: Callable[[dict[str, Any]], str]) -> str:
+    """Write a page's ``numbers`` (with the generator's wall time since ``t0``
+    [perf_counter s]) to ``numbers_path`` and ``render(numbers)`` to ``page_path``;
+    returns the page's text."""
+    from pdeflow.io import write_json, write_text
+
+    numbers["generator_wall_s"] = round(time.perf_counter() - t0, 1)
+    write_json(numbers_path, numbers)
+    text = render(numbers)
+    write_text(page_path, text)
+    return text
+
+
 def fill_rows(points: Sequence[Any], path: Path, fields: Sequence[str], rows: list[Row],
               key: Callable[[Any], Any], row_key: Callable[[Row], Any],
               measure: Callable[[Any], Row],
