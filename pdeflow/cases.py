@@ -467,16 +467,16 @@ class Case:
         an erodible layer, else None (no bed, or the model runs on the rigid bed)."""
         if systems.get(model).bed_layer is None:
             return None
-        if x is None:
-            x = self.make_grid().axes_coords[0] - self.x_start
-        return bed_depth(self.initial, x)
+        return bed_depth(self.initial, self._cell_x(x))
 
     def bed_region(self, x: np.ndarray | None = None) -> np.ndarray | None:
         """The cells (a mask over ``x`` [m from the domain's start; default: the case's
         grid]) where the shape lays its bed, None if it lays none."""
-        if x is None:
-            x = self.make_grid().axes_coords[0] - self.x_start
-        return bed_region(self.initial, x)
+        return bed_region(self.initial, self._cell_x(x))
+
+    def _cell_x(self, x: np.ndarray | None) -> np.ndarray:
+        """``x``, or the case's cell centres [m from the domain's start]."""
+        return self.make_grid().axes_coords[0] - self.x_start if x is None else x
 
     def bed_kind(self, model: str) -> str | None:
         """'erodible' or 'rigid' if the case lays a bed ('rigid': ``model`` has no
