@@ -54,17 +54,13 @@ else:  # pragma: no cover
 
 from . import systems
 from .initial_shapes import (
-    SHAPES,
     bed_depth,
     bed_region,
-    check_initial,
     has_bed,
     profiles_from_file,
     total_depth,
 )
-from .models.base import check_range
-from .numerics.layout import GEOMETRIES
-from .variant import MAX_CFL, Variant, VariantError, variant_of
+from .variant import Variant, variant_of
 
 PAPER_MODEL = "two_layer"
 """the registered name of the paper's two-layer model"""
@@ -158,129 +154,11 @@ class Case:
         return CaseError(f"{self.source}: {msg}")
 
     def validate(self) -> None:
-        """Check sections, keys, types and ranges; raise CaseError naming the key."""
-        from .checks import check_memory
+        """Check sections, keys, types and ranges; raise CaseError naming the key
+        (:func:`pdeflow.case_validation.validate`)."""
+        from .case_validation import validate
 
-        for section, content in self.data.items():
-            if section not in SCHEMA and section not in systems.names():
-                raise self._err(f"unknown section [{section}]; allowed: "
-                                f"{[*SCHEMA, *systems.names()]}")
-            if not isinstance(content, dict):
-                raise self._err(f"[{section}] must be a table")
-            allowed = SCHEMA.get(section)
-            if not allowed:
-                continue  # a model's section: checked by its parameter class
-            for key, value in content.items():
-                if key not in allowed:
-                    raise self._err(f"unknown key {section}.{key}; allowed: "
-                                    f"{sorted(allowed)}")
-                if isinstance(value, bool) or not isinstance(value, allowed[key]):
-                    names = " or ".join(t.__name__ for t in allowed[key])
-                    raise self._err(f"{section}.{key} must be {names}, got {value!r}")
-                self._check_finite(f"{section}.{key}", value)
-        for name in systems.names():
-            try:
-                systems.get(name).parameters_class.from_dict(self.data.get(name, {}))
-            except (ValueError, TypeError) as err:
-                raise self._err(f"[{name}] {err}") from None
-        for model in self.models:
-            if model not in systems.names():
-                raise self._err(f"case.models: unknown model {model!r}; allowed: "
-                                f"{list(systems.names())}")
-        try:
-            check_range("case.t_end", self.t_end, 0, math.inf, low_open=True, unit="s")
-            check_range("grid.length", self.length, 0, math.inf, low_open=True,
-                        unit="m")
-            self._check_cells()
-            check_range("grid.dx", self.dx, 0, self.length, low_open=True, unit="m")
-            check_range("numerics.cfl", self.cfl, 0, 1, low_open=True)
-            reconstruction = self.data.get("numerics", {}).get("reconstruction")
-            if reconstruction == "muscl":
-                check_range("numerics.cfl (with reconstruction = 'muscl')", self.cfl, 0,
-                            MAX_CFL[reconstruction], low_open=True)
-            if "dt" in self.data.get("numerics", {}):
-                check_range("numerics.dt", self.data["numerics"]["dt"], 0, math.inf,
-                            low_open=True, unit="s")
-            for t in self.snapshot_times:
-                check_range("output.snapshot_times", t, 0, self.t_end, unit="s")
-            check_range("output.front_threshold", self.front_threshold, 0, math.inf,
-                        low_open=True, unit="m")
-            check_range("output.series_every", self.series_every, 0, self.t_end,
-                        low_open=True, unit="s")
-        except ValueError as err:
-            raise self._err(str(err)) from None
-        self._check_geometry()
-        if self._get("output", "erosion_series", "auto") not in SERIES:
-            raise self._err(f"output.erosion_series must be one of {list(SERIES)}, got "
-                            f"{self._get('output', 'erosion_series', 'auto')!r}")
-        if self.frames not in FRAMES:
-            raise self._err(f"output.frames must be one of {list(FRAMES)}, got "
-                            f"{self.frames!r}")
-        for side in ("left", "right"):
-            bc = self.data.get("boundaries", {}).get(side, "wall" if side == "left"
-                                                      else "open")
-            if bc not in ("wall", "open"):
-                raise self._err(f"boundaries.{side} must be 'wall' or 'open', got {bc!r}")
-        if "initial" not in self.data or "shape" not in self.data["initial"]:
-            raise self._err("[initial] with a 'shape' is required")
-        try:
-            self.variant  # noqa: B018 - checks solver, flux, reconstruction, limiter, ...
-        except VariantError as err:
-            raise self._err(str(err)) from None
-        if self.initial["shape"] not in SHAPES:
-            raise self._err(f"initial.shape must be one of {list(SHAPES)}, got "
-                            f"{self.initial['shape']!r}")
-        self._check_initial()
-        try:
-            check_memory(self)
-        except ValueError as err:
-            raise self._err(str(err)) from None
-
-    def _check_geometry(self) -> None:
-        """grid.geometry is 'planar' or 'axisymmetric'; an axisymmetric grid starts at the
-        axis (x_start = 0), whose boundary is a wall (mirror symmetry: no flux)."""
-        if self.geometry not in GEOMETRIES:
-            raise self._err(f"grid.geometry must be one of {list(GEOMETRIES)}, got "
-                            f"{self.geometry!r}")
-        if self.geometry != "axisymmetric":
-            return
-        if self.x_start != 0.0:
-            raise self._err(f"grid.x_start must be 0 on an axisymmetric grid (the axis), "
-                            f"got {self.x_start:g}")
-        if self.bc[0] != "wall":
-            raise self._err("boundaries.left is the axis on an axisymmetric grid and must "
-                            f"be 'wall' (symmetry: no flux), got {self.bc[0]!r}")
-
-    def _check_finite(self, key: str, value: Any) -> None:
-        """Numbers (also inside lists) must be finite: TOML allows nan and inf."""
-        items = value if isinstance(value, list) else [value]
-        for v in items:
-            if isinstance(value, list) and key == "output.snapshot_times" and (
-                    isinstance(v, bool) or not isinstance(v, (int, float))):
-                raise self._err(f"{key} must be a list of numbers [s], got {v!r}")
-            if isinstance(v, float) and not math.isfinite(v):
-                raise self._err(f"{key} must be a finite number, got {v!r}")
-
-    def _check_cells(self) -> None:
-        """grid.cells >= 1 (it wins over grid.dx); grid.dx must divide grid.length."""
-        grid = self.data.get("grid", {})
-        if "cells" in grid:
-            if grid["cells"] < 1:
-                raise ValueError(f"grid.cells must be an integer >= 1, got "
-                                 f"{grid['cells']!r}")
-        elif "dx" in grid and self.dx > 0:
-            n = self.length / self.dx
-            if abs(n - round(n)) > 1e-9 * n:
-                raise ValueError(
-                    f"grid.dx = {self.dx:g} m does not divide grid.length = "
-                    f"{self.length:g} m into whole cells ({n:.6g}); use a dx in "
-                    f"(0, {self.length:g}] m with length/dx an integer, or grid.cells")
-
-    def _check_initial(self) -> None:
-        try:
-            check_initial(self.initial, self.length, self.base_dir)
-        except ValueError as err:
-            raise self._err(str(err)) from None
+        validate(self)
 
     # --- accessors ------------------------------------------------------------------------
     def _get(self, section: str, key: str, default: Any) -> Any:

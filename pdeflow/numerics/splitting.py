@@ -201,12 +201,10 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int) ->
         # to undo a Strang half source step that broke the CFL, or an IFCP step
         diag_keep = diag_backup[:L.N_DIAG]
         fex_keep = diag_backup[L.N_DIAG:]
-        # Only the cells a step can change are visited: the live cells (moving, or
-        # changed by the last step) widened by the reach of a step; every other cell is
-        # dry, or at rest with a stencil at rest, and no stage changes it
-        # (pdeflow.numerics.resting). A call that goes on from the state the last one
-        # left (diag[D_RESUME], which the caller clears otherwise) starts from its live
-        # cells; else the first step visits all cells (the source stage cleans the
+        # Only the live cells (moving, or changed by the last step) widened by the reach
+        # of a step are visited; no stage changes the others (pdeflow.numerics.resting).
+        # A call going on from the state the last one left (diag[D_RESUME]) starts from
+        # its live cells; else the first step visits all (the source stage cleans the
         # initial state).
         first = diag[L.D_RESUME] != 1.0
         v_lo = 0 if first else int(diag[L.D_LIVE_LO])
