@@ -95,3 +95,17 @@ def generator_modules(*names: str) -> Iterator[tuple]:
         yield tuple(importlib.import_module(n) for n in names)
     finally:
         sys.path.remove(str(GENERATE))
+
+
+def cli_warnings(case: Path, overrides: list[str], tmp_path: Path, capsys) -> list[str]:
+    """The ``pdeflow: warning:`` lines ``pdeflow run case --set ...`` prints (quietly,
+    its outputs in ``tmp_path``)."""
+    from pdeflow.cli import main
+
+    capsys.readouterr()
+    argv = ["run", str(case), "--outdir", str(tmp_path), "--quiet"]
+    for o in overrides:
+        argv += ["--set", o]
+    assert main(argv) == 0
+    return [r for r in capsys.readouterr().err.splitlines()
+            if r.startswith("pdeflow: warning:")]

@@ -37,7 +37,7 @@ from pdeflow.numerics.hyperbolicity import (  # noqa: E402
 )
 from pdeflow.simulate import print_summary, run_model  # noqa: E402
 
-from .helpers import skip_or_fail_in_ci  # noqa: E402
+from .helpers import cli_warnings, skip_or_fail_in_ci  # noqa: E402
 
 ROOT = Path(__file__).parents[1]
 CASES = ROOT / "cases"
@@ -313,14 +313,8 @@ def test_friction_law_choice_sets_every_model_and_enables_its_sliders():
 
 # --- the lecture hall: warnings, domain length, opening frame, presentation mode ---------
 def _cli_warnings(overrides: list[str], tmp_path: Path, capsys) -> list[str]:
-    """The ``pdeflow: warning:`` lines of ``pdeflow run`` for test 5.1."""
-    capsys.readouterr()
-    argv = ["run", str(CASE_51), "--outdir", str(tmp_path), "--quiet"]
-    for o in overrides:
-        argv += ["--set", o]
-    assert main(argv) == 0
-    return [r for r in capsys.readouterr().err.splitlines()
-            if r.startswith("pdeflow: warning:")]
+    """The warning lines of ``pdeflow run`` for test 5.1 with ``overrides``."""
+    return cli_warnings(CASE_51, overrides, tmp_path, capsys)
 
 
 def test_the_page_warns_as_the_command_line_does(tmp_path, capsys):

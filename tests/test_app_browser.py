@@ -35,6 +35,8 @@ from pdeflow.app.browser import (
 from pdeflow.cases import load_case
 from pdeflow.simulate import run_model
 
+from .helpers import cli_warnings
+
 pytestmark = pytest.mark.skipif(os.environ.get("PDEFLOW_SKIP_BROWSER") == "1",
                                 reason="PDEFLOW_SKIP_BROWSER=1")
 
@@ -305,15 +307,7 @@ def test_presentation_mode_has_larger_fonts_and_fewer_controls(browser, server):
 
 def _cli_warnings(overrides: list[str], tmp_path: Path, capsys) -> list[str]:
     """The warning lines of ``pdeflow run`` for test 5.1 with ``overrides``."""
-    from pdeflow.cli import main
-
-    capsys.readouterr()
-    argv = ["run", str(CASE_51), "--outdir", str(tmp_path), "--quiet"]
-    for o in overrides:
-        argv += ["--set", o]
-    assert main(argv) == 0
-    return [r for r in capsys.readouterr().err.splitlines()
-            if r.startswith("pdeflow: warning:")]
+    return cli_warnings(CASE_51, overrides, tmp_path, capsys)
 
 
 def _shown_warnings(page) -> list[str]:
