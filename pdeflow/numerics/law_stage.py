@@ -33,8 +33,9 @@ from .rheology import friction_two_layer_law, law_block, law_velocity
 
 def _with_callees(dispatcher: Any, name: str, **callees: Any) -> Callable:
     """The Python function of the kernel ``dispatcher`` with the global names
-    ``callees`` bound to other kernels, named ``name`` in this module."""
-    f = dispatcher.py_func
+    ``callees`` bound to other kernels, named ``name`` in this module (with
+    ``NUMBA_DISABLE_JIT=1`` the kernels are Python functions)."""
+    f = getattr(dispatcher, "py_func", dispatcher)
     scope = {**f.__globals__, **callees}
     new = types.FunctionType(f.__code__, scope, name, f.__defaults__, f.__closure__)
     new.__qualname__ = name
