@@ -340,6 +340,43 @@ def test_split_work_keeps_this_process_busy_and_no_fork_beside_threads():
         thread.join()
 
 
+WORK_KERNELS = """
+from pdeflow.numerics.compiled import cached, f8, kernel
+
+
+@cached(inline="always")
+def twice(x):
+    return 2.0 * x
+
+
+@cached
+def half(x):
+    return 0.5 * x
+
+
+@kernel(f8)
+def caller(x):
+    return twice(x) + twice(x + 1.0) + twice(x + 2.0) + half(x) + half(x + 1.0)
+"""
+
+
+def test_compile_work_counts_an_inlined_callee_per_call_site(tmp_path, monkeypatch):
+    """numba types an inlined callee again at each call site and compiles any other
+    callee once, on its own: the work of ``caller`` is its bytecode, three times that of
+    ``twice`` and once that of ``half``, plus the overhead of the two kernels compiled on
+    their own."""
+    (tmp_path / "work_kernels.py").write_text(WORK_KERNELS)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import work_kernels as w
+
+    def size(k):
+        return len(k.py_func.__code__.co_code)
+
+    assert parallel._own_work(w.caller) == size(w.caller) + 3 * size(w.twice)
+    assert parallel._work([w.caller]) == (size(w.caller) + 3 * size(w.twice) + size(w.half)
+                                          + 2 * parallel.KERNEL_OVERHEAD)
+
+
 def test_meanwhile_is_called_once_whatever_there_is_to_compile():
     """The caller's work for the wait runs once, also with nothing to compile or wait
     for (kernels already loaded, no kernels)."""

@@ -19,6 +19,7 @@ itself. Measurements of what this saves: docs/performance.md, "Cold first run".
 from __future__ import annotations
 
 import contextlib
+import dis
 import gc
 import multiprocessing
 import os
@@ -29,13 +30,20 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
-from .compiled import in_disk_cache, ready, referenced_kernels
+from .compiled import in_disk_cache, named_kernels, ready
 
-HELPER_SHARE = 0.42
-"""The helper process's share of the compile work (bytecode of the call trees) that
-:func:`split_work` aims at. Below one half because the bytecode of a closure's tree
-overcounts: it includes the kernels of the branches that its constants drop (the
-fluxes a scheme does not use)."""
+HELPER_SHARE = 0.5
+"""The helper process's share of the compile work (:func:`_work`) that
+:func:`split_work` aims at: half. (The estimate is rough: where its split leaves this
+process the smaller share, what the caller gives it to do meanwhile fills the wait.)"""
+
+
+KERNEL_OVERHEAD = 230
+"""What compiling one more kernel costs beyond its bytecode (numba's pipeline, an LLVM
+module of its own, machine code), in bytes of bytecode that cost as much: fitted to the
+compile times of the five entry kernels of test 5.1, each compiled alone (a tree of
+many small kernels, the two-layer source stage, costs more per byte than the stepping
+loop, whose helpers are inlined)."""
 
 
 GC_THRESHOLD = (10000, 10, 10)
@@ -173,22 +181,51 @@ def _importable(compiled: Any) -> bool:
         getattr(module, func.__qualname__, None) is compiled
 
 
+def _inlined(compiled: Any) -> bool:
+    """True for a kernel numba copies into its callers (``inline="always"``): its IR is
+    typed and lowered again at every call site, never compiled on its own."""
+    return compiled.targetoptions.get("inline") == "always"
+
+
+def _callee_sites(compiled: Any) -> list[tuple[Any, int]]:
+    """The kernels ``compiled`` closes over or names
+    (:func:`~pdeflow.numerics.compiled.named_kernels`), each with how often its code
+    loads it: its call sites."""
+    func = compiled.py_func
+    loads: dict[str, int] = {}
+    for ins in dis.get_instructions(func.__code__):
+        if ins.opname in ("LOAD_GLOBAL", "LOAD_DEREF"):
+            loads[ins.argval] = loads.get(ins.argval, 0) + 1
+    closed, named = named_kernels(compiled)
+    return [(k, loads.get(name, 1)) for name, k in (*closed, *named)]
+
+
+def _own_work(compiled: Any) -> int:
+    """Bytecode size [bytes] that compiling ``compiled`` types and lowers: its own, and
+    that of every inlined callee once per call site (recursively)."""
+    return len(compiled.py_func.__code__.co_code) + sum(
+        sites * _own_work(k) for k, sites in _callee_sites(compiled) if _inlined(k))
+
+
 def _call_tree(compiled: Any, found: dict[int, Any]) -> dict[int, Any]:
-    """``compiled`` and every kernel it closes over or names, recursively."""
+    """``compiled`` and every kernel compiled on its own that it calls, recursively
+    (through inlined callees too)."""
     if id(compiled) not in found:
         found[id(compiled)] = compiled
-        closed, named = referenced_kernels(compiled)
-        for kernel in (*closed, *named):
+        for kernel, _ in _callee_sites(compiled):
             _call_tree(kernel, found)
     return found
 
 
 def _work(kernels: Sequence[Any]) -> int:
-    """Bytecode size [bytes] of the union of the call trees of ``kernels``."""
+    """Compile work of the union of the call trees of ``kernels`` [bytes of bytecode]:
+    every kernel compiled on its own counts with :func:`_own_work` plus
+    :data:`KERNEL_OVERHEAD`."""
     found: dict[int, Any] = {}
     for k in kernels:
         _call_tree(k, found)
-    return sum(len(k.py_func.__code__.co_code) for k in found.values())
+    return sum(_own_work(k) + KERNEL_OVERHEAD for k in found.values()
+               if not _inlined(k) or k in kernels)
 
 
 def _cores() -> int:

@@ -211,11 +211,19 @@ def first_class(compiled: Any) -> Any:
 
 def referenced_kernels(compiled: Any) -> tuple[list[Any], list[Any]]:
     """(the kernels ``compiled`` closes over, the module-level kernels its code names)."""
+    closed, named = named_kernels(compiled)
+    return [k for _, k in closed], [k for _, k in named]
+
+
+def named_kernels(compiled: Any) -> tuple[list[tuple[str, Any]], list[tuple[str, Any]]]:
+    """:func:`referenced_kernels` with the name each goes by in the code of
+    ``compiled``: (closed over, named at module level), as (name, kernel) pairs."""
     func = compiled.py_func
-    closed = [c.cell_contents for c in func.__closure__ or ()]
-    named = [func.__globals__.get(name) for name in func.__code__.co_names]
-    return ([k for k in closed if isinstance(k, Dispatcher)],
-            [k for k in named if isinstance(k, Dispatcher)])
+    cells = zip(func.__code__.co_freevars, func.__closure__ or (), strict=True)
+    closed = [(name, cell.cell_contents) for name, cell in cells]
+    named = [(name, func.__globals__.get(name)) for name in func.__code__.co_names]
+    return ([(n, k) for n, k in closed if isinstance(k, Dispatcher)],
+            [(n, k) for n, k in named if isinstance(k, Dispatcher)])
 
 
 def _callees(compiled: Any) -> Iterator[Any]:
