@@ -162,7 +162,10 @@ def main(argv: list[str] | None = None) -> int:
                          ("dx = 0.025 m, CFL 0.3", ("grid.dx=0.025",)),
                          ("dx = 0.025 m, CFL 0.1", ("grid.dx=0.025", "numerics.cfl=0.1")),
                          ("dx = 0.0125 m, CFL 0.3", ("grid.dx=0.0125",)),
-                         ("dx = 0.0125 m, CFL 0.1", ("grid.dx=0.0125", "numerics.cfl=0.1"))):
+                         ("dx = 0.0125 m, CFL 0.1", ("grid.dx=0.0125", "numerics.cfl=0.1")),
+                         ("dx = 0.05 m, CFL 0.3, MUSCL", ("numerics.reconstruction='muscl'",)),
+                         ("dx = 0.05 m, CFL 0.3, Rusanov", ("numerics.flux='rusanov'",)),
+                         ("dx = 0.05 m, CFL 0.3, IFCP", ("numerics.flux='ifcp'",))):
         s = run(46, 0.65, 3.0, *extra, t_end=30.0).summary
         lines.append(f"| {label}, t_end = 30 s | {_row(s)} | "
                      f"{_t(s['lower_stop_time'])} / {_t(s['upper_stop_time'])} |")
