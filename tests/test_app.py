@@ -17,7 +17,12 @@ pn = pytest.importorskip("panel")  # the app extra (part of the test extra)
 
 from pdeflow.analysis.sweep import PUBLISHED_LAWS, published_law, run_sweep  # noqa: E402
 from pdeflow.app.controls import KNOBS, command_line, find_case_dir  # noqa: E402
-from pdeflow.app.dam_break import DamBreakPage, SharedRun, simulate  # noqa: E402
+from pdeflow.app.dam_break import (  # noqa: E402
+    FRAMES_PER_T_END,
+    DamBreakPage,
+    SharedRun,
+    simulate,
+)
 from pdeflow.app.hyperbolicity import (  # noqa: E402
     G,
     HyperbolicityPage,
@@ -140,6 +145,12 @@ def test_dam_break_animation_ends_on_the_summarised_state():
         np.testing.assert_allclose(run.states[m][0], case.make_state(m)[1].data)
     assert run.fextra.shape == (len(run.times), run.x.size)
     assert run.fextra.max() > 0
+    # one frame per frame time for both models, not one per model's step time
+    interval = case.t_end / FRAMES_PER_T_END
+    ends = {res.t_final for res in run.results.values()}
+    inner = [t for t in run.times if not np.isclose(list(ends), t, rtol=0, atol=1e-8).any()]
+    np.testing.assert_allclose(np.diff(inner), interval, rtol=1e-6)
+    assert len(inner) == int(max(ends) / interval + 1e-9) + 1
 
 
 def test_scheme_and_case_choices_become_overrides():

@@ -6,9 +6,9 @@ line printed under it, and the final state: these go to the browser at once), an
 once with a :class:`~pdeflow.trackers.FextraStorageTracker` that records the frames of the
 animation. Observers do not change the solver's steps (docs/user_guide.md), so that run
 takes the same steps as the first; its frames are the states after the first step at or
-past each frame time, at their true times (fv-split's ``outputs="step"``: states of the
-scheme, hyperbolic after the restoration); the numbers and the last frame come from the
-first run.
+past each frame time (fv-split's ``outputs="step"``: states of the scheme, hyperbolic
+after the restoration), shown at that frame time; the numbers and the last frame come
+from the first run.
 Depths in m, velocities in m/s, F_extra/rho1 in m^2/s^2, times in s.
 """
 
@@ -148,10 +148,15 @@ def add_frames(run: DamBreakRun) -> None:
 def _set_frames(run: DamBreakRun,
                 frames: dict[str, list[tuple[float, np.ndarray, np.ndarray]]]) -> None:
     """Put per-model frames (t, state, F_extra) before each model's end, and its final
-    state, on the common times of ``run``; a model that has stopped keeps its end."""
+    state, on the common times of ``run``: the multiples k dt_f of the frame interval,
+    where each model shows its first state at or past k dt_f (within one of its steps:
+    the models' steps differ, and their true times would make two frames of each), and
+    the models' ends; a model that has stopped keeps its end."""
+    interval = run.case.t_end / FRAMES_PER_T_END
     series = {}
     for m, res in run.results.items():
-        items = [f for f in frames[m] if f[0] < res.t_final - 1e-9]
+        items = [(interval * np.floor(t / interval + 1e-9), d, f) for t, d, f in frames[m]
+                 if t < res.t_final - 1e-9]
         items.append((res.t_final, res.state.data, res.fextra_over_rho1))
         series[m] = items
     run.times = np.unique(np.round([f[0] for items in series.values() for f in items], 9))
