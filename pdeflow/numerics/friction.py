@@ -109,11 +109,29 @@ def bisect_fextra(b1, b2, h1, h2, du0, dt, P, k, c):
 
 @cached
 def restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P, k, c):
+    """Smallest F_extra/rho2 [m^2/s^2] making the post-friction state (u1, u2) [m/s]
+    of a non-hyperbolic cell hyperbolic, the velocities it leads to, and whether the
+    bisection fallback was used: :func:`restore_to_edge` with the edge of
+    :func:`pdeflow.numerics.hyperbolicity.band_lower_edge` (F_L in ``bound`` mode).
+    The source stage finds the edge with its hyperbolicity test
+    (:func:`pdeflow.numerics.hyperbolicity.restoration_target`)."""
+    g = P[T.G_Z]
+    r = P[T.R]
+    if int(P[T.HYPERBOLICITY]) == L.HYPERBOLICITY_BOUND:
+        edge = lower_bound_fl(h1, h2, g, r)
+    else:
+        edge = band_lower_edge(h1, h2, g, r, abs(u1 - u2))
+    return restore_to_edge(b1, b2, h1, h2, u1, u2, dt, P, k, c, edge)
+
+
+@cached
+def restore_to_edge(b1, b2, h1, h2, u1, u2, dt, P, k, c, edge):
     r"""Smallest F_extra/rho2 [m^2/s^2] making the post-friction state hyperbolic, the
     velocities (u1, u2) [m/s] it leads to, and whether the bisection fallback was used.
 
-    The depths are frozen, so the target is a relative velocity: the lower band edge
-    F_c1 (F_L in ``bound`` mode). Stage (32) with the extra exchange f = F_extra/rho2
+    The depths are frozen, so the target is a relative velocity: ``edge`` [m/s], the
+    lower band edge F_c1 (F_L in ``bound`` mode; <= 0: none found, bisect). Stage (32)
+    with the extra exchange f = F_extra/rho2
     shifts b1 by -dt f/m1 and b2 by +dt f/m2 and keeps m1 b1 + m2 b2, so on each branch
     of its closed-form solution (:func:`pdeflow.numerics.sources.friction_two_layer`)
     du is an explicit function of f, inverted here for du = sgn(du0) d with
@@ -131,12 +149,7 @@ def restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P, k, c):
     """
     g = P[T.G_Z]
     r = P[T.R]
-    mode = int(P[T.HYPERBOLICITY])
     du0 = u1 - u2
-    if mode == L.HYPERBOLICITY_BOUND:
-        edge = lower_bound_fl(h1, h2, g, r)
-    else:
-        edge = band_lower_edge(h1, h2, g, r, abs(du0))
     if edge > 0.0:
         d = edge * (1.0 - 1e-8)  # a hair inside: round-off must not leave the band edge
         sgn = 1.0 if du0 > 0.0 else -1.0

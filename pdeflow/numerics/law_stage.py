@@ -64,8 +64,8 @@ implicit_friction_law = cached(_with_callees(
     bed_under_both=bed_under_both_law, bed_under_lower=bed_under_lower_law))
 bisect_fextra_law = cached(_with_callees(
     friction.bisect_fextra, "bisect_fextra_law", implicit_friction=implicit_friction_law))
-restore_hyperbolicity_law = cached(_with_callees(
-    friction.restore_hyperbolicity, "restore_hyperbolicity_law",
+restore_to_edge_law = cached(_with_callees(
+    friction.restore_to_edge, "restore_to_edge_law",
     implicit_friction=implicit_friction_law, bisect_fextra=bisect_fextra_law))
 predictor_two_layer_law = kernel(STATE, f8, PARAMS, i8, i8)(_with_callees(
     friction.predictor_two_layer, "predictor_two_layer_law",
@@ -73,7 +73,7 @@ predictor_two_layer_law = kernel(STATE, f8, PARAMS, i8, i8)(_with_callees(
 sources_two_layer_law = kernel(STATE, f8, f8, PARAMS, VECTOR, i8, i8)(_with_callees(
     source_stage.sources_two_layer, "sources_two_layer_law",
     implicit_friction=implicit_friction_law,
-    restore_hyperbolicity=restore_hyperbolicity_law))
+    restore_to_edge=restore_to_edge_law))
 source_stage_two_layer_law = kernel(STATE, f8, f8, PARAMS, VECTOR)(_with_callees(
     source_stage.source_stage_two_layer, "source_stage_two_layer_law",
     sources_two_layer=sources_two_layer_law))

@@ -28,8 +28,8 @@ from . import layout as L
 from . import layout_single_layer as S
 from . import layout_two_layer as T
 from .compiled import PARAMS, STATE, VECTOR, cached, f8, i8, kernel
-from .friction import implicit_friction, restore_hyperbolicity
-from .hyperbolicity import is_hyperbolic
+from .friction import implicit_friction, restore_to_edge
+from .hyperbolicity import restoration_target
 from .sources import coulomb_single, exchange_step
 from .state import velocity
 
@@ -124,9 +124,10 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
             v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, 0.0, k_eff, c_eff)
             # --- (33)-(34) hyperbolicity --------------------------------------------------
             if mode != L.HYPERBOLICITY_NONE and h1 > dry and h2 > dry:
-                if not is_hyperbolic(h1, h2, v1, v2, g, r, mode):
-                    f, v1, v2, bisected = restore_hyperbolicity(b1, b2, h1, h2, v1, v2,
-                                                                 dt, P, k_eff, c_eff)
+                bad, edge = restoration_target(h1, h2, v1 - v2, g, r, mode)
+                if bad:
+                    f, v1, v2, bisected = restore_to_edge(b1, b2, h1, h2, v1, v2, dt, P,
+                                                          k_eff, c_eff, edge)
                     if bisected:
                         diag[L.D_HYP_BISECTIONS] += 1.0
                     fex[i] = abs(f) / r
