@@ -191,7 +191,9 @@ def restore_to_edge(b1, b2, h1, h2, u1, u2, dt, fp, k, c, edge):
                 f = (m1 * b1 - m1 * p / mt
                      - sgn * (kdt + m1 * m2 / mt * d + cdt * d * d)) / dt
             if f * sgn > 0.0:
-                v1, v2 = implicit_friction(b1, b2, h1, h2, dt, fp, f, k, c)
+                # implicit_friction(b1, b2, h1, h2, dt, fp, f, k, c) of two wet layers
+                v1, v2 = bed_under_both(b1 - dt * f / m1, b2 + dt * f / h2, m1, h1, h2,
+                                        kdt, cdt, dt, g, r, fp)
                 # below the edge is hyperbolic down to F_L (the band is one interval)
                 found = low <= sgn * (v1 - v2) <= edge
     if not found:

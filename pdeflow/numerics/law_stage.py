@@ -76,7 +76,7 @@ implicit_friction_law = cached(_with_callees(
 bisect_fextra_law = cached(_with_callees(
     friction.bisect_fextra, "bisect_fextra_law", implicit_friction=implicit_friction_law))
 restore_to_edge_law = cached(_with_callees(
-    friction.restore_to_edge, "restore_to_edge_law",
+    friction.restore_to_edge, "restore_to_edge_law", bed_under_both=bed_under_both_law,
     implicit_friction=implicit_friction_law, bisect_fextra=bisect_fextra_law))
 predictor_two_layer_law = kernel(STATE, f8, PARAMS, i8, i8)(_with_callees(
     friction.predictor_two_layer, "predictor_two_layer_law",
