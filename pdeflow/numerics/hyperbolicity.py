@@ -189,7 +189,7 @@ def band_lower_edge(h1: float, h2: float, g: float, r: float, du_bad: float) -> 
     return _edge_below(a, c2, hi, D)
 
 
-@cached
+@cached(inline="always")
 def _edge_below(a: tuple[float, float, float, float, float], c2: float, hi: float,
                 D: float) -> float:
     """F_c1 [m/s]: the root of the quartic ``a`` of :func:`_quartic_in_a` below
