@@ -107,6 +107,22 @@ def target_row(data: dict[str, Any]) -> str:
             f"{'**met**' if ok else '**missed**'} |")
 
 
+def finding(data: dict[str, Any]) -> str:
+    """Sentence of the Findings on the restoration's share (the ``none`` rows)."""
+    out = []
+    for w, d in data["workloads"].items():
+        one, two = d["rows"]["single_layer"], d["rows"]["two_layer"]
+        none = d["rows"]["two_layer, hyperbolicity none"]
+        out.append(f"{w}: {two['ns_per_update']:.0f} ns per cell update against "
+                   f"{none['ns_per_update']:.0f} ns with `hyperbolicity = \"none\"` "
+                   f"({none['ns_per_update'] / one['ns_per_update']:.1f}x one layer)")
+    return (" Without the restoration (*Two layers against one*): " + "; ".join(out)
+            + ". Most of the two-layer time goes to the source stage: chains of dependent "
+            "divisions and square roots (the exchange, the coupled friction solve, and in "
+            "a restored cell the band edge's Halley iteration and a second friction "
+            "solve).")
+
+
 def render(data: dict[str, Any]) -> str:
     """The docs/performance.md section from :func:`measure`'s result."""
     L = ["## Two layers against one: cost per cell update\n",

@@ -620,7 +620,7 @@ def _findings(wp: dict[str, Any] | None, b: dict[str, Any] | None,
             "edge F_c1 is its root (Halley's method from the current du, 2-3 iterations); "
             "the closed-form friction step is inverted for the F_extra that lands du on "
             "it, and one friction solve confirms the branch."
-            + _hyp_share(b))
+            + (layer_cost.finding(layers) if layers else _hyp_share(b)))
         wet = ", ".join(f"{r['model']} {r['ratio']:.2f}x" for r in b["wet_region"])
         L.append(
             f"* **Dry cells: a 10x longer domain (same collapse, same dx) costs {wet}** "
