@@ -187,7 +187,12 @@ def test_direct_restoration_is_the_bisection_limit(mode):
     """The closed-form inversion of the friction step lands |du| on the band edge:
     hyperbolic, never more F_extra than bisection to w = 1e-3, and |du| within 1e-8
     (relative) of bisection to w = 1e-12."""
-    from pdeflow.numerics.friction import bisect_fextra, implicit_friction, restore_hyperbolicity
+    from pdeflow.numerics.friction import (
+        bisect_fextra,
+        friction_params,
+        implicit_friction,
+        restore_hyperbolicity,
+    )
 
     rng = np.random.default_rng(7)
     checked = 0
@@ -201,18 +206,20 @@ def test_direct_restoration_is_the_bisection_limit(mode):
         b1, b2 = rng.uniform(-8, 8, 2)
         dt = rng.uniform(1e-4, 1e-2)
         kc = (P[T.K], P[T.C])  # the paper's interface stress t1 (no erosion this step)
-        v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, 0.0, *kc)
+        fp = friction_params(P)
+        v1, v2 = implicit_friction(b1, b2, h1, h2, dt, fp, 0.0, *kc)
         if is_hyperbolic(h1, h2, v1, v2, P[T.G_Z], P[T.R], mode):
             continue
-        f, u1, u2, bisected = restore_hyperbolicity(b1, b2, h1, h2, v1, v2, dt, P, *kc)
+        f, u1, u2, bisected = restore_hyperbolicity(b1, b2, h1, h2, v1, v2, dt, fp, *kc)
         assert not bisected  # the direct solve found it
         assert is_hyperbolic(h1, h2, u1, u2, P[T.G_Z], P[T.R], mode)
-        assert (u1, u2) == implicit_friction(b1, b2, h1, h2, dt, P, f, *kc)
-        f_w = bisect_fextra(b1, b2, h1, h2, v1 - v2, dt, P, *kc)
+        assert (u1, u2) == implicit_friction(b1, b2, h1, h2, dt, fp, f, *kc)
+        f_w = bisect_fextra(b1, b2, h1, h2, v1 - v2, dt, fp, *kc)
         assert abs(f) <= abs(f_w) * (1 + 1e-12)
         P[T.W] = 1e-12
-        f_fine = bisect_fextra(b1, b2, h1, h2, v1 - v2, dt, P, *kc)
-        du_fine = np.subtract(*implicit_friction(b1, b2, h1, h2, dt, P, f_fine, *kc))
+        fp = friction_params(P)
+        f_fine = bisect_fextra(b1, b2, h1, h2, v1 - v2, dt, fp, *kc)
+        du_fine = np.subtract(*implicit_friction(b1, b2, h1, h2, dt, fp, f_fine, *kc))
         assert abs((u1 - u2) - du_fine) <= 2e-8 * abs(du_fine)
         checked += 1
     assert checked > 30

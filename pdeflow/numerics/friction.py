@@ -9,6 +9,10 @@ friction would hold at rest in the intermediate stage of SSP-RK2 (MUSCL).
 
 Kinematic units (divided by rho2) as in :mod:`pdeflow.numerics.sources`:
 f = F_extra/rho2 [m^2/s^2], velocities [m/s], depths [m].
+
+The helpers take the parameters they read as the tuple ``fp`` of :func:`friction_params`
+(built once per stage), not the parameter array: an array passed on to a helper that
+calls others costs two atomic reference-count updates per call.
 """
 
 from __future__ import annotations
@@ -23,31 +27,44 @@ from .hyperbolicity import band_lower_edge, is_hyperbolic, lower_bound_fl
 from .sources import _drag_root, coulomb_single, friction_two_layer
 from .state import velocity
 
+FP_R, FP_G, FP_DRY, FP_TAN_INT, FP_TAN_B, FP_W, FP_MODE = range(7)
+"""positions in :func:`friction_params`' tuple"""
+
 
 @cached(inline="always")
-def bed_under_both(b1, b2, m1, h1, h2, kdt, cdt, dt, g, r, P):
+def friction_params(P):
+    """What stages (32)-(34) read of the parameter vector ``P``, as a tuple of floats:
+    (r [-], g_z [m/s^2], dry tolerance [m], tan(phi_int), tan(phi_B), w [m/s], the
+    hyperbolicity mode's code) at the positions FP_*."""
+    return (P[T.R], P[T.G_Z], P[T.DRY], P[T.TAN_INT], P[T.TAN_B], P[T.W],
+            P[T.HYPERBOLICITY])
+
+
+@cached(inline="always")
+def bed_under_both(b1, b2, m1, h1, h2, kdt, cdt, dt, g, r, fp):
     """Stage (32) of two wet layers with Coulomb friction at the bed: (u1, u2) [m/s]
     (``m1`` = r h1, ``kdt``, ``cdt``: the interface law's terms times dt)."""
-    bdt = dt * g * (r * h1 + h2) * P[T.TAN_B]
+    bdt = dt * g * (r * h1 + h2) * fp[FP_TAN_B]
     return friction_two_layer(b1, b2, m1, h2, kdt, cdt, bdt)
 
 
 @cached(inline="always")
-def bed_under_lower(b2, h1, h2, dt, g, r, P):
+def bed_under_lower(b2, h1, h2, dt, g, r, fp):
     """Stage (32) of the lower layer alone (a dry upper layer's weight still counted):
     Coulomb friction at the bed, u2 [m/s]."""
-    mu_dt = dt * g * P[T.TAN_B] * (h2 + r * max(h1, 0.0)) / h2
+    mu_dt = dt * g * fp[FP_TAN_B] * (h2 + r * max(h1, 0.0)) / h2
     return coulomb_single(b2, mu_dt)
 
 
 @cached
-def implicit_friction(b1, b2, h1, h2, dt, P, f, k, c):
+def implicit_friction(b1, b2, h1, h2, dt, fp, f, k, c):
     """Implicit stage (32) for one cell with extra exchange ``f`` = F_extra/rho2 and the
     interface law (22) with friction reduction ``k`` and collisional coefficient ``c``
-    (the parameters', or those of t1 - M du in a cell that eroded this step)."""
-    r = P[T.R]
-    g = P[T.G_Z]
-    dry = P[T.DRY]
+    (the parameters', or those of t1 - M du in a cell that eroded this step); ``fp``:
+    :func:`friction_params`."""
+    r = fp[FP_R]
+    g = fp[FP_G]
+    dry = fp[FP_DRY]
     wet1 = h1 > dry
     wet2 = h2 > dry
     if wet1 and wet2:
@@ -55,28 +72,28 @@ def implicit_friction(b1, b2, h1, h2, dt, P, f, k, c):
         if f != 0.0:
             b1 = b1 - dt * f / m1
             b2 = b2 + dt * f / h2
-        kdt = dt * k * r * g * h1 * P[T.TAN_INT]
-        return bed_under_both(b1, b2, m1, h1, h2, kdt, dt * c, dt, g, r, P)
+        kdt = dt * k * r * g * h1 * fp[FP_TAN_INT]
+        return bed_under_both(b1, b2, m1, h1, h2, kdt, dt * c, dt, g, r, fp)
     if wet1:
         # no lower layer: the upper layer rubs on the bed with the interface law (22)
         m1 = r * h1
-        kdt = dt * k * r * g * h1 * P[T.TAN_INT]
+        kdt = dt * k * r * g * h1 * fp[FP_TAN_INT]
         u1 = _drag_root(m1 * abs(b1) - kdt, m1, dt * c)
         return (u1 if b1 > 0.0 else -u1), 0.0
     if wet2:
-        return 0.0, bed_under_lower(b2, h1, h2, dt, g, r, P)
+        return 0.0, bed_under_lower(b2, h1, h2, dt, g, r, fp)
     return 0.0, 0.0
 
 
 @cached
-def bisect_fextra(b1, b2, h1, h2, du0, dt, P, k, c):
+def bisect_fextra(b1, b2, h1, h2, du0, dt, fp, k, c):
     """F_extra/rho2 [m^2/s^2] by bracketing and bisection on the hyperbolicity test:
     the fallback of :func:`restore_hyperbolicity`, stopping when the bracket in du is
     below w."""
-    g = P[T.G_Z]
-    r = P[T.R]
-    mode = int(P[T.HYPERBOLICITY])
-    w = P[T.W]
+    g = fp[FP_G]
+    r = fp[FP_R]
+    mode = int(fp[FP_MODE])
+    w = fp[FP_W]
     # Bracket: f_lo leaves du of the original sign and non-hyperbolic; f_hi makes the
     # state hyperbolic or flips the sign of du (du(f) decreases monotonically in f, so
     # the smallest hyperbolic f lies before the sign change).
@@ -85,7 +102,7 @@ def bisect_fextra(b1, b2, h1, h2, du0, dt, P, k, c):
     du_lo = abs(du0)
     sgn = 1.0 if du0 > 0.0 else -1.0
     for _ in range(60):
-        v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, f_hi, k, c)
+        v1, v2 = implicit_friction(b1, b2, h1, h2, dt, fp, f_hi, k, c)
         du_hi = sgn * (v1 - v2)
         if du_hi <= 0.0 or is_hyperbolic(h1, h2, v1, v2, g, r, mode):
             break
@@ -96,7 +113,7 @@ def bisect_fextra(b1, b2, h1, h2, du0, dt, P, k, c):
         if du_lo - du_hi <= w or abs(f_hi - f_lo) <= 1e-12 * abs(f_hi):
             break
         f_mid = 0.5 * (f_lo + f_hi)
-        v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, f_mid, k, c)
+        v1, v2 = implicit_friction(b1, b2, h1, h2, dt, fp, f_mid, k, c)
         du_mid = sgn * (v1 - v2)
         if du_mid <= 0.0 or is_hyperbolic(h1, h2, v1, v2, g, r, mode):
             f_hi = f_mid
@@ -108,12 +125,30 @@ def bisect_fextra(b1, b2, h1, h2, du0, dt, P, k, c):
 
 
 @cached
-def restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P, k, c):
+def restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, fp, k, c):
+    """Smallest F_extra/rho2 [m^2/s^2] making the post-friction state (u1, u2) [m/s]
+    of a non-hyperbolic cell hyperbolic, the velocities it leads to, and whether the
+    bisection fallback was used: :func:`restore_to_edge` with the edge of
+    :func:`pdeflow.numerics.hyperbolicity.band_lower_edge` (F_L in ``bound`` mode).
+    The source stage finds the edge with its hyperbolicity test
+    (:func:`pdeflow.numerics.hyperbolicity.restoration_target`)."""
+    g = fp[FP_G]
+    r = fp[FP_R]
+    if int(fp[FP_MODE]) == L.HYPERBOLICITY_BOUND:
+        edge = lower_bound_fl(h1, h2, g, r)
+    else:
+        edge = band_lower_edge(h1, h2, g, r, abs(u1 - u2))
+    return restore_to_edge(b1, b2, h1, h2, u1, u2, dt, fp, k, c, edge)
+
+
+@cached
+def restore_to_edge(b1, b2, h1, h2, u1, u2, dt, fp, k, c, edge):
     r"""Smallest F_extra/rho2 [m^2/s^2] making the post-friction state hyperbolic, the
     velocities (u1, u2) [m/s] it leads to, and whether the bisection fallback was used.
 
-    The depths are frozen, so the target is a relative velocity: the lower band edge
-    F_c1 (F_L in ``bound`` mode). Stage (32) with the extra exchange f = F_extra/rho2
+    The depths are frozen, so the target is a relative velocity: ``edge`` [m/s], the
+    lower band edge F_c1 (F_L in ``bound`` mode; <= 0: none found, bisect). Stage (32)
+    with the extra exchange f = F_extra/rho2
     shifts b1 by -dt f/m1 and b2 by +dt f/m2 and keeps m1 b1 + m2 b2, so on each branch
     of its closed-form solution (:func:`pdeflow.numerics.sources.friction_two_layer`)
     du is an explicit function of f, inverted here for du = sgn(du0) d with
@@ -129,25 +164,25 @@ def restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P, k, c):
     if none passes (round-off at a branch boundary), bisection decides
     (:func:`bisect_fextra`).
     """
-    g = P[T.G_Z]
-    r = P[T.R]
-    mode = int(P[T.HYPERBOLICITY])
+    g = fp[FP_G]
+    r = fp[FP_R]
     du0 = u1 - u2
-    if mode == L.HYPERBOLICITY_BOUND:
-        edge = lower_bound_fl(h1, h2, g, r)
-    else:
-        edge = band_lower_edge(h1, h2, g, r, abs(du0))
+    found = False
+    f = v1 = v2 = 0.0
     if edge > 0.0:
         d = edge * (1.0 - 1e-8)  # a hair inside: round-off must not leave the band edge
         sgn = 1.0 if du0 > 0.0 else -1.0
         m1 = r * h1
         m2 = h2
         mt = m1 + m2
-        kdt = dt * k * r * g * h1 * P[T.TAN_INT]
+        kdt = dt * k * r * g * h1 * fp[FP_TAN_INT]
         cdt = dt * c
-        bdt = dt * g * (r * h1 + h2) * P[T.TAN_B]
+        bdt = dt * g * (r * h1 + h2) * fp[FP_TAN_B]
+        low = edge - fp[FP_W]
         s_first = 1.0 if u2 >= 0.0 else -1.0
         for branch in range(3):
+            if found:
+                break
             if branch == 2:
                 f = (m1 * b1 - sgn * (kdt + m1 * d + cdt * d * d)) / dt
             else:
@@ -155,15 +190,16 @@ def restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, P, k, c):
                 p = m1 * b1 + m2 * b2 - bdt * s2
                 f = (m1 * b1 - m1 * p / mt
                      - sgn * (kdt + m1 * m2 / mt * d + cdt * d * d)) / dt
-            if f * sgn <= 0.0:
-                continue
-            v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, f, k, c)
-            # below the edge is hyperbolic down to F_L (the band is one interval)
-            if edge - P[T.W] <= sgn * (v1 - v2) <= edge:
-                return f, v1, v2, False
-    f = bisect_fextra(b1, b2, h1, h2, du0, dt, P, k, c)
-    v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, f, k, c)
-    return f, v1, v2, True
+            if f * sgn > 0.0:
+                # implicit_friction(b1, b2, h1, h2, dt, fp, f, k, c) of two wet layers
+                v1, v2 = bed_under_both(b1 - dt * f / m1, b2 + dt * f / h2, m1, h1, h2,
+                                        kdt, cdt, dt, g, r, fp)
+                # below the edge is hyperbolic down to F_L (the band is one interval)
+                found = low <= sgn * (v1 - v2) <= edge
+    if not found:
+        f = bisect_fextra(b1, b2, h1, h2, du0, dt, fp, k, c)
+        v1, v2 = implicit_friction(b1, b2, h1, h2, dt, fp, f, k, c)
+    return f, v1, v2, not found
 
 
 @kernel(STATE, f8, PARAMS, i8, i8)
@@ -175,6 +211,7 @@ def predictor_two_layer(q: np.ndarray, dt: float, P: np.ndarray, lo: int,
     heaps creep. Moving layers are left untouched (friction proper is applied once, in
     the source stage)."""
     dry = P[T.DRY]
+    fp = friction_params(P)
     for i in range(lo, hi + 1):
         h1 = max(q[0, i], 0.0)
         h2 = max(q[2, i], 0.0)
@@ -182,7 +219,7 @@ def predictor_two_layer(q: np.ndarray, dt: float, P: np.ndarray, lo: int,
             continue
         b1 = velocity(h1, q[1, i], dry) + dt * P[T.G_X] if h1 > dry else 0.0
         b2 = velocity(h2, q[3, i], dry) + dt * P[T.G_X] if h2 > dry else 0.0
-        u1, u2 = implicit_friction(b1, b2, h1, h2, dt, P, 0.0, P[T.K], P[T.C])
+        u1, u2 = implicit_friction(b1, b2, h1, h2, dt, fp, 0.0, P[T.K], P[T.C])
         if u1 == 0.0:
             q[1, i] = 0.0
         if u2 == 0.0:

@@ -138,27 +138,73 @@ def is_hyperbolic(h1: float, h2: float, u1: float, u2: float, g: float, r: float
     return discriminant(h1, h2, u1, u2, g, r) >= 0.0
 
 
+@cached(inline="always")
+def _quartic_at(a: tuple[float, float, float, float, float], x: float) -> float:
+    """Delta/16 at A = ``x``: the quartic of :func:`_quartic_in_a` by Horner's rule."""
+    a4, a3, a2, a1, a0 = a
+    return (((a4 * x + a3) * x + a2) * x + a1) * x + a0
+
+
+@cached
+def restoration_target(h1: float, h2: float, du: float, g: float, r: float,
+                       mode: int) -> tuple[bool, float]:
+    """:func:`is_hyperbolic` for the restoration: (False, 0) where the state is
+    hyperbolic, else (True, the |du| [m/s] to restore): the band edge F_c1 of
+    :func:`band_lower_edge` (``mode`` exact), or F_L (``mode`` bound).
+
+    The same tests as :func:`is_hyperbolic` and the same edge as
+    :func:`band_lower_edge` with ``du_bad`` = |du|, in one pass: the quartic's
+    coefficients and its value at A = (du/2)^2/(g H) found by the test start the
+    Halley iteration of the edge."""
+    if du * du <= (1.0 - r) * g * (h1 + h2):
+        return False, 0.0  # below F_L (see is_hyperbolic)
+    if mode == L.HYPERBOLICITY_BOUND:
+        fl = lower_bound_fl(h1, h2, g, r)
+        return abs(du) > fl, fl
+    a = _quartic_in_a(h1, h2, r)
+    c2 = g * (h1 + h2)
+    A = 0.25 * du * du / c2
+    D = _quartic_at(a, A)
+    if D >= 0.0:
+        return False, 0.0
+    return True, _edge_below(a, c2, A, D)
+
+
 @cached
 def band_lower_edge(h1: float, h2: float, g: float, r: float, du_bad: float) -> float:
     """Lower edge F_c1 [m/s] of the non-hyperbolic band, given a non-hyperbolic |du|.
 
     ``du_bad`` (> F_c1, inside the band) brackets the root together with du = 0
-    (hyperbolic: Delta(0) = 16 c (4c - 1)^2 >= 0). Halley's method on the quartic of
-    :func:`_quartic_in_a` from the non-hyperbolic end (the restoration calls it with
-    |du| just above F_c1: two or three iterations), safeguarded by false position;
-    returns F_c1 to one part in 1e-9, from the hyperbolic side up to round-off (callers
-    aiming at the edge stay a hair below it), or -1 if ``du_bad`` is not inside the
-    band.
+    (hyperbolic: Delta(0) = 16 c (4c - 1)^2 >= 0); the root is refined by
+    :func:`_edge_below`. Returns F_c1 to one part in 1e-9, from the hyperbolic side up
+    to round-off (callers aiming at the edge stay a hair below it), or -1 if
+    ``du_bad`` is not inside the band.
     """
-    a4, a3, a2, a1, a0 = _quartic_in_a(h1, h2, r)
+    a = _quartic_in_a(h1, h2, r)
     c2 = g * (h1 + h2)
-    lo = 0.0
-    d_lo = a0
     hi = 0.25 * du_bad * du_bad / c2
-    x = hi
-    D = (((a4 * x + a3) * x + a2) * x + a1) * x + a0
+    D = _quartic_at(a, hi)
     if D >= 0.0:
         return -1.0
+    return _edge_below(a, c2, hi, D)
+
+
+@cached(inline="always")
+def _edge_below(a: tuple[float, float, float, float, float], c2: float, hi: float,
+                D: float) -> float:
+    """F_c1 [m/s]: the root of the quartic ``a`` of :func:`_quartic_in_a` below
+    A = ``hi`` (where it is ``D`` < 0), returned as 2 sqrt(A c2) (``c2`` = g H
+    [m^2/s^2]).
+
+    Halley's method from the non-hyperbolic end (the restoration calls it with |du|
+    just above F_c1: two or three iterations), safeguarded by false position on the
+    bracket [0, hi] (Delta(0) >= 0); at convergence (a step below 1e-10 A) the root is
+    settled on its hyperbolic side.
+    """
+    a4, a3, a2, a1, a0 = a
+    lo = 0.0
+    d_lo = a0
+    x = hi
     d_hi = D
     for _ in range(100):
         dD = ((4.0 * a4 * x + 3.0 * a3) * x + 2.0 * a2) * x + a1
@@ -170,7 +216,7 @@ def band_lower_edge(h1: float, h2: float, g: float, r: float, du_bad: float) -> 
             eps = 1e-10
             while D < 0.0 and eps < 1e-6:
                 y = x * (1.0 - eps) - abs(step)
-                D = (((a4 * y + a3) * y + a2) * y + a1) * y + a0
+                D = _quartic_at(a, y)
                 if D >= 0.0:
                     x = y
                 eps *= 4.0
@@ -183,7 +229,7 @@ def band_lower_edge(h1: float, h2: float, g: float, r: float, du_bad: float) -> 
             if not (lo < xn < hi):
                 xn = 0.5 * (lo + hi)
         x = xn
-        D = (((a4 * x + a3) * x + a2) * x + a1) * x + a0
+        D = _quartic_at(a, x)
         if D >= 0.0:
             lo = x
             d_lo = D

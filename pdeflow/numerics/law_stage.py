@@ -28,6 +28,7 @@ from . import friction, source_stage
 from . import layout_single_layer as S
 from . import layout_two_layer as T
 from .compiled import PARAMS, STATE, VECTOR, cached, f8, i8, kernel
+from .friction import FP_MODE, friction_params
 from .rheology import friction_two_layer_law, law_block, law_velocity
 
 
@@ -45,19 +46,29 @@ def _with_callees(dispatcher: Any, name: str, **callees: Any) -> Callable:
 
 
 @cached(inline="always")
-def bed_under_both_law(b1, b2, m1, h1, h2, kdt, cdt, dt, g, r, P):
-    """:func:`pdeflow.numerics.friction.bed_under_both` with the basal law at
-    ``T.LAW`` (:func:`pdeflow.numerics.rheology.friction_two_layer_law`; the law sees
-    the total depth h1 + h2 and the weight of both layers)."""
-    return friction_two_layer_law(b1, b2, m1, h2, kdt, cdt, dt, g, h1 + h2,
-                                  law_block(P, T.LAW))
+def friction_params_law(P):
+    """:func:`pdeflow.numerics.friction.friction_params` with the basal law's block
+    (:func:`pdeflow.numerics.rheology.law_block`) at the position FP_LAW."""
+    return friction_params(P) + (law_block(P, T.LAW),)
+
+
+FP_LAW = FP_MODE + 1
+"""position of the law's block in :func:`friction_params_law`' tuple"""
 
 
 @cached(inline="always")
-def bed_under_lower_law(b2, h1, h2, dt, g, r, P):
+def bed_under_both_law(b1, b2, m1, h1, h2, kdt, cdt, dt, g, r, fp):
+    """:func:`pdeflow.numerics.friction.bed_under_both` with the basal law of
+    ``fp[FP_LAW]`` (:func:`pdeflow.numerics.rheology.friction_two_layer_law`; the law
+    sees the total depth h1 + h2 and the weight of both layers)."""
+    return friction_two_layer_law(b1, b2, m1, h2, kdt, cdt, dt, g, h1 + h2, fp[FP_LAW])
+
+
+@cached(inline="always")
+def bed_under_lower_law(b2, h1, h2, dt, g, r, fp):
     """:func:`pdeflow.numerics.friction.bed_under_lower` with the basal law."""
     gw = g * (h2 + r * max(h1, 0.0)) / h2
-    return law_velocity(b2, h2 + max(h1, 0.0), gw, h2, dt, law_block(P, T.LAW))
+    return law_velocity(b2, h2 + max(h1, 0.0), gw, h2, dt, fp[FP_LAW])
 
 
 implicit_friction_law = cached(_with_callees(
@@ -65,16 +76,16 @@ implicit_friction_law = cached(_with_callees(
     bed_under_both=bed_under_both_law, bed_under_lower=bed_under_lower_law))
 bisect_fextra_law = cached(_with_callees(
     friction.bisect_fextra, "bisect_fextra_law", implicit_friction=implicit_friction_law))
-restore_hyperbolicity_law = cached(_with_callees(
-    friction.restore_hyperbolicity, "restore_hyperbolicity_law",
+restore_to_edge_law = cached(_with_callees(
+    friction.restore_to_edge, "restore_to_edge_law", bed_under_both=bed_under_both_law,
     implicit_friction=implicit_friction_law, bisect_fextra=bisect_fextra_law))
 predictor_two_layer_law = kernel(STATE, f8, PARAMS, i8, i8)(_with_callees(
     friction.predictor_two_layer, "predictor_two_layer_law",
-    implicit_friction=implicit_friction_law))
+    implicit_friction=implicit_friction_law, friction_params=friction_params_law))
 sources_two_layer_law = kernel(STATE, f8, f8, PARAMS, VECTOR, i8, i8)(_with_callees(
     source_stage.sources_two_layer, "sources_two_layer_law",
-    implicit_friction=implicit_friction_law,
-    restore_hyperbolicity=restore_hyperbolicity_law))
+    implicit_friction=implicit_friction_law, friction_params=friction_params_law,
+    restore_to_edge=restore_to_edge_law))
 source_stage_two_layer_law = kernel(STATE, f8, f8, PARAMS, VECTOR)(_with_callees(
     source_stage.source_stage_two_layer, "source_stage_two_layer_law",
     sources_two_layer=sources_two_layer_law))

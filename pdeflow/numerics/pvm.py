@@ -211,6 +211,13 @@ def _two_layer(rusanov: bool, ifcp: bool):
 
         dh1 = h1R - h1L
         dh2 = h2R - h2L
+        if m1L == 0.0 and m1R == 0.0 and m2L == 0.0 and m2R == 0.0:
+            # both layers at rest on both sides (or absent): the at-rest rule below for
+            # both, without the flux's fluctuations it replaces
+            dH = dh1 + dh2
+            dE = dh2 + r * dh1
+            return ((0.0, 0.5 * g * h1L * dH, 0.0, 0.5 * g * h2L * dE),
+                    (0.0, 0.5 * g * h1R * dH, 0.0, 0.5 * g * h2R * dE), smax)
         a0 = u1R * h1R - u1L * h1L
         a1 = (u1R * u1R * h1R - u1L * u1L * h1L) + g * 0.5 * (h1L + h1R) * (dh1 + dh2)
         a2 = u2R * h2R - u2L * h2L

@@ -28,8 +28,8 @@ from . import layout as L
 from . import layout_single_layer as S
 from . import layout_two_layer as T
 from .compiled import PARAMS, STATE, VECTOR, cached, f8, i8, kernel
-from .friction import implicit_friction, restore_hyperbolicity
-from .hyperbolicity import is_hyperbolic
+from .friction import friction_params, implicit_friction, restore_to_edge
+from .hyperbolicity import restoration_target
 from .sources import coulomb_single, exchange_step
 from .state import velocity
 
@@ -65,6 +65,7 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
     fast2 = False
     changed = False
     fex = diag[L.N_DIAG:]
+    fp = friction_params(P)
     for i in range(lo, hi + 1):
         h1 = q[0, i]
         m1 = q[1, i]
@@ -121,12 +122,13 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
             # --- (32) implicit momentum sources ------------------------------------------
             b1 = u1 + dt * gx if h1 > dry else 0.0
             b2 = u2 + dt * gx if h2 > dry else 0.0
-            v1, v2 = implicit_friction(b1, b2, h1, h2, dt, P, 0.0, k_eff, c_eff)
+            v1, v2 = implicit_friction(b1, b2, h1, h2, dt, fp, 0.0, k_eff, c_eff)
             # --- (33)-(34) hyperbolicity --------------------------------------------------
             if mode != L.HYPERBOLICITY_NONE and h1 > dry and h2 > dry:
-                if not is_hyperbolic(h1, h2, v1, v2, g, r, mode):
-                    f, v1, v2, bisected = restore_hyperbolicity(b1, b2, h1, h2, v1, v2,
-                                                                 dt, P, k_eff, c_eff)
+                bad, edge = restoration_target(h1, h2, v1 - v2, g, r, mode)
+                if bad:
+                    f, v1, v2, bisected = restore_to_edge(b1, b2, h1, h2, v1, v2, dt, fp,
+                                                          k_eff, c_eff, edge)
                     if bisected:
                         diag[L.D_HYP_BISECTIONS] += 1.0
                     fex[i] = abs(f) / r

@@ -112,29 +112,45 @@ def _drag_root(y: float, mass: float, cdt: float) -> float:
     return 2.0 * y / (mass + math.sqrt(mass * mass + 4.0 * cdt * y))
 
 
+@cached(inline="always")
+def _sliding(p, b1, m1, mt, mu, Kdt, Cdt):
+    """(d, u2) [m/s] of :func:`friction_two_layer` with the lower layer sliding, given
+    the total momentum after basal friction ``p`` = m1 b1 + m2 b2 - Bdt s2 [m^2/s]:
+    the relative velocity d = u1 - u2 solves mu d + Cdt d|d| + Kdt Sgn(d) = rel with
+    rel = m1 (b1 - p/mt), and u2 = (p - m1 d)/mt."""
+    rel = m1 * (b1 - p / mt)  # = mu (b1 - u_mean) : drive of the relative velocity
+    d = _sign(rel) * _drag_root(abs(rel) - Kdt, mu, Cdt)
+    return d, (p - m1 * d) / mt
+
+
 @cached
 def friction_two_layer(b1, b2, m1, m2, Kdt, Cdt, Bdt):
     """Solve the coupled implicit friction step for (u1, u2); see module docstring.
 
     ``b1, b2`` velocities before friction [m/s]; ``m1 = r h1``, ``m2 = h2`` [m];
     ``Kdt = dt K``, ``Cdt = dt C``, ``Bdt = dt B`` [m^2/s] (C dt in [m]).
+
+    The sliding solutions for both directions s2 = +-1 of the lower layer
+    (p = m1 b1 + m2 b2 - Bdt s2) are computed before the stuck test decides between
+    them and the stuck solution: they do not depend on it, so the three chains of
+    divisions and square roots run side by side instead of one after the other.
     """
+    mt = m1 + m2
+    mu = m1 * m2 / mt
+    p0 = m1 * b1 + m2 * b2
+    # 2) lower layer slides in direction s2: total momentum after basal friction
+    df, u2f = _sliding(p0 - Bdt, b1, m1, mt, mu, Kdt, Cdt)  # s2 = +1
+    db, u2b = _sliding(p0 + Bdt, b1, m1, mt, mu, Kdt, Cdt)  # s2 = -1
     # 1) try the lower layer stuck: the upper layer slides over a fixed surface
     u1 = _sign(b1) * _drag_root(m1 * abs(b1) - Kdt, m1, Cdt)
     push = m2 * b2 + m1 * (b1 - u1)  # force the stuck lower layer must resist, x dt
     if abs(push) <= Bdt:
         return u1, 0.0
-    s2 = _sign(push)
-    # 2) lower layer slides in direction s2: total momentum after basal friction
-    mt = m1 + m2
-    p = m1 * b1 + m2 * b2 - Bdt * s2
-    mu = m1 * m2 / mt
-    rel = m1 * (b1 - p / mt)  # = mu (b1 - u_mean) : drive of the relative velocity
-    d = _sign(rel) * _drag_root(abs(rel) - Kdt, mu, Cdt)
-    u2 = (p - m1 * d) / mt
-    if u2 * s2 < 0.0:  # round-off at the stick/slip boundary
-        u2 = 0.0
-    return u2 + d, u2
+    # the lower layer slides the way it is pushed; u2 of the other sign is round-off at
+    # the stick/slip boundary
+    if push > 0.0:
+        return (df, 0.0) if u2f < 0.0 else (u2f + df, u2f)
+    return (db, 0.0) if u2b > 0.0 else (u2b + db, u2b)
 
 
 @cached
