@@ -215,6 +215,24 @@ def test_cache_key_follows_the_code_of_every_called_kernel(monkeypatch):
     assert key() != before
 
 
+def test_the_cache_key_changes_with_the_compile_options():
+    """Two kernels of the same code compiled with other options (inlined into callers,
+    without entry points) get other machine code, so other cache keys: a changed
+    ``inline=`` once loaded the code compiled under the old option."""
+
+    def f(x):
+        return 2.0 * x
+
+    plain = compiled._jit(f)
+    helper = compiled._jit(f, helper=True)
+    inlined = compiled._jit(f, helper=True, inline="always")
+    sig = (compiled.f8,)
+    keys = {k._cache._index_key(sig, k.targetctx.codegen()) for k in (plain, helper, inlined)}
+    assert len(keys) == 3
+    again = compiled._jit(f, helper=True)
+    assert again._cache._index_key(sig, again.targetctx.codegen()) in keys
+
+
 def test_the_cache_key_changes_with_the_constants_a_kernel_reads(monkeypatch):
     """numba compiles module constants in (``L.N_DIAG``, the per-cell F_extra's offset in
     the diagnostics): a kernel whose code is unchanged but whose layout constant moved

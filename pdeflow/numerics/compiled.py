@@ -150,7 +150,7 @@ def _jit(func: Callable, *, helper: bool = False, pointer: bool = True,
                "no_cpython_wrapper": helper, "no_cfunc_wrapper": helper or not pointer}
     compiled = (HelperKernel if helper else CPUDispatcher)(
         py_func=func, locals={}, targetoptions=options)
-    compiled._cache = _CodeKeyedCache(func, python_twin)
+    compiled._cache = _CodeKeyedCache(func, python_twin, options)
     return compiled
 
 
@@ -339,15 +339,18 @@ def _describe(value: Any, depth: int = 0) -> Any:
 
 class _CodeKeyedCache(FunctionCache):
     """numba's disk cache for a kernel, keyed by its code, what it closes over (see the
-    module docstring) and the code of every kernel it calls. numba's own key is the
-    kernel's source file's time stamp: a kernel whose callee in another file changed
-    would be loaded with the old callee compiled in (and give stale results); here it
-    is recompiled."""
+    module docstring), the code of every kernel it calls and its compile options.
+    numba's own key is the kernel's source file's time stamp: a kernel whose callee in
+    another file changed would be loaded with the old callee compiled in (and give
+    stale results); here it is recompiled."""
 
-    def __init__(self, py_func: Callable, python_twin: bool = False):
+    def __init__(self, py_func: Callable, python_twin: bool = False,
+                 options: dict[str, Any] | None = None):
         super().__init__(py_func)
-        # a helper's twin (see HelperKernel) has entry points the helper lacks
-        self._variant = "python twin" if python_twin else ""
+        # a helper's twin (see HelperKernel) has entry points the helper lacks; the
+        # compile options (inlining, entry points) change the machine code too
+        self._variant = ("python twin" if python_twin else "",
+                         tuple(sorted((options or {}).items())))
 
     def load_overload(self, sig: Any, target_context: Any) -> Any:
         """numba's load without its ``target_context.refresh()``: that loads every
