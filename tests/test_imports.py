@@ -18,7 +18,10 @@ NOT_NEEDED = ("matplotlib", "panel", "bokeh", "dask", "distributed", "pandas", "
               # only the options of the command it runs)
               "pdeflow.analysis.convergence", "pdeflow.analysis.workprecision",
               "pdeflow.analysis.sweep", "pdeflow.study", "pdeflow.app.server",
-              "pdeflow.storage")
+              "pdeflow.storage",
+              # the fv-split solver's compiled loop is pdeflow's own: py-pde's numba
+              # backend (and the numba modules it pulls in) is not needed for it
+              "pde.backends.numba")
 
 SCRIPT = """
 import json, sys
