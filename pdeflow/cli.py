@@ -86,12 +86,6 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
     return trackers
 
 
-def _import_plotting() -> None:
-    import matplotlib.pyplot  # noqa: F401
-
-    from . import case_figures  # noqa: F401
-
-
 def _load_run_case(args: argparse.Namespace) -> Any:
     """The case of ``pdeflow run``; a study file is pointed to ``pdeflow study``."""
     import tomllib
@@ -182,10 +176,9 @@ def _run_models(args: argparse.Namespace, case: Any) -> tuple[dict, dict, list]:
 
 def _write_run_outputs(args: argparse.Namespace, case: Any, summary: dict,
                        results: dict, stores: dict, trackers: list,
-                       outdir: Path | None) -> list[Any]:
+                       outdir: Path | None, worker: Any = None) -> list[Any]:
     """Write (commit) every output of ``pdeflow run``; returns what was written."""
     from .io import write_json, write_npz
-    from .numerics.geometry import COORDINATES
 
     written: list[Any] = []
     for model, tracker in stores.items():
@@ -204,26 +197,16 @@ def _write_run_outputs(args: argparse.Namespace, case: Any, summary: dict,
         for i, m in enumerate(case.models):
             written.append(write_npz(_model_path(args.final, m, i == 0),
                                      results[m].final_arrays()))
-    if args.plot:
-        from .case_figures import deposit_figure
-        from .plotting import save
+    if args.plot or outdir:
+        from .case_figures import draw_all, run_figure_jobs
 
-        runs = list(results.values())
-        coordinate = COORDINATES[case.geometry]
-        fig = deposit_figure(runs[0].x, [(r.model, r.state.data) for r in runs], case.name,
-                             coordinate=coordinate)
-        written.append(save(fig, args.plot))
-    if outdir:
-        from .case_figures import case_figures
-
-        written.extend(case_figures(results, outdir))
+        jobs = run_figure_jobs(results, outdir, args.plot)
+        # drawn by the figure worker (pdeflow.figure_worker) where there is one
+        written.extend(worker.draw(jobs) if worker is not None else draw_all(jobs))
     return written
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from .interrupts import deferred_signals
-    from .numerics.warmup import prepare
-    from .simulate import case_steppers, print_summary
     from .sizecheck import check_size
 
     case = _load_run_case(args)
@@ -236,9 +219,41 @@ def cmd_run(args: argparse.Namespace) -> int:
     _check_run_outputs(args, outdir)
     check_size(case, args.force, "use a coarser grid (--set grid.dx=...)")
     live_window = _live_window(args)
-    # matplotlib's import (~0.5 s) fills the wait for the kernels a helper compiles
+    worker = _start_figure_worker(args, outdir)
+    try:
+        return _run_and_write(args, case, outdir, worker, live_window)
+    finally:
+        if worker is not None:
+            worker.close()
+
+
+def _start_figure_worker(args: argparse.Namespace, outdir: Path | None) -> Any:
+    """For a run that writes figures, a :class:`~pdeflow.figure_worker.FigureWorker`
+    forked now: it imports matplotlib while this process loads the kernels and runs
+    the models. None without figures, where it cannot fork, and next to a live plot,
+    a movie or frames (they draw in this process, with pyplot)."""
+    if not (args.plot or outdir) or args.live or args.movie or args.frames:
+        return None
+    from .figure_worker import FigureWorker
+
+    return FigureWorker.start()
+
+
+def _run_and_write(args: argparse.Namespace, case: Any, outdir: Path | None,
+                   worker: Any, live_window: bool) -> int:
+    """The body of ``pdeflow run`` after the checks: kernels, runs, outputs, printing."""
+    from .interrupts import deferred_signals
+    from .numerics.warmup import prepare
+    from .simulate import case_steppers, print_summary
+
+    meanwhile = None
+    if (args.plot or outdir) and worker is None:
+        from .figure_worker import import_matplotlib
+
+        # matplotlib's import fills the wait for the kernels a helper compiles
+        meanwhile = import_matplotlib
     prepare(case_steppers(case), log=None if args.quiet else sys.stderr,
-            meanwhile=_import_plotting if args.plot or outdir else None)
+            meanwhile=meanwhile)
     results, stores, trackers = _run_models(args, case)
     summary = {
         "case": case.name,
@@ -250,7 +265,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     }
     with deferred_signals() as came:  # the results are written completely, or not
         written = _write_run_outputs(args, case, summary, results, stores, trackers,
-                                     outdir)
+                                     outdir, worker)
     if came:
         print("pdeflow: interrupted after the results were written", file=sys.stderr)
         return 130
