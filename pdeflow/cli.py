@@ -176,8 +176,9 @@ def _run_models(args: argparse.Namespace, case: Any) -> tuple[dict, dict, list]:
 
 def _write_run_outputs(args: argparse.Namespace, case: Any, summary: dict,
                        results: dict, stores: dict, trackers: list,
-                       outdir: Path | None, worker: Any = None) -> list[Any]:
-    """Write (commit) every output of ``pdeflow run``; returns what was written."""
+                       outdir: Path | None, figures: Any = None) -> list[Any]:
+    """Write (commit) every output of ``pdeflow run`` (the figures by ``figures``, a
+    :class:`~pdeflow.figure_worker.RunFigures`); returns what was written."""
     from .io import write_json, write_npz
 
     written: list[Any] = []
@@ -197,12 +198,10 @@ def _write_run_outputs(args: argparse.Namespace, case: Any, summary: dict,
         for i, m in enumerate(case.models):
             written.append(write_npz(_model_path(args.final, m, i == 0),
                                      results[m].final_arrays()))
-    if args.plot or outdir:
-        from .case_figures import draw_all, run_figure_jobs
+    if figures is not None:
+        from .case_figures import run_figure_jobs
 
-        jobs = run_figure_jobs(results, outdir, args.plot)
-        # drawn by the figure worker (pdeflow.figure_worker) where there is one
-        written.extend(worker.draw(jobs) if worker is not None else draw_all(jobs))
+        written.extend(figures.draw(run_figure_jobs(results, outdir, args.plot)))
     return written
 
 
@@ -219,41 +218,33 @@ def cmd_run(args: argparse.Namespace) -> int:
     _check_run_outputs(args, outdir)
     check_size(case, args.force, "use a coarser grid (--set grid.dx=...)")
     live_window = _live_window(args)
-    worker = _start_figure_worker(args, outdir)
+    figures = None
+    if args.plot or outdir:
+        from .figure_worker import RunFigures
+
+        figures = RunFigures(here=bool(args.live or args.movie or args.frames))
     try:
-        return _run_and_write(args, case, outdir, worker, live_window)
+        return _run_and_write(args, case, outdir, figures, live_window)
     finally:
-        if worker is not None:
-            worker.close()
-
-
-def _start_figure_worker(args: argparse.Namespace, outdir: Path | None) -> Any:
-    """For a run that writes figures, a :class:`~pdeflow.figure_worker.FigureWorker`
-    forked now: it imports matplotlib while this process loads the kernels and runs
-    the models. None without figures, where it cannot fork, and next to a live plot,
-    a movie or frames (they draw in this process, with pyplot)."""
-    if not (args.plot or outdir) or args.live or args.movie or args.frames:
-        return None
-    from .figure_worker import FigureWorker
-
-    return FigureWorker.start()
+        if figures is not None:
+            figures.close()
 
 
 def _run_and_write(args: argparse.Namespace, case: Any, outdir: Path | None,
-                   worker: Any, live_window: bool) -> int:
-    """The body of ``pdeflow run`` after the checks: kernels, runs, outputs, printing."""
+                   figures: Any, live_window: bool) -> int:
+    """The body of ``pdeflow run`` after the checks: kernels, runs, outputs, printing;
+    ``figures``: a :class:`~pdeflow.figure_worker.RunFigures` (None: no figures)."""
     from .interrupts import deferred_signals
-    from .numerics.warmup import prepare
+    from .numerics.warmup import COLD, prepare, status
     from .simulate import case_steppers, print_summary
 
+    steppers = case_steppers(case)
     meanwhile = None
-    if (args.plot or outdir) and worker is None:
-        from .figure_worker import import_matplotlib
-
-        # matplotlib's import fills the wait for the kernels a helper compiles
-        meanwhile = import_matplotlib
-    prepare(case_steppers(case), log=None if args.quiet else sys.stderr,
-            meanwhile=meanwhile)
+    if figures is not None and status(steppers) == COLD:
+        meanwhile = figures.start  # it fills the wait for the kernels a helper compiles
+    elif figures is not None:
+        figures.start()  # matplotlib's import overlaps the kernels' loading and the runs
+    prepare(steppers, log=None if args.quiet else sys.stderr, meanwhile=meanwhile)
     results, stores, trackers = _run_models(args, case)
     summary = {
         "case": case.name,
@@ -265,7 +256,7 @@ def _run_and_write(args: argparse.Namespace, case: Any, outdir: Path | None,
     }
     with deferred_signals() as came:  # the results are written completely, or not
         written = _write_run_outputs(args, case, summary, results, stores, trackers,
-                                     outdir, worker)
+                                     outdir, figures)
     if came:
         print("pdeflow: interrupted after the results were written", file=sys.stderr)
         return 130

@@ -1,11 +1,14 @@
-"""Drawing the figures of ``pdeflow run`` in a process forked before the run.
+"""Drawing the figures of ``pdeflow run`` in a process forked before they are needed.
 
 Importing matplotlib takes longer than loading a case's kernels from the disk cache and
 running it: a :class:`FigureWorker` forked before the kernels are loaded imports it
 meanwhile, then draws the figure jobs (:mod:`pdeflow.case_figures`) it is sent, on two
 cores where there are (:func:`pdeflow.case_figures.draw_all`), while this process
-waits; this process never imports matplotlib. The figures are drawn from the results
-the run sends, after it: they cannot change a run's numbers.
+waits; this process never imports matplotlib. When kernels must be compiled, the
+worker is forked while this process waits for the compile helper (the import then
+fills that wait, :func:`pdeflow.numerics.warmup.prepare`). :class:`RunFigures` is what
+``pdeflow run`` uses. The figures are drawn from the results the run sends, after
+it: they cannot change a run's numbers.
 
 Signals: until its jobs come, the worker ends on SIGINT or SIGTERM (as this process
 does, :func:`pdeflow.interrupts.signals_interrupt`); while it draws it holds them back
@@ -28,6 +31,48 @@ from .numerics.compile_parallel import can_fork, fork_context
 
 class FigureError(RuntimeError):
     """Drawing the figures failed in the worker (the message has its traceback)."""
+
+
+class RunFigures:
+    """How one ``pdeflow run`` draws its figures: :meth:`start` forks the
+    :class:`FigureWorker` (where it cannot fork, or with ``here``, it imports matplotlib
+    in this process instead), :meth:`draw` draws the jobs there (or here), :meth:`close`
+    ends the worker.
+
+    Args:
+        here: draw in this process (a live plot, a movie or frames draw here, with
+            pyplot: a fork would share their window).
+    """
+
+    def __init__(self, here: bool = False):
+        self.here = here
+        self.worker: FigureWorker | None = None
+        self.started = False
+
+    def start(self) -> None:
+        """Fork the worker (or import matplotlib here); once."""
+        if self.started:
+            return
+        self.started = True
+        if not self.here:
+            self.worker = FigureWorker.start()
+        if self.worker is None:
+            import_matplotlib()
+
+    def draw(self, jobs: Sequence[Any]) -> list[Path]:
+        """Draw and save the figures of ``jobs`` (:mod:`pdeflow.case_figures`); their
+        paths."""
+        self.start()
+        if self.worker is not None:
+            return self.worker.draw(jobs)
+        from .case_figures import draw_all
+
+        return draw_all(jobs)
+
+    def close(self) -> None:
+        """End the worker, if there is one."""
+        if self.worker is not None:
+            self.worker.close()
 
 
 class FigureWorker:
