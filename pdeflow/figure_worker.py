@@ -105,11 +105,13 @@ class FigureWorker:
         try:
             self.conn.send(list(jobs))
             status, value = self.conn.recv()
-        except (EOFError, OSError) as err:
-            raise FigureError(f"the figure worker ended before the figures were drawn "
-                              f"(exit code {self.process.exitcode})") from err
+        except (EOFError, OSError):
+            status, value = "gone", None
         finally:
             self.close()
+        if status == "gone":
+            raise FigureError(f"the figure worker ended before the figures were drawn "
+                              f"(exit code {self.process.exitcode})")
         if status != "ok":
             raise FigureError(f"drawing the figures failed:\n{value}")
         return value
