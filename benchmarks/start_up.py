@@ -15,16 +15,22 @@ Measured by ``python benchmarks/run_benchmarks.py --only start`` (into
 * **app**: ``pdeflow app`` started to the dam-break page's first picture
   (:mod:`app_start`), when Chromium and Playwright are there.
 
-Every process uses one numba cache of its own, filled by one run first.
+Every process uses one numba cache of its own, filled by one run first, and one
+bytecode cache (``PYTHONPYCACHEPREFIX``, ``PYTHONDONTWRITEBYTECODE`` unset for the
+children): where the environment sets ``PYTHONDONTWRITEBYTECODE``, every process would
+otherwise compile pdeflow's modules from source while py-pde's come compiled from
+site-packages, which is no warm start.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import statistics
 import sys
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -72,20 +78,21 @@ def measure(repeats: int = 9, app: bool = True, log: Any = sys.stderr) -> dict[s
     load = os.getloadavg()
     cache = tempfile.mkdtemp(prefix="pdeflow-start-numba-")
     try:
-        cmds = commands()
-        _child(cmds["run -q"], cache)  # fills the cache
-        loads = [_child([sys.executable, "-c", _LOAD, str(ROOT / CASE)], cache)
-                 for _ in range(repeats)]
-        runs: dict[str, list[dict[str, Any]]] = {k: [] for k in cmds}
-        for i in range(repeats + 1):  # the first round is not counted
-            for label, cmd in cmds.items():
-                r = _child(cmd, cache)
-                if i:
-                    runs[label].append(r)
-            if log is not None and i:
-                print(f"start-up round {i}/{repeats}: " + ", ".join(
-                    f"{k} {v[-1]['wall_s']:.2f} s" for k, v in runs.items()),
-                    file=log, flush=True)
+        with _bytecode_cache(os.path.join(cache, "pycache")):
+            cmds = commands()
+            _child(cmds["run -q"], cache)  # fills the cache
+            loads = [_child([sys.executable, "-c", _LOAD, str(ROOT / CASE)], cache)
+                     for _ in range(repeats)]
+            runs: dict[str, list[dict[str, Any]]] = {k: [] for k in cmds}
+            for i in range(repeats + 1):  # the first round is not counted
+                for label, cmd in cmds.items():
+                    r = _child(cmd, cache)
+                    if i:
+                        runs[label].append(r)
+                if log is not None and i:
+                    print(f"start-up round {i}/{repeats}: " + ", ".join(
+                        f"{k} {v[-1]['wall_s']:.2f} s" for k, v in runs.items()),
+                        file=log, flush=True)
     finally:
         shutil.rmtree(cache, ignore_errors=True)
     pde = runs["import pde"]
@@ -112,6 +119,23 @@ def measure(repeats: int = 9, app: bool = True, log: Any = sys.stderr) -> dict[s
     return out
 
 
+@contextlib.contextmanager
+def _bytecode_cache(prefix: str) -> Iterator[None]:
+    """Inside the block, the child processes (they inherit this environment) write and
+    read their bytecode in ``prefix``."""
+    names = ("PYTHONPYCACHEPREFIX", "PYTHONDONTWRITEBYTECODE")
+    saved = {name: os.environ.get(name) for name in names}
+    os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
+    os.environ["PYTHONPYCACHEPREFIX"] = prefix
+    try:
+        yield
+    finally:
+        for name, value in saved.items():
+            os.environ.pop(name, None)
+            if value is not None:
+                os.environ[name] = value
+
+
 def _app(repeats: int) -> dict[str, Any] | None:
     """:func:`app_start.warm_start_to_first_picture`, or None without a browser."""
     import app_start
@@ -135,7 +159,8 @@ def render(data: dict[str, Any]) -> str:
     load = data["load_avg_at_start"][0]
     L = ["## Warm start\n",
          "Measured by `python benchmarks/run_benchmarks.py --only start` "
-         "(`benchmarks/start_up.py`): the numba cache filled by one run first, then "
+         "(`benchmarks/start_up.py`): the numba cache and a bytecode cache "
+         "(`PYTHONPYCACHEPREFIX`) filled by one run first, then "
          f"{data['repeats']} fresh processes of each; load average {load:.1f} at the "
          "start (2 cores). *Kernel load*: `pdeflow.numerics.warmup.prepare` of the 5.1 "
          "case's kernels (both models) after `import pdeflow`. The commands ran in turn "

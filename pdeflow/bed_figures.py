@@ -10,11 +10,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from . import systems
-from .plotting import LAYER_STYLES
+from .plotting import LAYER_STYLES, new_figure
 
 SIDE_VIEWS = 6
 """side views drawn, at evenly spaced frames from t = 0 to the end of the flow"""
@@ -97,8 +96,8 @@ def bed_figure(x: np.ndarray, t: np.ndarray, frames: Sequence[np.ndarray], model
     [s] (the flow's; default: the whole run)."""
     reach = np.nanmax(series.front) if np.isfinite(series.front).any() else x[-1]
     keep = x <= min(x[-1], reach + 0.15 * (reach - x[0]) + 1e-12)
-    fig, axes = plt.subplots(2, 1, figsize=(8, 7.5), sharex=True,
-                             gridspec_kw={"height_ratios": [1.4, 1]})
+    fig = new_figure((8, 7.5))
+    axes = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [1.4, 1]})
     picks = view_times(t, duration)
     sub = [f[:, keep] for f in frames]
     b0 = None if bed0 is None else bed0[keep]

@@ -1,23 +1,41 @@
 """The figures of a case's runs: snapshots like the paper's Figs. 3-6 and the final
-deposits (Fig. 7), written by ``pdeflow run`` (drawn on two cores where there are).
+deposits (Fig. 7), written by ``pdeflow run`` (drawn on two cores where there are, in
+a process forked before the run: :mod:`pdeflow.figure_worker`).
 
 Each run is drawn as its system describes its layers (:mod:`pdeflow.systems`,
-:data:`pdeflow.plotting.LAYER_STYLES`).
+:data:`pdeflow.plotting.LAYER_STYLES`). The figures are plain matplotlib figures
+(:class:`matplotlib.figure.Figure`, drawn by Agg when saved): no pyplot, so nothing a
+GUI or a notebook would show by itself, and matplotlib is imported only when one is
+drawn. A figure *job* is ``(make, args, path)``: ``make(*args)`` returns the figure to
+save at ``path``; the snapshots of a case are drawn by one :class:`SnapshotFigures`,
+which redraws one figure in place (they share their axes, ticks and labels).
 """
 
 from __future__ import annotations
 
+import sys
+import traceback
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from . import systems
 from .numerics.compile_parallel import can_fork, fork_context
 from .numerics.geometry import COORDINATES
-from .plotting import LAYER_STYLES, _short, _symbol, _velocity, fixed_margins, save
+from .plotting import (
+    LAYER_STYLES,
+    _short,
+    _symbol,
+    _velocity,
+    fixed_margins,
+    new_figure,
+    save,
+)
+
+Job = tuple[Callable[..., Any], tuple, Path]
+"""a figure job: (make, its arguments, path), see the module docstring"""
 
 
 def plot_depths(ax, x: np.ndarray, runs: Sequence[tuple[str, np.ndarray]]) -> None:
@@ -65,25 +83,71 @@ def snapshot_figure(x: np.ndarray, t: float, runs: Sequence[tuple[str, np.ndarra
                     coordinate: str = "x") -> Any:
     """Three stacked panels at time t, like the paper's Figs. 3-6: depths and velocities
     of the runs (model name, state data), F_extra/rho1 [m^2/s^2]."""
-    fig, axes = plt.subplots(3, 1, figsize=(7, 7.5), sharex=True)
-    plot_depths(axes[0], x, runs)
-    plot_velocities(axes[1], x, runs)
-    axes[2].plot(x, fextra if fextra is not None else np.zeros_like(x), color="tab:red")
+    fig = new_figure((7, 7.5))
+    axes = fig.subplots(3, 1, sharex=True)
+    _snapshot_data(fig, x, t, runs, fextra, title)
     axes[2].set_ylabel(r"$F_{extra}/\rho_1$ [m$^2$/s$^2$]")
-    axes[0].legend(loc="upper right", fontsize=8)
-    axes[1].legend(loc="upper right", fontsize=8)
     axes[2].set_xlabel(f"{coordinate} [m]")
     for ax in axes:
         ax.grid(alpha=0.3)
-    fig.suptitle(f"{title} t = {t:g} s".strip())
     fixed_margins(fig, top=0.45)
     return fig
+
+
+def _snapshot_data(fig: Any, x: np.ndarray, t: float,
+                   runs: Sequence[tuple[str, np.ndarray]], fextra: np.ndarray | None,
+                   title: str) -> None:
+    """The runs' layers, velocities and F_extra/rho1 [m^2/s^2] at t [s] in the panels of
+    a snapshot figure, their legends and the title."""
+    axes = fig.axes
+    plot_depths(axes[0], x, runs)
+    plot_velocities(axes[1], x, runs)
+    axes[2].plot(x, fextra if fextra is not None else np.zeros_like(x), color="tab:red")
+    axes[0].legend(loc="upper right", fontsize=8)
+    axes[1].legend(loc="upper right", fontsize=8)
+    fig.suptitle(f"{title} t = {t:g} s".strip())
+
+
+class SnapshotFigures:
+    """The snapshot figures (:func:`snapshot_figure`) of one case, one figure redrawn in
+    place: :meth:`draw` draws the runs at another time into it. The data, legends and
+    title are drawn anew and the data limits recomputed, so that each image is the one
+    a new figure gives, whatever was drawn before; the axes, their ticks and labels
+    stay (making them took most of a figure's time).
+
+    Args:
+        x: cell centres [m].
+        title: the case's name (before "t = ... s").
+        coordinate: the grid's coordinate, 'x' or 'r'.
+    """
+
+    def __init__(self, x: np.ndarray, title: str = "", coordinate: str = "x"):
+        self.x, self.title, self.coordinate = x, title, coordinate
+        self.fig: Any = None
+
+    def draw(self, t: float, runs: Sequence[tuple[str, np.ndarray]],
+             fextra: np.ndarray | None) -> Any:
+        """The figure at time t [s] of the runs (model name, state data), F_extra/rho1
+        [m^2/s^2]: valid until the next call."""
+        if self.fig is None:
+            self.fig = snapshot_figure(self.x, t, runs, fextra, self.title,
+                                       self.coordinate)
+            return self.fig
+        for ax in self.fig.axes:
+            for artist in [*ax.lines, *ax.collections, *ax.patches, *ax.texts]:
+                artist.remove()
+            if ax.get_legend() is not None:
+                ax.get_legend().remove()
+            ax.relim()  # no artist left: the limits of a new axes
+        _snapshot_data(self.fig, self.x, t, runs, fextra, self.title)
+        return self.fig
 
 
 def deposit_figure(x: np.ndarray, runs: Sequence[tuple[str, np.ndarray]],
                    title: str = "", times: str = "", coordinate: str = "x") -> Any:
     """Final deposits of the runs (model name, state data): the paper's Fig. 7."""
-    fig, ax = plt.subplots(figsize=(7, 3.2))
+    fig = new_figure((7, 3.2))
+    ax = fig.subplots()
     plot_depths(ax, x, runs)
     ax.legend(loc="upper right", fontsize=8)
     ax.set_xlabel(f"{coordinate} [m]")
@@ -95,22 +159,42 @@ def deposit_figure(x: np.ndarray, runs: Sequence[tuple[str, np.ndarray]],
 
 def case_figures(results: dict[str, Any], outdir: str | Path, prefix: str = "",
                  parallel: bool = True) -> list[Path]:
-    """Snapshot figures at every stored time and the final-deposit figure (drawn by
-    :func:`draw_all`, on two cores with ``parallel``)."""
+    """Snapshot figures at every stored time and the final-deposit figure (the jobs of
+    :func:`figure_jobs`, drawn by :func:`draw_all`, on two cores with ``parallel``)."""
+    return draw_all(figure_jobs(results, outdir, prefix), parallel)
+
+
+def run_figure_jobs(results: dict[str, Any], outdir: str | Path | None = None,
+                    plot: str | Path | None = None) -> list[Job]:
+    """The figures of ``pdeflow run``: the final deposits at ``plot`` (``--plot``), then
+    those of :func:`figure_jobs` in ``outdir`` (``--outdir``)."""
+    jobs: list[Job] = []
+    if plot:
+        runs = list(results.values())
+        jobs.append((deposit_figure, (runs[0].x, [(r.model, r.state.data) for r in runs],
+                                      runs[0].case.name, "",
+                                      COORDINATES[runs[0].case.geometry]), Path(plot)))
+    if outdir:
+        jobs.extend(figure_jobs(results, outdir))
+    return jobs
+
+
+def figure_jobs(results: dict[str, Any], outdir: str | Path,
+                prefix: str = "") -> list[Job]:
+    """The jobs of :func:`case_figures` (``outdir`` is created): the snapshots, the
+    final deposits and the bed figures."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     runs = list(results.values())
     first = runs[0]
-    coordinate = COORDINATES[first.case.geometry]
-    times = sorted(set().union(*(res.snapshots for res in runs)))
-    jobs = []
-    for t in times:
+    snapshots = SnapshotFigures(first.x, first.case.name, COORDINATES[first.case.geometry])
+    jobs: list[Job] = []
+    for t in sorted(set().union(*(res.snapshots for res in runs))):
         shown = [res for res in runs if t in res.snapshots]
         fextra = next((res.snapshots[t][1] for res in shown if res.pde.system.has_fextra),
                       None)
-        jobs.append((snapshot_figure, (first.x, t, [(res.model, res.snapshots[t][0])
-                                                   for res in shown],
-                                       fextra, first.case.name, coordinate),
+        jobs.append((snapshots.draw, (t, [(res.model, res.snapshots[t][0])
+                                          for res in shown], fextra),
                      outdir / f"{prefix}snapshot_t{t:g}.png"))
     stop = []
     for res in runs:
@@ -118,10 +202,10 @@ def case_figures(results: dict[str, Any], outdir: str | Path, prefix: str = "",
         stop.append(f"{res.model}: t={st:.2f} s" if st else f"{res.model}: moving")
     jobs.append((deposit_figure, (first.x, [(res.model, res.state.data) for res in runs],
                                   first.case.name, "(" + ", ".join(stop) + ")",
-                                  coordinate),
+                                  snapshots.coordinate),
                  outdir / f"{prefix}final_deposits.png"))
     jobs.extend(bed_jobs(runs, outdir, prefix))
-    return draw_all(jobs, parallel)
+    return jobs
 
 
 def bed_jobs(runs: Sequence[Any], outdir: Path, prefix: str = "") -> list[tuple]:
@@ -143,29 +227,55 @@ def bed_jobs(runs: Sequence[Any], outdir: Path, prefix: str = "") -> list[tuple]
     return jobs
 
 
-def draw_all(jobs: Sequence[tuple[Callable, tuple, Path]],
-             parallel: bool = True) -> list[Path]:
-    """Draw and :func:`save` the figures ``jobs`` (figure function, its arguments,
-    path); returns the paths. With ``parallel``, Agg (no window a fork would share)
-    and :func:`~pdeflow.numerics.compile_parallel.can_fork`, a forked process draws
-    every second figure meanwhile (matplotlib uses one core)."""
-    agg = plt.get_backend().lower() == "agg"
-    if not (parallel and len(jobs) > 1 and agg and can_fork()):
+def draw_all(jobs: Sequence[Job], parallel: bool = True) -> list[Path]:
+    """Draw and :func:`save` the figures of ``jobs``; returns their paths. With
+    ``parallel``, no GUI figure open (a fork would share its window) and
+    :func:`~pdeflow.numerics.compile_parallel.can_fork`, a forked process draws every
+    second one meanwhile (matplotlib uses one core)."""
+    pyplot = sys.modules.get("matplotlib.pyplot")
+    gui = pyplot is not None and pyplot.get_backend().lower() != "agg"
+    if not (parallel and len(jobs) > 1 and not gui and can_fork()):
         return [_draw(job) for job in jobs]
-    with fork_context().Pool(1) as pool:
-        theirs = pool.map_async(_draw, jobs[1::2])
-        mine = [_draw(job) for job in jobs[::2]]
-        paths = theirs.get()
-        # the worker leaves on its own: the pool's terminate() at the end of the block
-        # stops it with SIGTERM, which the run's deferred signals (the outputs are
-        # written whole) hold back in the fork, and the join hung, the worker waiting
-        pool.close()
-        pool.join()
-    return [mine[i // 2] if i % 2 == 0 else paths[i // 2] for i in range(len(jobs))]
+    ctx = fork_context()
+    mine, theirs = ctx.Pipe()
+    helper = ctx.Process(target=_draw_each, args=(jobs[1::2], theirs),
+                         name="pdeflow-figures-helper")
+    helper.start()
+    theirs.close()
+    try:
+        for job in jobs[::2]:
+            _draw(job)
+    finally:
+        # the helper leaves on its own, whatever happens here (the run's deferred
+        # signals, the outputs written whole, hold a SIGTERM back in the fork)
+        try:
+            failed = mine.recv()
+        except EOFError:
+            failed = "it ended without a word"
+        helper.join()
+    if failed is not None or helper.exitcode != 0:
+        raise RuntimeError(f"drawing figures in the helper process failed "
+                           f"(exit code {helper.exitcode}):\n{failed}")
+    return [Path(path) for _, _, path in jobs]
 
 
-def _draw(job: tuple[Callable, tuple, Path]) -> Path:
+def _draw(job: Job) -> Path:
+    """Draw and save the figure of one job; its path."""
     make, args, path = job
     return save(make(*args), path)
 
 
+def _draw_each(jobs: Sequence[Job], conn: Any) -> None:
+    """The helper of :func:`draw_all`: draw ``jobs``, then send None or the
+    traceback."""
+    try:
+        mathtext = sys.modules.get("matplotlib.mathtext")
+        if mathtext is not None:
+            # matplotlib opens its fonts anew in a fork (their files' read offsets are
+            # shared with the parent); mathtext's cached layouts hold the parent's
+            mathtext.MathTextParser._parse_cached.cache_clear()
+        for job in jobs:
+            _draw(job)
+        conn.send(None)
+    except BaseException:
+        conn.send(traceback.format_exc())

@@ -86,12 +86,6 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
     return trackers
 
 
-def _import_plotting() -> None:
-    import matplotlib.pyplot  # noqa: F401
-
-    from . import case_figures  # noqa: F401
-
-
 def _load_run_case(args: argparse.Namespace) -> Any:
     """The case of ``pdeflow run``; a study file is pointed to ``pdeflow study``."""
     import tomllib
@@ -182,10 +176,10 @@ def _run_models(args: argparse.Namespace, case: Any) -> tuple[dict, dict, list]:
 
 def _write_run_outputs(args: argparse.Namespace, case: Any, summary: dict,
                        results: dict, stores: dict, trackers: list,
-                       outdir: Path | None) -> list[Any]:
-    """Write (commit) every output of ``pdeflow run``; returns what was written."""
+                       outdir: Path | None, figures: Any = None) -> list[Any]:
+    """Write (commit) every output of ``pdeflow run`` (the figures by ``figures``, a
+    :class:`~pdeflow.figure_worker.RunFigures`); returns what was written."""
     from .io import write_json, write_npz
-    from .numerics.geometry import COORDINATES
 
     written: list[Any] = []
     for model, tracker in stores.items():
@@ -204,26 +198,14 @@ def _write_run_outputs(args: argparse.Namespace, case: Any, summary: dict,
         for i, m in enumerate(case.models):
             written.append(write_npz(_model_path(args.final, m, i == 0),
                                      results[m].final_arrays()))
-    if args.plot:
-        from .case_figures import deposit_figure
-        from .plotting import save
+    if figures is not None:
+        from .case_figures import run_figure_jobs
 
-        runs = list(results.values())
-        coordinate = COORDINATES[case.geometry]
-        fig = deposit_figure(runs[0].x, [(r.model, r.state.data) for r in runs], case.name,
-                             coordinate=coordinate)
-        written.append(save(fig, args.plot))
-    if outdir:
-        from .case_figures import case_figures
-
-        written.extend(case_figures(results, outdir))
+        written.extend(figures.draw(run_figure_jobs(results, outdir, args.plot)))
     return written
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from .interrupts import deferred_signals
-    from .numerics.warmup import prepare
-    from .simulate import case_steppers, print_summary
     from .sizecheck import check_size
 
     case = _load_run_case(args)
@@ -236,9 +218,33 @@ def cmd_run(args: argparse.Namespace) -> int:
     _check_run_outputs(args, outdir)
     check_size(case, args.force, "use a coarser grid (--set grid.dx=...)")
     live_window = _live_window(args)
-    # matplotlib's import (~0.5 s) fills the wait for the kernels a helper compiles
-    prepare(case_steppers(case), log=None if args.quiet else sys.stderr,
-            meanwhile=_import_plotting if args.plot or outdir else None)
+    figures = None
+    if args.plot or outdir:
+        from .figure_worker import RunFigures
+
+        figures = RunFigures(here=bool(args.live or args.movie or args.frames))
+    try:
+        return _run_and_write(args, case, outdir, figures, live_window)
+    finally:
+        if figures is not None:
+            figures.close()
+
+
+def _run_and_write(args: argparse.Namespace, case: Any, outdir: Path | None,
+                   figures: Any, live_window: bool) -> int:
+    """The body of ``pdeflow run`` after the checks: kernels, runs, outputs, printing;
+    ``figures``: a :class:`~pdeflow.figure_worker.RunFigures` (None: no figures)."""
+    from .interrupts import deferred_signals
+    from .numerics.warmup import COLD, prepare, status
+    from .simulate import case_steppers, print_summary
+
+    steppers = case_steppers(case)
+    meanwhile = None
+    if figures is not None and status(steppers) == COLD:
+        meanwhile = figures.start  # it fills the wait for the kernels a helper compiles
+    elif figures is not None:
+        figures.start()  # matplotlib's import overlaps the kernels' loading and the runs
+    prepare(steppers, log=None if args.quiet else sys.stderr, meanwhile=meanwhile)
     results, stores, trackers = _run_models(args, case)
     summary = {
         "case": case.name,
@@ -250,7 +256,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     }
     with deferred_signals() as came:  # the results are written completely, or not
         written = _write_run_outputs(args, case, summary, results, stores, trackers,
-                                     outdir)
+                                     outdir, figures)
     if came:
         print("pdeflow: interrupted after the results were written", file=sys.stderr)
         return 130

@@ -76,14 +76,30 @@ def log_ticks(axis: Any, ticks: Sequence[float]) -> None:
     axis.set_minor_formatter(NullFormatter())
 
 
+def new_figure(figsize: tuple[float, float]) -> Any:
+    """A plain :class:`matplotlib.figure.Figure` of ``figsize`` [inch] on an Agg canvas:
+    not pyplot's (no figure manager, nothing a GUI shows). Its canvas keeps its
+    renderer, and with it the renderer's text and mathtext caches, from one save to
+    the next (saving a figure without a canvas of its own makes a new one each time)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize)
+    FigureCanvasAgg(fig)
+    return fig
+
+
 def save(fig: Any, path: str | Path) -> Path:
-    """Save a figure atomically (complete file or none) and close it."""
+    """Save a figure atomically (complete file or none) and close it if pyplot made it
+    (a plain :class:`matplotlib.figure.Figure` holds nothing to release: it can be
+    redrawn and saved again)."""
     path = Path(path)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=110, format=path.suffix.lstrip(".") or "png")
-    import matplotlib.pyplot as plt  # here, not at the top: the app takes DRY only
+    if getattr(fig.canvas, "manager", None) is not None:
+        import matplotlib.pyplot as plt  # here, not at the top: the app takes DRY only
 
-    plt.close(fig)
+        plt.close(fig)
     return path
 
 

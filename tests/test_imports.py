@@ -1,4 +1,5 @@
-"""A run that draws, serves, studies, stores and shows nothing imports nothing for it.
+"""A run that draws, serves, studies, stores and shows nothing imports nothing for it;
+one that draws its figures leaves matplotlib to the figure worker's process.
 
 py-pde itself imports scipy and tqdm (``import pde``), so those are not checked."""
 
@@ -18,7 +19,10 @@ NOT_NEEDED = ("matplotlib", "panel", "bokeh", "dask", "distributed", "pandas", "
               # only the options of the command it runs)
               "pdeflow.analysis.convergence", "pdeflow.analysis.workprecision",
               "pdeflow.analysis.sweep", "pdeflow.study", "pdeflow.app.server",
-              "pdeflow.storage")
+              "pdeflow.storage",
+              # the fv-split solver's compiled loop is pdeflow's own: py-pde's numba
+              # backend (and the numba modules it pulls in) is not needed for it
+              "pde.backends.numba")
 
 SCRIPT = """
 import json, sys
@@ -45,3 +49,27 @@ def test_a_quiet_run_imports_no_plotting_serving_or_study_machinery(tmp_path):
     assert api == [], f"the Python API imported {api}"
     assert cli == [], f"pdeflow run -q --summary imported {cli}"
     assert json.loads((tmp_path / "s.json").read_text())["models"]
+
+
+FIGURES = """
+import json, sys
+from pdeflow.cli import main
+from pdeflow.numerics.compile_parallel import can_fork
+forks = can_fork()
+main(["run", sys.argv[1], "--set", "grid.dx=0.1", "--outdir", sys.argv[2], "-q"])
+print("MODULES" + json.dumps([forks, sorted(m for m in sys.modules
+                                            if m.split(".")[0] == "matplotlib")]))
+"""
+
+
+def test_a_run_with_figures_draws_them_in_the_figure_workers_process(tmp_path):
+    proc = subprocess.run([sys.executable, "-c", FIGURES, str(CASE), str(tmp_path / "out")],
+                          capture_output=True, text=True, cwd=tmp_path, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    line = next(x for x in proc.stdout.splitlines() if x.startswith("MODULES"))
+    forks, imported = json.loads(line[len("MODULES"):])
+    assert sorted(p.name for p in (tmp_path / "out").glob("*.png")) == [
+        "final_deposits.png", "snapshot_t0.1.png", "snapshot_t0.25.png",
+        "snapshot_t0.4.png", "snapshot_t0.7.png"]
+    if forks:  # else the figures are drawn in this process (macOS, Windows, one core)
+        assert imported == [], f"pdeflow run --outdir imported {imported}"

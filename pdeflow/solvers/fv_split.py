@@ -232,7 +232,12 @@ class FVSplitSolver(SolverBase):
         dx = pde.check_state(state)
         metric = pde.metric(state.grid)
         M = metric.array()
-        self._select_backend(state)
+        if self._backend == "numba":
+            # the compiled loop is pdeflow's own kernel: py-pde's numba backend (and the
+            # numba modules its import pulls in) is not needed for it
+            self.info["backend"] = {"name": "numba", "implementation": "numba"}
+        else:
+            self._select_backend(state)
         if self.backend_name == "numba":
             # the compiled loop calls the source stage itself: no hook to compile (the
             # state was checked above, as the hook would)
