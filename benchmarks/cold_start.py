@@ -116,6 +116,12 @@ for _module in _figure_modules:
     for _name, _f in list(vars(_module).items()):
         if inspect.isfunction(_f) and _f.__module__ == _module.__name__:
             setattr(_module, _name, _timed("figures", _f))
+try:  # since session8 the figures are drawn by a forked worker: this process waits
+    from pdeflow.figure_worker import RunFigures as _RunFigures
+    _RunFigures.start = _timed("figures", _RunFigures.start)
+    _RunFigures.draw = _timed("figures", _RunFigures.draw)
+except ImportError:
+    pass
 import runpy
 sys.argv = ["pdeflow", *sys.argv[1:]]
 try:
@@ -242,7 +248,8 @@ to the other jobs on this shared machine. *imports*, *compile*, *figures* and *r
 split the same command run through a wrapper that times top-level imports, numba's
 compilations (since *session4* with the wait for the helper process that compiles part
 of the kernels on the second core, `pdeflow.numerics.warmup.prepare`) and
-`pdeflow.plotting` (since *session4* drawn on two cores; the rest: interpreter start,
+`pdeflow.plotting` (since *session4* drawn on two cores; since *session8* drawn by a
+forked worker, and *figures* is this process's wait for it; the rest: interpreter start,
 reading the case, both runs, the summary). *warm*: the command again with the cache
 the cold run left. *load*: 1-minute load average of the machine at the start (2 cores).
 """
@@ -269,7 +276,9 @@ CHANGES = {
                        "CPU time of the two processes' shares of the compile work",
     "session8": "the compile work split by an estimate that counts inlined helpers per "
                 "call site and a fixed cost per kernel (`compile_parallel._work`), so that "
-                "the two processes' shares take about the same CPU time",
+                "the two processes' shares take about the same CPU time; the figures drawn "
+                "by a worker forked while the kernels compile (`pdeflow.figure_worker`); the "
+                "two-layer source stage and fluctuations reworked for speed (issue 27)",
 }
 """what the code of each measured label changed (rendered under the table)"""
 MECHANISMS = """
