@@ -275,8 +275,8 @@ CHANGES = {
     "session8-before": "the code of *session7* with this harness, which also books the "
                        "CPU time of the two processes' shares of the compile work",
     "session8": "the compile work split by an estimate that counts inlined helpers per "
-                "call site and a fixed cost per kernel (`compile_parallel._work`), so that "
-                "the two processes' shares take about the same CPU time; the figures drawn "
+                "call site and a fixed cost per kernel (`compile_parallel._work`): the two "
+                "processes' shares of the CPU time closer (column *shares*); the figures drawn "
                 "by a worker forked while the kernels compile (`pdeflow.figure_worker`); the "
                 "two-layer source stage and fluctuations reworked for speed (issue 27)",
 }
@@ -294,13 +294,14 @@ above, not re-measured since the code moved behind `prepare`):
   The split follows an estimate of each entry kernel's compile work: the bytecode of
   its call tree, an inlined helper counted once per call site (numba types it again
   there), plus `KERNEL_OVERHEAD` per kernel compiled on its own. The helper gets the
-  share nearest `HELPER_SHARE` = 0.5 (for 5.1: the two-layer model's advection and
-  source stages; this process compiles the stepping loop and the single layer's
-  kernels, then imports what the figures need). Before *session8* the estimate was the plain
-  bytecode (`HELPER_SHARE` = 0.42), which undercounted the stepping loop (its helpers are
-  inlined): the helper got the two advection stages and the single-layer sources and
-  this process the loop and the two-layer sources, about twice the helper's CPU time
-  (*session8-before* in the table above, column *shares*). Where
+  share nearest `HELPER_SHARE` = 0.5 (for 5.1 in *session8*: the stepping loop and the
+  single layer's advection; this process compiles the two-layer kernels and the single
+  layer's sources and forks the figure worker). Before *session8* the estimate was the
+  plain bytecode (`HELPER_SHARE` = 0.42), which undercounted the stepping loop (its
+  helpers are inlined): the helper got the two advection stages and the single-layer
+  sources, this process the loop and the two-layer sources, 2.5 times the helper's CPU
+  time (*session8-before*, column *shares*). Now the shares are closer (*session8*)
+  but not even: the estimate still undercounts the two-layer kernels. Where
   no fork is safe (threads: a server, Jupyter, Dask) the helper is a new interpreter,
   which first spends ~1 s importing pdeflow.
 * **Helpers without entry points** (`compiled.HelperKernel`): the two-layer source stage
