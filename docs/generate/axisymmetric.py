@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 import run_cache
+from law_set import law_set_overrides
 
 from pdeflow.analysis.sweep import deposit_numbers, fit_power_law
 from pdeflow.cases import load_case, tomllib
@@ -34,7 +35,6 @@ from pdeflow.simulate import run_model
 
 ROOT = Path(__file__).resolve().parents[2]
 SWEEP_CASE = ROOT / "cases" / "axisymmetric_collapse_sweep.toml"
-LAW_CASE = ROOT / "cases" / "paper_5_2_two_layer_law.toml"
 OUT = ROOT / "docs" / "axisymmetric"
 CSV = OUT / "sweep.csv"
 R0 = 0.1
@@ -52,16 +52,6 @@ BREAK = 1.7
 FIELDS = ("set", "dx", "a", "r", "runout", "final_height", "H_inf_over_L0", "H_inf_over_H0",
           "top_radius_over_L0", "arrest_time_scaled", "stop_time", "at_rest", "steps",
           "wall_time_s", "mass_relative_error", "warnings")
-
-
-def law_set_overrides(path: Path = LAW_CASE) -> list[str]:
-    """The planar law set as --set overrides: every [two_layer] key of ``path`` and its
-    initial.wedge_angle_deg."""
-    data = tomllib.loads(path.read_text())
-    out = [f"two_layer.{k}={v!r}" for k, v in data["two_layer"].items()]
-    if "wedge_angle_deg" in data.get("initial", {}):
-        out.append(f"initial.wedge_angle_deg={data['initial']['wedge_angle_deg']!r}")
-    return out
 
 
 SETS: dict[str, tuple[str, list[str]]] = {

@@ -70,7 +70,7 @@ def profile_numbers(profiles: dict[str, Any]) -> dict[str, Any]:
 def planar_law_check(grids: tuple[float, ...] = (0.01, 0.0025)) -> list[list[float]]:
     """The planar law set of cases/paper_5_2_two_layer_law.toml (two layers, a = 2 .. 30):
     [dx, prefactor, exponent] of its planar fit on each grid."""
-    from axisymmetric import LAW_CASE
+    from law_set import LAW_CASE
 
     out = []
     for dx in grids:

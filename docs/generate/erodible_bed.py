@@ -28,14 +28,14 @@ from typing import Any
 
 import numpy as np
 import run_cache
+from law_set import law_set_overrides
 
-from pdeflow.cases import load_case, tomllib
+from pdeflow.cases import load_case
 from pdeflow.checks import RunWarning
 from pdeflow.simulate import run_model
 
 ROOT = Path(__file__).resolve().parents[2]
 CASE = ROOT / "cases" / "erodible_bed.toml"
-LAW_CASE = ROOT / "cases" / "paper_5_2_two_layer_law.toml"
 OUT = ROOT / "docs" / "erodible_bed"
 CSV = OUT / "sweep.csv"
 H0 = 0.14
@@ -78,19 +78,11 @@ FIELDS = ("set", "closure", "theta", "e_i", "dx", "runout", "flow_duration", "st
           "steps", "wall_time_s", "mass_relative_error", "warnings")
 
 
-def law_set_overrides(path: Path = LAW_CASE) -> list[str]:
-    """The planar law set as overrides: its [two_layer] keys but du_reg (the closure's)
-    and its initial.wedge_angle_deg."""
-    data = tomllib.loads(path.read_text())
-    out = [f"two_layer.{k}={v!r}" for k, v in data["two_layer"].items() if k != "du_reg"]
-    out.append(f"initial.wedge_angle_deg={data['initial']['wedge_angle_deg']!r}")
-    return out
-
-
 SETS: dict[str, tuple[str, list[str]]] = {
     "single layer": ("single_layer", []),
     "two layers, defaults": ("two_layer", []),
-    "two layers, planar law set": ("two_layer", law_set_overrides()),
+    # the planar law set but its closure (du_reg): the bed runs the default one
+    "two layers, planar law set": ("two_layer", law_set_overrides(omit=("du_reg",))),
     "two layers, pouliquen": ("two_layer", ["two_layer.friction_law='pouliquen'"]),
     "two layers, mu_i": ("two_layer", ["two_layer.friction_law='mu_i'"]),
 }
