@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import contextlib
 import dis
+import functools
 import gc
 import multiprocessing
 import os
@@ -187,19 +188,22 @@ def _inlined(compiled: Any) -> bool:
     return compiled.targetoptions.get("inline") == "always"
 
 
-def _callee_sites(compiled: Any) -> list[tuple[Any, int]]:
+@functools.cache
+def _callee_sites(compiled: Any) -> tuple[tuple[Any, int], ...]:
     """The kernels ``compiled`` closes over or names
     (:func:`~pdeflow.numerics.compiled.named_kernels`), each with how often its code
-    loads it: its call sites."""
+    loads it: its call sites (memoised: a kernel's code and callees are fixed once it is
+    built; :func:`split_work` asks for the same trees for every split it weighs)."""
     func = compiled.py_func
     loads: dict[str, int] = {}
     for ins in dis.get_instructions(func.__code__):
         if ins.opname in ("LOAD_GLOBAL", "LOAD_DEREF"):
             loads[ins.argval] = loads.get(ins.argval, 0) + 1
     closed, named = named_kernels(compiled)
-    return [(k, loads.get(name, 1)) for name, k in (*closed, *named)]
+    return tuple((k, loads.get(name, 1)) for name, k in (*closed, *named))
 
 
+@functools.cache
 def _own_work(compiled: Any) -> int:
     """Bytecode size [bytes] that compiling ``compiled`` types and lowers: its own, and
     that of every inlined callee once per call site (recursively)."""
