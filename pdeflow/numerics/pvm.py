@@ -211,75 +211,74 @@ def _two_layer(rusanov: bool, ifcp: bool):
 
         dh1 = h1R - h1L
         dh2 = h2R - h2L
-        if m1L == 0.0 and m1R == 0.0 and m2L == 0.0 and m2R == 0.0:
-            # both layers at rest on both sides (or absent): the at-rest rule below for
-            # both, without the flux's fluctuations it replaces
-            dH = dh1 + dh2
-            dE = dh2 + r * dh1
-            return ((0.0, 0.5 * g * h1L * dH, 0.0, 0.5 * g * h2L * dE),
-                    (0.0, 0.5 * g * h1R * dH, 0.0, 0.5 * g * h2R * dE), smax)
-        a0 = u1R * h1R - u1L * h1L
-        a1 = (u1R * u1R * h1R - u1L * u1L * h1L) + g * 0.5 * (h1L + h1R) * (dh1 + dh2)
-        a2 = u2R * h2R - u2L * h2L
-        a3 = (u2R * u2R * h2R - u2L * u2L * h2L) + g * 0.5 * (h2L + h2R) * (dh2 + r * dh1)
+        rest1 = m1L == 0.0 and m1R == 0.0
+        rest2 = m2L == 0.0 and m2R == 0.0
+        dm0 = dm1 = dm2 = dm3 = dp0 = dp1 = dp2 = dp3 = 0.0
+        if not (rest1 and rest2):
+            # (where both layers are at rest on both sides the at-rest rule below sets
+            # every fluctuation: the flux's are not needed)
+            a0 = u1R * h1R - u1L * h1L
+            a1 = (u1R * u1R * h1R - u1L * u1L * h1L) + g * 0.5 * (h1L + h1R) * (dh1 + dh2)
+            a2 = u2R * h2R - u2L * h2L
+            a3 = (u2R * u2R * h2R - u2L * u2L * h2L) + g * 0.5 * (h2L + h2R) * (dh2 + r * dh1)
 
-        h1 = h2 = u1 = u2 = 0.0
-        if rusanov:
-            c0, c1, c2 = rusanov_coefficients(sL, sR)
-        elif ifcp:
-            h1 = 0.5 * (h1L + h1R)
-            h2 = 0.5 * (h2L + h2R)
-            u1 = _roe_velocity(h1L, u1L, h1R, u1R)
-            u2 = _roe_velocity(h2L, u2L, h2R, u2R)
-            # the parabola is not positivity preserving near a layer's front: there, HLL
-            if min(h1L, h1R, h2L, h2R) > IFCP_MIN_FRACTION * max(HL, HR):
-                c0, c1, c2 = ifcp_coefficients(sL, sR, internal_speed(h1, u1, h2, u2, g,
-                                                                      r))
+            h1 = h2 = u1 = u2 = 0.0
+            if rusanov:
+                c0, c1, c2 = rusanov_coefficients(sL, sR)
+            elif ifcp:
+                h1 = 0.5 * (h1L + h1R)
+                h2 = 0.5 * (h2L + h2R)
+                u1 = _roe_velocity(h1L, u1L, h1R, u1R)
+                u2 = _roe_velocity(h2L, u2L, h2R, u2R)
+                # the parabola is not positivity preserving near a layer's front: there, HLL
+                if min(h1L, h1R, h2L, h2R) > IFCP_MIN_FRACTION * max(HL, HR):
+                    c0, c1, c2 = ifcp_coefficients(sL, sR, internal_speed(h1, u1, h2, u2, g,
+                                                                          r))
+                else:
+                    c0, c1, c2 = hll_coefficients(sL, sR)
             else:
                 c0, c1, c2 = hll_coefficients(sL, sR)
-        else:
-            c0, c1, c2 = hll_coefficients(sL, sR)
-        q0 = c0 * dh1 + c1 * a0
-        q1 = c0 * (m1R - m1L) + c1 * a1
-        q2 = c0 * dh2 + c1 * a2
-        q3 = c0 * (m2R - m2L) + c1 * a3
-        e0 = e1 = 0.0
-        if ifcp and c2 != 0.0:
-            # alpha2 A (A dq), A = pseudo-Jacobian of (28) at the averaged state
-            e0 = c2 * a1
-            e1 = c2 * ((g * h1 - u1 * u1) * a0 + 2.0 * u1 * a1 + g * h1 * a2)
-            b2 = a3
-            b3 = r * g * h2 * a0 + (g * h2 - u2 * u2) * a2 + 2.0 * u2 * a3
-            q0 += e0
-            q1 += e1
-            q2 += c2 * b2
-            q3 += c2 * b3
-        dm0 = 0.5 * (a0 - q0)
-        dm1 = 0.5 * (a1 - q1)
-        dm2 = 0.5 * (a2 - q2)
-        dm3 = 0.5 * (a3 - q3)
-        dp0 = a0 - dm0
-        dp1 = a1 - dm1
-        dp2 = a2 - dm2
-        dp3 = a3 - dm3
-        if m2L == 0.0 and m2R == 0.0 and dh2 != 0.0:
-            # a step of a lower layer at rest: where it rises above the upper layer's
-            # surface on one side, the upper layer's transport and viscosity act on the
-            # depths above its top (see upper_layer_at_uncovered_step)
-            top = max(h2L, h2R)
-            sL = h1L + h2L - top
-            sR = h1R + h2R - top
-            if sL <= 0.0 or sR <= 0.0:
-                dm0, dm1, dp0, dp1 = upper_layer_at_uncovered_step(
-                    h1L, u1L, max(sL, 0.0), h1R, u1R, max(sR, 0.0), a1, c0, c1, e0, e1,
-                    dry)
-        if m1L == 0.0 and m1R == 0.0:
+            q0 = c0 * dh1 + c1 * a0
+            q1 = c0 * (m1R - m1L) + c1 * a1
+            q2 = c0 * dh2 + c1 * a2
+            q3 = c0 * (m2R - m2L) + c1 * a3
+            e0 = e1 = 0.0
+            if ifcp and c2 != 0.0:
+                # alpha2 A (A dq), A = pseudo-Jacobian of (28) at the averaged state
+                e0 = c2 * a1
+                e1 = c2 * ((g * h1 - u1 * u1) * a0 + 2.0 * u1 * a1 + g * h1 * a2)
+                b2 = a3
+                b3 = r * g * h2 * a0 + (g * h2 - u2 * u2) * a2 + 2.0 * u2 * a3
+                q0 += e0
+                q1 += e1
+                q2 += c2 * b2
+                q3 += c2 * b3
+            dm0 = 0.5 * (a0 - q0)
+            dm1 = 0.5 * (a1 - q1)
+            dm2 = 0.5 * (a2 - q2)
+            dm3 = 0.5 * (a3 - q3)
+            dp0 = a0 - dm0
+            dp1 = a1 - dm1
+            dp2 = a2 - dm2
+            dp3 = a3 - dm3
+            if rest2 and dh2 != 0.0:
+                # a step of a lower layer at rest: where it rises above the upper layer's
+                # surface on one side, the upper layer's transport and viscosity act on the
+                # depths above its top (see upper_layer_at_uncovered_step)
+                top = max(h2L, h2R)
+                sL = h1L + h2L - top
+                sR = h1R + h2R - top
+                if sL <= 0.0 or sR <= 0.0:
+                    dm0, dm1, dp0, dp1 = upper_layer_at_uncovered_step(
+                        h1L, u1L, max(sL, 0.0), h1R, u1R, max(sR, 0.0), a1, c0, c1, e0, e1,
+                        dry)
+        if rest1:
             dH = dh1 + dh2
             dm0 = 0.0
             dp0 = 0.0
             dm1 = 0.5 * g * h1L * dH
             dp1 = 0.5 * g * h1R * dH
-        if m2L == 0.0 and m2R == 0.0:
+        if rest2:
             dE = dh2 + r * dh1
             dm2 = 0.0
             dp2 = 0.0
