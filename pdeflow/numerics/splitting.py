@@ -244,38 +244,35 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int) ->
             if strang or ifcp:
                 _copy_range(diag_keep, diag, 0, L.N_DIAG - 1)
                 _copy_range(fex_keep, fex, b_lo, b_hi)
-            dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
-                advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right, P,
-                g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, e_lo,
-                e_hi, b_lo, b_hi, s_rest)
+            # One call site of the (inlined) advection stage for every attempt: numba
+            # types and lowers an inlined function again at each site.
             fell_back = False
-            if ifcp and not ok:
-                # IFCP is Roe's linearisation for one layer: not positive where cells
-                # move apart fast. Redo the step with HLL, which is, and count it.
-                _copy_cells(q, backup, b_lo, b_hi)
-                _copy_range(diag, diag_keep, 0, L.N_DIAG - 1)
-                _copy_range(fex, fex_keep, b_lo, b_hi)
-                fell_back = True
-                dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
-                    fallback, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
-                    P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep,
-                    first, e_lo, e_hi, b_lo, b_hi, s_rest)
             retries = 0
-            while not ok and retries < MAX_RETRIES:
-                # safety net: a step that would leave a depth negative is rejected and
-                # redone with half the time step (the limited schemes are positive for
-                # a small enough dt); counted in diag[D_RETRIES]
+            step_end = t_end
+            while True:
+                dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
+                    fallback if fell_back else advect, sources, predictor, q, t, step_end,
+                    dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag, rate, backup,
+                    rec, q0, diag_keep, fex_keep, first, e_lo, e_hi, b_lo, b_hi, s_rest)
+                if ok:
+                    break
+                if ifcp and not fell_back and retries == 0:
+                    # IFCP is Roe's linearisation for one layer: not positive where
+                    # cells move apart fast. Redo the step with HLL, which is; counted.
+                    fell_back = True
+                elif retries < MAX_RETRIES:
+                    # safety net: a step that would leave a depth negative is rejected
+                    # and redone with half the time step (the limited schemes are
+                    # positive for a small enough dt); counted in diag[D_RETRIES]. (The
+                    # step ends at t + dt/2 at the latest: its own end time caps dt.)
+                    retries += 1
+                    step_end = t + 0.5 * dt
+                else:
+                    break
                 _copy_cells(q, backup, b_lo, b_hi)
                 if strang or ifcp:
                     _copy_range(diag, diag_keep, 0, L.N_DIAG - 1)
                     _copy_range(fex, fex_keep, b_lo, b_hi)
-                retries += 1
-                # (the step ends at t + dt/2 at the latest: its own end time caps dt)
-                dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
-                    fallback if fell_back else advect, sources, predictor, q, t,
-                    t + 0.5 * dt, dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag,
-                    rate, backup, rec, q0, diag_keep, fex_keep, first, e_lo, e_hi, b_lo, b_hi,
-                    s_rest)
             if fell_back:
                 diag[L.D_FLUX_FALLBACKS] += 1.0
             diag[L.D_RETRIES] += retries
