@@ -7,10 +7,15 @@ numba's disk cache (the kernels' cache keys are their code, the same in every pr
 loads the helper's kernels from the cache. The helper is
 
 * a **fork** of this process where that is safe (:func:`can_fork`: Linux, no other
-  thread): it starts at once and takes any kernel, closures included;
+  thread): it starts at once and takes any kernel, closures included. The two
+  processes take the kernels one at a time from a :class:`SharedQueue`, heaviest first
+  by :func:`_work`, so that the estimate only orders them: whichever process is free
+  takes the next (a static split by the estimate left one core idle for a second
+  while the other compiled what the estimate had undercounted);
 * else a **new interpreter** (a server, a Jupyter kernel, a Dask worker: processes with
   threads), which has to import pdeflow first and takes only the kernels it can find by
-  name (module-level ones, such as the source stages).
+  name (module-level ones, such as the source stages): a static split
+  (:func:`split_work`).
 
 Nothing depends on the helper: if it fails, the calling process compiles its kernels
 itself. Measurements of what this saves: docs/performance.md, "Cold first run".
@@ -27,7 +32,7 @@ import os
 import subprocess
 import sys
 import threading
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -52,21 +57,44 @@ GC_THRESHOLD = (10000, 10, 10)
 10): a collection of the youngest objects every 10000 new ones instead of every 700."""
 
 
-def start_helper(todo: Sequence[Any]) -> tuple[Any, list[Any]]:
-    """(the helper process, the kernels of ``todo`` it compiles), or (None, []) where
-    there is no second core, fewer than two kernels to compile (not in the disk cache)
-    or nothing to give the helper. The helper is waited for with ``wait()`` and stopped
-    with ``terminate()``."""
-    if _cores() < 2 or len(todo) < 2:
-        return None, []
+def start_helper(todo: Sequence[Any]) -> tuple[Any, Iterable[Any]]:
+    """(the helper process, the kernels of ``todo`` this process compiles meanwhile),
+    or (None, ``todo``) where there is no second core, fewer than two kernels to
+    compile (not in the disk cache) or nothing to give the helper. A forked helper and
+    this process share a :class:`SharedQueue` of the kernels to compile; a new
+    interpreter gets its share of a static split. The helper is waited for with
+    ``wait()`` and stopped with ``terminate()``; then every kernel of ``todo`` is still
+    to be readied here (those the helper compiled load from the disk cache)."""
     cold = [k for k in todo if not in_disk_cache(k)]
-    forked = can_fork()
-    kernels = split_work(cold, movable=None if forked else
-                         [k for k in cold if _importable(k)])
-    if not kernels:
-        return None, []
-    helper = _Forked(kernels) if forked else _interpreter(kernels)
-    return helper, kernels if helper is not None else []
+    if _cores() < 2 or len(cold) < 2:
+        return None, todo
+    if can_fork():
+        queue = SharedQueue(sorted(cold, key=lambda k: -_work([k])))
+        return _Forked(queue), queue
+    theirs = split_work(cold, movable=[k for k in cold if _importable(k)])
+    helper = _interpreter(theirs) if theirs else None
+    if helper is None:
+        return None, todo
+    return helper, [k for k in todo if k not in theirs]
+
+
+class SharedQueue:
+    """Kernels handed out one at a time to whichever process asks first: this one and
+    the helper forked after the queue was made iterate over it (a counter in shared
+    memory, under its lock), and each kernel goes to one of them."""
+
+    def __init__(self, kernels: Sequence[Any]):
+        self.kernels = list(kernels)
+        self.taken = fork_context().Value("i", 0)
+
+    def __iter__(self) -> Iterator[Any]:
+        while True:
+            with self.taken.get_lock():
+                i = self.taken.value
+                self.taken.value = i + 1
+            if i >= len(self.kernels):
+                return
+            yield self.kernels[i]
 
 
 @contextlib.contextmanager
@@ -141,7 +169,7 @@ def helper_main(names: Sequence[str]) -> None:
 class _Forked:
     """A forked helper process, waited for like a ``subprocess.Popen``."""
 
-    def __init__(self, kernels: Sequence[Any]):
+    def __init__(self, kernels: Iterable[Any]):
         self.process = fork_context().Process(target=ready_each, args=(kernels,),
                                               daemon=True)
         self.process.start()
@@ -168,7 +196,7 @@ def _interpreter(kernels: Sequence[Any]) -> subprocess.Popen | None:
         return None
 
 
-def ready_each(kernels: Sequence[Any]) -> None:
+def ready_each(kernels: Iterable[Any]) -> None:
     """:func:`~pdeflow.numerics.compiled.ready` every kernel of ``kernels``."""
     for k in kernels:
         ready(k)

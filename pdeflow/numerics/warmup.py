@@ -100,9 +100,9 @@ def _compile(kernels: list[Any], parallel: bool,
     ``parallel``; ``meanwhile`` after this process's share, before the wait."""
     with fewer_collections():
         todo = [k for k in kernels if needs_compiling(k)]
-        helper, helper_kernels = start_helper(todo) if parallel else (None, [])
+        helper, mine = start_helper(todo) if parallel else (None, todo)
         try:
-            ready_each([k for k in todo if k not in helper_kernels])
+            ready_each(mine)
             if meanwhile is not None:
                 meanwhile()
         except BaseException:
