@@ -291,19 +291,23 @@ above, not re-measured since the code moved behind `prepare`):
 
 * **Helper process on the second core** (`compile_parallel`): test 5.1 compiled ~11 s
   in one process, one core busy (*session3*); with a forked helper 5.5 s (*session4*).
-  The split follows an estimate of each entry kernel's compile work: the bytecode of
-  its call tree, an inlined helper counted once per call site (numba types it again
-  there), plus `KERNEL_OVERHEAD` per kernel compiled on its own. The helper gets the
-  share nearest `HELPER_SHARE` = 0.5 (for 5.1 in *session8*: the stepping loop and the
-  single layer's advection; this process compiles the two-layer kernels and the single
-  layer's sources and forks the figure worker). Before *session8* the estimate was the
-  plain bytecode (`HELPER_SHARE` = 0.42), which undercounted the stepping loop (its
-  helpers are inlined): the helper got the two advection stages and the single-layer
-  sources, this process the loop and the two-layer sources, 2.5 times the helper's CPU
-  time (*session8-before*, column *shares*). Now the shares are closer (*session8*)
-  but not even: the estimate still undercounts the two-layer kernels. Where
-  no fork is safe (threads: a server, Jupyter, Dask) the helper is a new interpreter,
-  which first spends ~1 s importing pdeflow.
+  Since *session9* the fork and this process take the entry kernels one at a time
+  from a shared queue (`compile_parallel.SharedQueue`), heaviest first by an estimate
+  of each one's compile work: the bytecode of its call tree, an inlined helper counted
+  once per call site (numba types it again there), plus `KERNEL_OVERHEAD` per kernel
+  compiled on its own. Whichever process is free takes the next kernel, so the
+  estimate only orders them. Before, the estimate split the kernels in two once, the
+  helper's share nearest `HELPER_SHARE` = 0.5 (*session8*; plain bytecode and 0.42
+  before it, which gave this process 2.5 times the helper's CPU time,
+  *session8-before*, column *shares*); it undercounts the two-layer source stage's
+  tree, and the helper finished 0.8-1.1 s before this process (a cold 5.1 run at load
+  0.5). Where no fork is safe (threads: a server, Jupyter, Dask) the helper is a new
+  interpreter, which first spends ~1 s importing pdeflow and takes the static split.
+* **One call site of the advection stage in the stepping loop**: the first attempt
+  of a step, IFCP's redo with HLL and the positivity retries call the inlined stage
+  from one place, where they had two (three with IFCP; numba types and lowers an
+  inlined function at every site). Compiling the first-order loop alone: 3.6 s of CPU
+  against 4.5 s (medians of 4 interleaved pairs, one core, load 2.9; *session9*).
 * **Helpers without entry points** (`compiled.HelperKernel`): the two-layer source stage
   is a tree of 20 helper kernels; with the Python and function-pointer entry points
   every caller linked in and compiled again at every level (*session5*, together with
