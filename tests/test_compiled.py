@@ -332,6 +332,45 @@ def test_prepare_compiles_part_of_the_kernels_in_a_helper_process(tmp_path, thre
     assert out["results"][:2] == [x + 1.0, medium]
 
 
+def test_the_shared_queue_gives_each_kernel_once_and_survives_a_dead_holder(monkeypatch):
+    """The kernels of a shared queue go one each to the processes that iterate over it;
+    a process that died holding the queue's lock (killed mid-take) does not hang the
+    other: it stops taking after QUEUE_LOCK_TIMEOUT, leaving the rest to prepare's final
+    pass."""
+    if not parallel.can_fork():
+        pytest.skip("no fork here")
+    import time
+
+    items = list(range(40))
+    queue = parallel.SharedQueue(items)
+    ctx = parallel.fork_context()
+    theirs = ctx.Array("i", [-1] * len(items))
+
+    def take() -> None:
+        for n, item in enumerate(queue):
+            theirs[n] = item
+            time.sleep(0.005)
+
+    child = ctx.Process(target=take)
+    child.start()
+    mine = []
+    for item in queue:
+        mine.append(item)
+        time.sleep(0.005)
+    child.join()
+    taken = [x for x in theirs if x >= 0]
+    assert sorted(mine + taken) == items and mine and taken
+    queue = parallel.SharedQueue(items)
+    it = iter(queue)
+    first = [next(it), next(it)]
+    holder = parallel.fork_context().Process(
+        target=lambda: (queue.taken.get_lock().acquire(), os._exit(0)))
+    holder.start()
+    holder.join()
+    monkeypatch.setattr(parallel, "QUEUE_LOCK_TIMEOUT", 0.2)
+    assert first == [0, 1] and list(it) == []
+
+
 def test_split_work_keeps_this_process_busy_and_no_fork_beside_threads():
     """The helper gets some kernels, never all, the split nearest HELPER_SHARE of the
     work (for test 5.1, both models: within 0.02 of it); with a second thread running

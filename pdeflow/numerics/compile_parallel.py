@@ -52,6 +52,13 @@ many small kernels, the two-layer source stage, costs more per byte than the ste
 loop, whose helpers are inlined)."""
 
 
+QUEUE_LOCK_TIMEOUT = 10.0
+"""Seconds a process waits for the lock of the :class:`SharedQueue` (held for a few
+microseconds per kernel) before it takes the other process for dead, stops taking
+kernels and leaves what is left to the final pass of
+:func:`pdeflow.numerics.warmup.prepare`, which compiles it here."""
+
+
 GC_THRESHOLD = (10000, 10, 10)
 """Python's garbage-collector thresholds while kernels compile (its default: 700, 10,
 10): a collection of the youngest objects every 10000 new ones instead of every 700."""
@@ -88,10 +95,15 @@ class SharedQueue:
         self.taken = fork_context().Value("i", 0)
 
     def __iter__(self) -> Iterator[Any]:
+        lock = self.taken.get_lock()
         while True:
-            with self.taken.get_lock():
+            if not lock.acquire(timeout=QUEUE_LOCK_TIMEOUT):
+                return  # the other process died holding it: the rest is readied later
+            try:
                 i = self.taken.value
                 self.taken.value = i + 1
+            finally:
+                lock.release()
             if i >= len(self.kernels):
                 return
             yield self.kernels[i]
