@@ -279,6 +279,15 @@ CHANGES = {
                 "processes' shares of the CPU time closer (column *shares*); the figures drawn "
                 "by a worker forked while the kernels compile (`pdeflow.figure_worker`); the "
                 "two-layer source stage and fluctuations reworked for speed (issue 27)",
+    "session9-before": "the code of *session8* (7b6bedb), measured in the same quarter of "
+                       "an hour as *session9* (the machine was faster than in *session8*)",
+    "session9": "the fork and this process take the kernels from a shared queue, heaviest "
+                "first (`compile_parallel.SharedQueue`); the stepping loop calls the "
+                "inlined advection stage from one site (issue 27)",
+    "session9b": "the code of *session9* measured again five minutes later, then "
+                 "*session9-before-b*: the code of *session8* again (the pairs show how "
+                 "far the machine drifts in minutes)",
+    "session9-before-b": "see *session9b*",
 }
 """what the code of each measured label changed (rendered under the table)"""
 MECHANISMS = """
