@@ -1,10 +1,10 @@
 """Compiling a run's kernels on two cores: a helper process fills numba's disk cache.
 
-Called by :func:`pdeflow.numerics.warmup.prepare` only. :func:`start_helper` splits the
-kernels to compile in two (:func:`split_work`): a helper process compiles its share into
-numba's disk cache (the kernels' cache keys are their code, the same in every process,
-:mod:`pdeflow.numerics.compiled`) while the calling process compiles the rest, then
-loads the helper's kernels from the cache. The helper is
+Called by :func:`pdeflow.numerics.warmup.prepare` only. :func:`start_helper` shares the
+kernels to compile between a helper process, which compiles its share into numba's disk
+cache (the kernels' cache keys are their code, the same in every process,
+:mod:`pdeflow.numerics.compiled`), and the calling process, which compiles the rest,
+then loads the helper's kernels from the cache. The helper is
 
 * a **fork** of this process where that is safe (:func:`can_fork`: Linux, no other
   thread): it starts at once and takes any kernel, closures included. The two

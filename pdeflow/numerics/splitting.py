@@ -256,7 +256,7 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int) ->
                     rec, q0, diag_keep, fex_keep, first, e_lo, e_hi, b_lo, b_hi, s_rest)
                 if ok:
                     break
-                if ifcp and not fell_back and retries == 0:
+                if ifcp and not fell_back:
                     # IFCP is Roe's linearisation for one layer: not positive where
                     # cells move apart fast. Redo the step with HLL, which is; counted.
                     fell_back = True
