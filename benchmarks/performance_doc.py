@@ -149,89 +149,103 @@ def render_targets(b: dict[str, Any], cold_runs: dict[str, Any] | None = None,
 
 
 def render_findings(wp: dict[str, Any] | None, b: dict[str, Any] | None,
-              layers: dict[str, Any] | None = None) -> str:
+                    layers: dict[str, Any] | None = None) -> str:
     """The section "Findings": what the measurements say, in sentences."""
     L = ["## Findings\n"]
     if b:
-        most = most_signatures(b["sweep"])
-        if most > 1:
-            L.append(
-                f"* **A kernel is compiled {most} times per process.** py-pde's "
-                "controller passes `t_start = 0` as an int when the run starts (a float "
-                "after a tracker interrupt, or from a direct stepper call), and "
-                "`FVSplitSolver.make_stepper` hands it to the kernel unconverted, so numba "
-                "compiles an `int64` and a `float64` version of the whole stepping loop. "
-                "Cold, that doubles the compile time of the first runs; warm, both load "
-                "from the cache. Fix (in `pdeflow/solvers/fv_split.py`): "
-                "`advance(state.data, float(t_start), float(t_end))`.")
-        two = b["sweep"]["ratio_two_vs_single_per_update"]
-        cost = f"{two:.2f}x"
-        if layers:
-            r = layer_cost.ratios(layers)
-            two = max(r.values())
-            cost = " and ".join(f"{v:.2f}x ({w})" for w, v in r.items())
-        L.append(
-            f"* **The two-layer model costs {cost} the single layer per cell update** "
-            f"(target 3x: {'met' if two <= 3 else 'missed'}). Part of it is inherent (4 "
-            "fields, the path-conservative coupling, the coupled implicit friction, the "
-            "mass exchange); the hyperbolicity stage is measured in the cell-update table "
-            "(`none` against `exact`). It was 7.2x (2026-11-22) while the restoration "
-            "searched F_extra by bracketing and bisection, re-solving the implicit "
-            "friction at every trial. It is now a direct solve: "
-            "the test is a quartic in (du)^2 with coefficients from h1/H and r; the band "
-            "edge F_c1 is its root (Halley's method from the current du, 2-3 iterations); "
-            "the closed-form friction step is inverted for the F_extra that lands du on "
-            "it, and one friction solve confirms the branch."
-            + (layer_cost.finding(layers) if layers else hyperbolicity_share(b)))
-        wet = ", ".join(f"{r['model']} {r['ratio']:.2f}x" for r in b["wet_region"])
-        L.append(
-            f"* **Dry cells: a 10x longer domain (same collapse, same dx) costs {wet}** "
-            "(it was 4.6x for one layer and 1.8x for two on 2026-11-22, when only the "
-            "advection loops skipped dry cells). Every stage of the stepping loop now "
-            "visits only the wet region plus the stencil (the state backup, the update, "
-            "the source stage, the MUSCL predictor); the first step visits all cells once "
-            "to clean the initial state, and the wet region is searched in a window two "
-            "cells wider than the last one. A test checks that the dry cells change "
-            "nothing, bit for bit (`tests/test_active_region.py`).")
-        r1 = b["sweep"]["ratio_single_vs_baseline_stepper"]
-        L.append(
-            "* **A scheme is compiled once; parameters and grids never recompile.** The "
-            "stepping loop is one kernel per reconstruction order and splitting, for "
-            "both models and every flux; the model's advection stage (one per model, "
-            "flux, reconstruction and limiter), source stage and predictor are its "
-            "arguments. Parameters are an array and the grid an argument, so a sweep "
-            "over them never recompiles, and a run compiles only what its scheme calls "
-            "(see *Cold first run*). What "
-            "a scene does not need is skipped by branches: dry cells and absent layers "
-            "(the loops' range and per-cell tests), the hyperbolicity stage where a layer "
-            "is absent, F_extra writes except where it is applied, the time after rest "
-            "(stop-at-rest table), trackers between their interrupts (one kernel call "
-            "per interval). The price of that generality is measured against the "
-            "hand-written single-layer loop, which is specialised to its one scheme: "
-            f"{r1:.2f}x on the sweep. The loop allocates nothing per step: its scratch "
-            "arrays come from the solver, and a test counts numba's allocations over a "
-            "short and a ten times longer run "
-            "(`tests/test_active_region.py::test_the_stepping_loop_allocates_nothing_per_step`).")
+        L += _bench_findings(b, layers)
     if wp:
-        probe = wp.get("mol_probe", [])
-        rows = [r for c in wp["cases"].values() for r in c["rows"]
-                if r["variant"] == "mol-rk"]
-        ok_cases = sorted({(r["case"], r["model"]) for r in rows if r["status"] == "ok"})
-        bad_cases = sorted({(r["case"], r["model"]) for r in rows if r["status"] != "ok"})
-        L.append(
-            "* **mol-rk** (py-pde's RK4 on the method-of-lines rate) works where the "
-            "sources are mild: " + ", ".join(f"{c} ({m})" for c, m in ok_cases)
-            + ". It fails on " + (", ".join(f"{c} ({m})" for c, m in bad_cases) or "none")
-            + ": the regularised Coulomb and exchange terms (sgn(u) ~ u/mol_eps, closure "
-            "denominator max(|du|, du_reg, mol_eps), mol_eps = 1e-3 m/s) have rates of "
-            "order g tan(phi)/mol_eps ~ 10^4 1/s, far beyond what an explicit step of the "
-            "CFL size can follow."
-            + (" With smaller fixed steps (table above): " + "; ".join(
-                f"CFL {r['cfl']:g}: {r['status']}" + (f" ({r['note']})" if r['note'] else
-                                                      f", {r['wall_s']:.3g} s")
-                for r in probe) + ": it runs once dt is 100x below the CFL step, then "
-                f"crawls ({crawl(wp)}; the cap stops anything slower)." if probe else "")
-            + (" Every grid also pays for a new py-pde compilation of the stepper and the "
-               "rate (`make_evolution_rate` builds a fresh, uncached numba closure), "
-               "seconds per grid." if rows else ""))
+        L += _wp_findings(wp)
     return "\n".join(L) + "\n"
+
+
+def _bench_findings(b: dict[str, Any], layers: dict[str, Any] | None) -> list[str]:
+    """The findings of the benchmark suite (and of the two-layer section)."""
+    L: list[str] = []
+    most = most_signatures(b["sweep"])
+    if most > 1:
+        L.append(
+            f"* **A kernel is compiled {most} times per process.** py-pde's "
+            "controller passes `t_start = 0` as an int when the run starts (a float "
+            "after a tracker interrupt, or from a direct stepper call), and "
+            "`FVSplitSolver.make_stepper` hands it to the kernel unconverted, so numba "
+            "compiles an `int64` and a `float64` version of the whole stepping loop. "
+            "Cold, that doubles the compile time of the first runs; warm, both load "
+            "from the cache. Fix (in `pdeflow/solvers/fv_split.py`): "
+            "`advance(state.data, float(t_start), float(t_end))`.")
+    two = b["sweep"]["ratio_two_vs_single_per_update"]
+    cost = f"{two:.2f}x"
+    if layers:
+        r = layer_cost.ratios(layers)
+        two = max(r.values())
+        cost = " and ".join(f"{v:.2f}x ({w})" for w, v in r.items())
+    L.append(
+        f"* **The two-layer model costs {cost} the single layer per cell update** "
+        f"(target 3x: {'met' if two <= 3 else 'missed'}). Part of it is inherent (4 "
+        "fields, the path-conservative coupling, the coupled implicit friction, the "
+        "mass exchange); the hyperbolicity stage is measured in the cell-update table "
+        "(`none` against `exact`). It was 7.2x (2026-11-22) while the restoration "
+        "searched F_extra by bracketing and bisection, re-solving the implicit "
+        "friction at every trial. It is now a direct solve: "
+        "the test is a quartic in (du)^2 with coefficients from h1/H and r; the band "
+        "edge F_c1 is its root (Halley's method from the current du, 2-3 iterations); "
+        "the closed-form friction step is inverted for the F_extra that lands du on "
+        "it, and one friction solve confirms the branch."
+        + (layer_cost.finding(layers) if layers else hyperbolicity_share(b)))
+    wet = ", ".join(f"{r['model']} {r['ratio']:.2f}x" for r in b["wet_region"])
+    L.append(
+        f"* **Dry cells: a 10x longer domain (same collapse, same dx) costs {wet}** "
+        "(it was 4.6x for one layer and 1.8x for two on 2026-11-22, when only the "
+        "advection loops skipped dry cells). Every stage of the stepping loop now "
+        "visits only the wet region plus the stencil (the state backup, the update, "
+        "the source stage, the MUSCL predictor); the first step visits all cells once "
+        "to clean the initial state, and the wet region is searched in a window two "
+        "cells wider than the last one. A test checks that the dry cells change "
+        "nothing, bit for bit (`tests/test_active_region.py`).")
+    r1 = b["sweep"]["ratio_single_vs_baseline_stepper"]
+    L.append(
+        "* **A scheme is compiled once; parameters and grids never recompile.** The "
+        "stepping loop is one kernel per reconstruction order and splitting, for "
+        "both models and every flux; the model's advection stage (one per model, "
+        "flux, reconstruction and limiter), source stage and predictor are its "
+        "arguments. Parameters are an array and the grid an argument, so a sweep "
+        "over them never recompiles, and a run compiles only what its scheme calls "
+        "(see *Cold first run*). What "
+        "a scene does not need is skipped by branches: dry cells and absent layers "
+        "(the loops' range and per-cell tests), the hyperbolicity stage where a layer "
+        "is absent, F_extra writes except where it is applied, the time after rest "
+        "(stop-at-rest table), trackers between their interrupts (one kernel call "
+        "per interval). The price of that generality is measured against the "
+        "hand-written single-layer loop, which is specialised to its one scheme: "
+        f"{r1:.2f}x on the sweep. The loop allocates nothing per step: its scratch "
+        "arrays come from the solver, and a test counts numba's allocations over a "
+        "short and a ten times longer run "
+        "(`tests/test_active_region.py::test_the_stepping_loop_allocates_nothing_per_step`).")
+    return L
+
+
+def _wp_findings(wp: dict[str, Any]) -> list[str]:
+    """The findings of the work-precision studies (mol-rk)."""
+    L: list[str] = []
+    probe = wp.get("mol_probe", [])
+    rows = [r for c in wp["cases"].values() for r in c["rows"]
+            if r["variant"] == "mol-rk"]
+    ok_cases = sorted({(r["case"], r["model"]) for r in rows if r["status"] == "ok"})
+    bad_cases = sorted({(r["case"], r["model"]) for r in rows if r["status"] != "ok"})
+    L.append(
+        "* **mol-rk** (py-pde's RK4 on the method-of-lines rate) works where the "
+        "sources are mild: " + ", ".join(f"{c} ({m})" for c, m in ok_cases)
+        + ". It fails on " + (", ".join(f"{c} ({m})" for c, m in bad_cases) or "none")
+        + ": the regularised Coulomb and exchange terms (sgn(u) ~ u/mol_eps, closure "
+        "denominator max(|du|, du_reg, mol_eps), mol_eps = 1e-3 m/s) have rates of "
+        "order g tan(phi)/mol_eps ~ 10^4 1/s, far beyond what an explicit step of the "
+        "CFL size can follow."
+        + (" With smaller fixed steps (table above): " + "; ".join(
+            f"CFL {r['cfl']:g}: {r['status']}" + (f" ({r['note']})" if r['note'] else
+                                                  f", {r['wall_s']:.3g} s")
+            for r in probe) + ": it runs once dt is 100x below the CFL step, then "
+            f"crawls ({crawl(wp)}; the cap stops anything slower)." if probe else "")
+        + (" Every grid also pays for a new py-pde compilation of the stepper and the "
+           "rate (`make_evolution_rate` builds a fresh, uncached numba closure), "
+           "seconds per grid." if rows else ""))
+    return L

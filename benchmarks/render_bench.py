@@ -66,7 +66,16 @@ def render_bench(b: dict[str, Any]) -> str:
                  for r in b["case_5_1"]))
     if "large_grid" in b:  # measurements older than this table lack it
         L += render_large_grid(b["large_grid"])
-    s = b["sweep"]
+    L += _sweep_table(b["sweep"])
+    L += _skipping_tables(b)
+    L.append("")
+    return "\n".join(L)
+
+
+
+def _sweep_table(s: dict[str, Any]) -> list[str]:
+    """The 5.2-like sweep: per height and in total, pdeflow, the baseline, PyClaw."""
+    L: list[str] = []
     claw = s.get("pyclaw")
     L += ["", "### 5.2-like sweep (L0 = 0.1 m, dx = 0.01 m, to rest; medians of "
           "interleaved rounds)\n",
@@ -95,6 +104,12 @@ def render_bench(b: dict[str, Any]) -> str:
     L.append(f"Per cell update: single layer {s['ns_per_update_single']:.1f} ns, baseline "
              f"{s['ns_per_update_baseline']:.1f} ns, two layers {s['ns_per_update_two']:.1f}"
              " ns.\n")
+    return L
+
+
+def _skipping_tables(b: dict[str, Any]) -> list[str]:
+    """What a scene does not need: the wet region only, stopping at rest."""
+    L: list[str] = []
     L += ["### Skipping what a scene does not need\n",
           "**Wet region only** (same collapse on a domain 10x longer, same dx):\n"]
     L += md_table(["model", "cells", "steps", "wall [ms]", "cells (10x)", "steps", "wall [ms]",
@@ -110,9 +125,7 @@ def render_bench(b: dict[str, Any]) -> str:
                  f"{r['wall_on_s'] * 1e3:.3g} | {r['steps_off']} | "
                  f"{r['wall_off_s'] * 1e3:.3g} | {100 * r['saving']:.0f} % |"
                  for r in b["stop_at_rest"]))
-    L.append("")
-    return "\n".join(L)
-
+    return L
 
 def render_large_grid(rows: list[dict[str, Any]]) -> list[str]:
     """The 10^5-cell table (suite.large_grid_steps)."""
