@@ -309,14 +309,16 @@ above, not re-measured since the code moved behind `prepare`):
   helper's share nearest `HELPER_SHARE` = 0.5 (*session8*; plain bytecode and 0.42
   before it, which gave this process 2.5 times the helper's CPU time,
   *session8-before*, column *shares*); it undercounts the two-layer source stage's
-  tree, and the helper finished 0.8-1.1 s before this process (a cold 5.1 run at load
-  0.5). Where no fork is safe (threads: a server, Jupyter, Dask) the helper is a new
+  tree, and the shares stayed uneven (*session9-before*, *-b*: 6.2 / 4.4 and 6.6 /
+  5.3 s; with the queue, *session9*, *9b*: 4.6 / 4.8 and 4.9 / 5.4 s). Where no fork
+  is safe (threads: a server, Jupyter, Dask) the helper is a new
   interpreter, which first spends ~1 s importing pdeflow and takes the static split.
 * **One call site of the advection stage in the stepping loop**: the first attempt
   of a step, IFCP's redo with HLL and the positivity retries call the inlined stage
   from one place, where they had two (three with IFCP; numba types and lowers an
-  inlined function at every site). Compiling the first-order loop alone: 3.6 s of CPU
-  against 4.5 s (medians of 4 interleaved pairs, one core, load 2.9; *session9*).
+  inlined function at every site). With the queue: compile 4.7 and 5.2 s against 5.9
+  and 6.4 s for the code before (column *compile*, *session9* and *9b* against
+  *session9-before* and *-b*, measured in the same quarter hour).
 * **Helpers without entry points** (`compiled.HelperKernel`): the two-layer source stage
   is a tree of 20 helper kernels; with the Python and function-pointer entry points
   every caller linked in and compiled again at every level (*session5*, together with
