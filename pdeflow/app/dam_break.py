@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 import panel as pn
 import param
-from bokeh.models import ColumnDataSource, Div, LinearColorMapper, Range1d, Span
+from bokeh.models import ColumnDataSource, Div, Range1d, Span
 from bokeh.plotting import figure
 
 from .. import systems
@@ -38,6 +38,7 @@ from ..solvers.fv_split import SimulationBlowUp
 from ..trackers import FextraStorageTracker
 from .controls import ParameterControls, command_line, list_cases, served
 from .look import PageLayout, fit_height, legend_outside, style_figures
+from .plan_view import PlanView
 
 FRAMES_PER_T_END = 250
 """Frame interval of the animation: t_end / this [s] (5.1: 0.02 s, ~70 frames to rest)."""
@@ -50,21 +51,6 @@ LABELS = {m: systems.get(m).label for m in (PAPER_MODEL, BASELINE_MODEL)}
 """The models as the pages name them."""
 FIGURE_HEIGHT = 240
 """Height of each of the three profile figures [px] (presentation mode: more)."""
-PLAN_PIXELS = 121
-"""Pixels across the plan view of an axisymmetric run (the revolved total depth)."""
-
-
-def plan_view(r: np.ndarray, depth: np.ndarray, radius: float,
-              pixels: int = PLAN_PIXELS) -> np.ndarray:
-    """The total depth ``depth`` [m] at the cell centres ``r`` [m] revolved about the
-    axis, on ``pixels`` x ``pixels`` points of [-radius, radius]^2 (NaN outside the
-    domain and where dry): what a camera above the collapse sees."""
-    axis = np.linspace(-radius, radius, pixels)
-    rr = np.hypot(*np.meshgrid(axis, axis))
-    image = np.interp(rr, r, depth, right=np.nan)
-    return np.where(image > DRY, image, np.nan)
-
-
 @dataclass
 class DamBreakRun:
     """One run of every model of a case: summary runs and animation frames."""
@@ -259,19 +245,11 @@ class DamBreakPage:
         for f in (fh, fu, ff):
             f.legend.click_policy = "hide"
             legend_outside(f)  # never over the data
-        # an axisymmetric run seen from above: the first model's total depth revolved
-        self.src_plan = ColumnDataSource({"image": [np.full((2, 2), np.nan)], "x": [-1.0],
-                                          "y": [-1.0], "dw": [2.0], "dh": [2.0]})
-        fp = figure(title="seen from above (total depth)", height=300, width=320,
-                    match_aspect=True, x_axis_label="x [m]", y_axis_label="y [m]",
-                    toolbar_location=None, visible=False)
-        self.plan_colours = LinearColorMapper(palette="Cividis256", low=0.0, high=1.0,
-                                              nan_color="white")
-        fp.image("image", x="x", y="y", dw="dw", dh="dh", source=self.src_plan,
-                 color_mapper=self.plan_colours)
-        for f, name in ((fh, "depths"), (fu, "velocities"), (ff, "fextra"), (fp, "plan")):
+        for f, name in ((fh, "depths"), (fu, "velocities"), (ff, "fextra")):
             f.css_classes = [f"pdeflow-{name}"]  # for the browser tests
-        self.fig_h, self.fig_u, self.fig_f, self.fig_plan = fh, fu, ff, fp
+        self.fig_h, self.fig_u, self.fig_f = fh, fu, ff
+        # an axisymmetric run seen from above: built by the first such run
+        self.plan = PlanView()
 
     # --- running --------------------------------------------------------------------------
     def rerun(self) -> None:
@@ -304,7 +282,8 @@ class DamBreakPage:
     def set_present(self, present: bool) -> None:
         """Presentation mode: larger fonts and lines, the expert choices hidden."""
         self.present = present
-        style_figures((self.fig_h, self.fig_u, self.fig_f, self.fig_plan), present)
+        style_figures((self.fig_h, self.fig_u, self.fig_f), present)
+        self.plan.set_present(present)
         for f in (self.fig_h, self.fig_u, self.fig_f):
             f.height = fit_height(FIGURE_HEIGHT, present)
         self.controls.set_present(present)
@@ -328,7 +307,6 @@ class DamBreakPage:
         self.fig_h.x_range.start, self.fig_h.x_range.end = case.x_start, case.x_start + case.length
         axisymmetric = case.geometry == "axisymmetric"
         self.fig_f.xaxis.axis_label = f"{COORDINATES[case.geometry]} [m]"
-        self.fig_plan.visible = axisymmetric
         for m, span in self.fronts.items():
             front = run.results[m].summary["front_position"] if m in run.results else None
             span.visible = front is not None
@@ -336,7 +314,7 @@ class DamBreakPage:
         initial = [case.initial_profiles(m) for m in run.results]
         depth = max(float(sum(p[k] for k in p if k.startswith("h")).max()) for p in initial)
         self.fig_h.y_range.start, self.fig_h.y_range.end = -0.02 * depth, 1.1 * depth
-        self.plan_colours.high = depth
+        self.plan.show_run(axisymmetric, depth)
         # the final state; the player and the velocity limits wait for the frames (each
         # change of the player would redraw it in the browser twice per move)
         self.show_frame(len(run.times) - 1)
@@ -393,18 +371,11 @@ class DamBreakPage:
                                  "u": velocity_profile(h, m, fill=np.nan)}
         else:
             self.src_one.data = {"x": x, "h": nan, "u": nan}
-        if self.fig_plan.visible:
-            self._show_plan(run, i)
+        if self.plan.visible:
+            state = next(iter(run.states.values()))[i]  # the first model's
+            self.plan.show_frame(run.x, state[::2].sum(axis=0), run.case.length)
         self.fig_h.title.text = (f"{run.case.name}: t = {run.times[i]:.2f} s"
                                  + (" (final state)" if i == len(run.times) - 1 else ""))
-
-    def _show_plan(self, run: DamBreakRun, i: int) -> None:
-        """The plan view of frame ``i``: the first model's total depth revolved."""
-        state = next(iter(run.states.values()))[i]
-        radius = run.case.length
-        self.src_plan.data = {"image": [plan_view(run.x, state[::2].sum(axis=0), radius)],
-                              "x": [-radius], "y": [-radius], "dw": [2 * radius],
-                              "dh": [2 * radius]}
 
     def _summary_html(self, run: DamBreakRun) -> str:
         rows = []
@@ -427,7 +398,7 @@ class DamBreakPage:
         plots = pn.Column(self.status, self.warnings, self.player,
                           pn.pane.Bokeh(self.fig_h), pn.pane.Bokeh(self.fig_u),
                           pn.pane.Bokeh(self.fig_f), sizing_mode="stretch_width")
-        results = pn.Column("### results", pn.pane.Bokeh(self.fig_plan),
+        results = pn.Column("### results", self.plan.pane,
                             pn.pane.Bokeh(self.summary), sizing_mode="stretch_width")
         self.layout = PageLayout(self.controls.panel("dam break"), plots, results)
         if self.present:
