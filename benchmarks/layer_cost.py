@@ -136,7 +136,9 @@ def render(data: dict[str, Any]) -> str:
          "the machine's load: the two cores are shared (and may be two threads of one "
          "core), and the single layer's loops suffer more from a busy neighbour than the "
          "two-layer source stage, whose cost is chains of dependent divisions and square "
-         "roots; compare ratios measured at similar loads.\n",
+         "roots; compare ratios measured at similar loads. Which kernels the time goes "
+         "to: `python benchmarks/kernel_profile.py` (perf's samples on the compiled "
+         "kernels, `--model single_layer` for one layer).\n",
          "| workload | rounds | load (start, end) | variant | cell updates | ns per update "
          "| / single layer | median of per-round ratios |",
          "|---|---:|---|---|---:|---:|---:|---:|"]
