@@ -114,20 +114,12 @@ def kernel_shares(report: str, kernels: set[str]) -> tuple[dict[str, float], flo
 
 
 def workload_runs(workload: str, model: str) -> list[Callable[[], Any]]:
-    """The runs of ``workload`` ('sweep' or '5.1') for ``model``, as
-    ``suite.fv_stepper_run`` callables."""
+    """The runs of ``workload`` ('sweep' or '5.1') for ``model``: those of
+    ``layer_cost``'s benchmark (``suite.fv_stepper_run`` callables)."""
     sys.path.insert(0, str(Path(__file__).resolve().parent))
-    import suite
+    import layer_cost
 
-    if workload == "5.1":
-        from pdeflow.analysis.points import case_on_grid, resolve_case
-        from pdeflow.variant import Variant
-
-        case = case_on_grid(resolve_case(suite.CASE_5_1), 0.0125,
-                            Variant.parse("hll/first-order"))
-        return [suite.fv_stepper_run(case, model, 0.4)]
-    return [suite.fv_stepper_run(suite.sweep_case(H0, model), model)
-            for H0 in suite.SWEEP_H0]
+    return [run for variant, run in layer_cost._runs(workload) if variant == model]
 
 
 def perf_map(pid: int) -> Path:
