@@ -240,9 +240,10 @@ def main(argv: list[str] | None = None) -> int:
     numbers["planar_law"] = page.planar_law_check()
     profiles = profile_runs()
     numbers["profiles"] = page.profile_numbers(profiles)
+    before = run_cache.snapshot(OUT.glob("*.png"))
     page.figures(rows, numbers, profiles, OUT)
     print(run_cache.publish(numbers, t0, OUT / "numbers.json",
-                            ROOT / "docs" / "axisymmetric.md", page.render_page))
+                            ROOT / "docs" / "axisymmetric.md", page.render_page, before))
     return 0
 
 

@@ -236,10 +236,11 @@ def main(argv: list[str] | None = None) -> int:
     import erodible_bed_page as page
 
     numbers = page.page_numbers(rows)
+    before = run_cache.snapshot(OUT.glob("*.png"))
     numbers.update(page.figures(rows, numbers, OUT))
     numbers["points"] = len(rows)
     print(run_cache.publish(numbers, t0, OUT / "numbers.json",
-                            ROOT / "docs" / "erodible_bed.md", page.render_page))
+                            ROOT / "docs" / "erodible_bed.md", page.render_page, before))
     return 0
 
 

@@ -91,9 +91,10 @@ def main(argv: list[str] | None = None) -> int:
     numbers["static_angles"] = {g: runs.static_angles(g) for g in ("planar", "axisymmetric")}
     numbers["static_depth"] = runs.STATIC_DEPTH
     numbers["cost"] = stored_cost()
+    before = run_cache.snapshot((out / "figures").glob("rheology_*.png"))
     numbers["figures"] = figures(numbers, out)
     run_cache.publish(numbers, t0, out / "rheology" / "numbers.json", out / "rheology.md",
-                      lambda n: render_page(n, n["figures"]))
+                      lambda n: render_page(n, n["figures"]), before)
     print(f"written: {out / 'rheology.md'} ({len(rows)} runs)", file=sys.stderr)
     return 0
 
