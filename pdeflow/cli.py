@@ -17,8 +17,10 @@ from . import __version__
 
 RUN_HELP = """Run every model listed in the case file (case.models) to rest or t_end.
 
-Without output options the summary and all figures go to results/<case name>/.
-Outputs are written atomically: a failed run leaves no partial file behind.
+Without output options the summary and all figures go to results/<case name>/ (the
+case as written) or results/<case name>--<overrides>/ (with --set); a run replaces
+its folder as a whole. Every output is complete or absent: a failed or interrupted
+run writes nothing (Ctrl-C while the results are written lets them finish).
 For cases with several models, per-model outputs (--final, --store, --movie) go to
 the given name for the first model and to NAME.<model>.SUFFIX for the others.
 
@@ -29,12 +31,6 @@ examples:
   pdeflow run cases/paper_5_1_dam_break.toml --movie 5_1.mp4 --store 5_1.h5
   pdeflow plot 5_1.h5 5_1.single_layer.h5 --time 0.4 --out t04.png"""
 
-def _model_path(path: str | Path, model: str, first: bool) -> Path:
-    """Per-model output name: PATH for the first model, NAME.<model>.SUFFIX after it."""
-    path = Path(path)
-    return path if first else path.with_name(f"{path.stem}.{model}{path.suffix}")
-
-
 def _positive(name: str, value: float | None) -> None:
     from .cases import CaseError
 
@@ -44,7 +40,10 @@ def _positive(name: str, value: float | None) -> None:
 
 def _run_trackers(args: argparse.Namespace, case: Any, model: str,
                   first: bool) -> list[Any]:
-    """The trackers that the run options ask for (progress, live plot, storage)."""
+    """The trackers that the run options ask for (progress, live plot, storage); those
+    that write files keep them under temporary names until the outputs are written."""
+    from .run_outputs import model_path
+
     trackers: list[Any] = []
     interval = case.t_end / 100
     progress = args.progress
@@ -61,7 +60,7 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
 
         label = model
         if drawing:
-            target = (_model_path(args.movie, model, first).name if args.movie
+            target = (model_path(args.movie, model, first).name if args.movie
                       else "frames")
             label = f"{model}, drawing {target}"
         trackers.append(ProgressBar(interval, label=label))
@@ -69,18 +68,18 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
     if show or args.movie or args.frames:
         from .trackers.live import LayersPlotTracker
 
-        movie = _model_path(args.movie, model, first) if args.movie else None
+        movie = model_path(args.movie, model, first) if args.movie else None
         frames = (Path(args.frames) / model) if args.frames else None
         trackers.append(LayersPlotTracker(
             args.live_every or interval, title=f"{case.name}: {model.replace('_', ' ')}",
             display="auto" if show else "none", movie=movie, frames=frames,
-            fps=args.fps))
+            fps=args.fps, autocommit=False))
     if args.store:
         from .storage import RunStorageTracker, run_metadata
 
         meta = run_metadata(case, model, overrides=args.set, case_file=str(args.case),
                             store_every=args.store_every or interval)
-        trackers.append(RunStorageTracker(_model_path(args.store, model, first),
+        trackers.append(RunStorageTracker(model_path(args.store, model, first),
                                           args.store_every or interval, metadata=meta,
                                           autocommit=False))
     return trackers
@@ -103,27 +102,6 @@ def _load_run_case(args: argparse.Namespace) -> Any:
     return load_case(args.case, args.set)
 
 
-def _check_run_outputs(args: argparse.Namespace, outdir: Path | None) -> None:
-    """Every output of ``pdeflow run`` can be written, checked before the run."""
-    from .outpaths import FIGURE_SUFFIXES, check_dir, check_file
-
-    check_file(args.summary, "--summary", (".json",))
-    check_file(args.final, "--final", (".npz",))
-    check_file(args.plot, "--plot", FIGURE_SUFFIXES)
-    check_file(args.store, "--store", (".h5", ".hdf5"))
-    check_file(args.movie, "--movie")
-    check_dir(args.frames, "--frames")
-    check_dir(outdir, "--outdir", create=not args.outdir)
-    if args.movie:
-        from .trackers.live import check_movie_path
-
-        check_movie_path(args.movie)
-    if args.store:
-        from .storage import require_h5py
-
-        require_h5py()
-
-
 def _live_display() -> bool:
     """Whether a live plot can be shown here (imports matplotlib: only for --live)."""
     from .trackers.live import display_mode
@@ -144,68 +122,27 @@ def _live_window(args: argparse.Namespace) -> bool:
     return display_mode("auto") == "window"
 
 
-def _run_models(args: argparse.Namespace, case: Any) -> tuple[dict, dict, list]:
-    """Run every model with the trackers the options ask for: (results, storage
-    trackers by model, all trackers). Nothing of a failed or interrupted run stays."""
+def _run_models(args: argparse.Namespace, case: Any, outputs: Any) -> dict[str, Any]:
+    """Run every model with the trackers the options ask for (those that write files
+    go to ``outputs``, a :class:`~pdeflow.run_outputs.RunOutputs`); the results."""
     from .interrupts import SignalCheck
     from .simulate import run_model
 
     results: dict[str, Any] = {}
-    stores: dict[str, Any] = {}
-    all_trackers: list[Any] = []
     if args.live or args.movie or args.frames:
         # drawing frames takes longer than the run itself: py-pde's warning about it
         # would only be noise here
         logging.getLogger("pde.solvers.controller").setLevel(logging.ERROR)
-    try:
-        for i, model in enumerate(case.models):
-            trackers = _run_trackers(args, case, model, first=i == 0)
-            all_trackers.extend(trackers)
-            for t in trackers:
-                if hasattr(t, "commit"):
-                    stores[model] = t
-            # a signal is handled within a second (observers do not change the run)
-            results[model] = run_model(case, model, tracker=[*trackers, SignalCheck()])
-    except BaseException:
-        for t in all_trackers:  # no partial movie or storage file stays behind
-            if hasattr(t, "discard"):
-                t.discard()
-        raise
-    return results, stores, all_trackers
-
-
-def _write_run_outputs(args: argparse.Namespace, case: Any, summary: dict,
-                       results: dict, stores: dict, trackers: list,
-                       outdir: Path | None, figures: Any = None) -> list[Any]:
-    """Write (commit) every output of ``pdeflow run`` (the figures by ``figures``, a
-    :class:`~pdeflow.figure_worker.RunFigures`); returns what was written."""
-    from .io import write_json, write_npz
-
-    written: list[Any] = []
-    for model, tracker in stores.items():
-        extra = {"summary": summary["models"][model]}
-        if results[model].series is not None:  # the erosion series (cases with a bed)
-            extra["erosion_series"] = results[model].series.to_dict()
-        written.append(tracker.commit(extra))
-    for t in trackers:
-        if getattr(t, "movie", None) is not None:
-            written.append(t.movie.path)
-        if getattr(t, "frames_dir", None) is not None and t.frame_paths:
-            written.append(t.frames_dir / f"frame_*.png ({len(t.frame_paths)} frames)")
-    if args.summary or outdir:
-        written.append(write_json(args.summary or outdir / "summary.json", summary))
-    if args.final:
-        for i, m in enumerate(case.models):
-            written.append(write_npz(_model_path(args.final, m, i == 0),
-                                     results[m].final_arrays()))
-    if figures is not None:
-        from .case_figures import run_figure_jobs
-
-        written.extend(figures.draw(run_figure_jobs(results, outdir, args.plot)))
-    return written
+    for i, model in enumerate(case.models):
+        trackers = _run_trackers(args, case, model, first=i == 0)
+        outputs.add(trackers)
+        # a signal is handled within a second (observers do not change the run)
+        results[model] = run_model(case, model, tracker=[*trackers, SignalCheck()])
+    return results
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    from .run_outputs import RunOutputs, check_run_outputs, run_folder
     from .sizecheck import check_size
 
     case = _load_run_case(args)
@@ -214,8 +151,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     default_out = not (args.summary or args.final or args.plot or args.outdir
                        or args.store or args.movie or args.frames)
     outdir = Path(args.outdir) if args.outdir else (
-        Path("results") / case.name if default_out else None)
-    _check_run_outputs(args, outdir)
+        run_folder(case.name, args.set) if default_out else None)
+    check_run_outputs(args, outdir)
     check_size(case, args.force, "use a coarser grid (--set grid.dx=...)")
     live_window = _live_window(args)
     figures = None
@@ -223,18 +160,23 @@ def cmd_run(args: argparse.Namespace) -> int:
         from .figure_worker import RunFigures
 
         figures = RunFigures(here=bool(args.live or args.movie or args.frames))
+    outputs = RunOutputs(args, outdir)
     try:
-        return _run_and_write(args, case, outdir, figures, live_window)
+        return _run_and_write(args, case, outputs, figures, live_window)
+    except BaseException:
+        outputs.discard()  # nothing of an unfinished run stays, hidden or not
+        raise
     finally:
         if figures is not None:
             figures.close()
 
 
-def _run_and_write(args: argparse.Namespace, case: Any, outdir: Path | None,
-                   figures: Any, live_window: bool) -> int:
-    """The body of ``pdeflow run`` after the checks: kernels, runs, outputs, printing;
-    ``figures``: a :class:`~pdeflow.figure_worker.RunFigures` (None: no figures)."""
-    from .interrupts import deferred_signals
+def _run_and_write(args: argparse.Namespace, case: Any, outputs: Any, figures: Any,
+                   live_window: bool) -> int:
+    """The body of ``pdeflow run`` after the checks: kernels, runs, outputs (``outputs``,
+    a :class:`~pdeflow.run_outputs.RunOutputs`), printing; ``figures``: a
+    :class:`~pdeflow.figure_worker.RunFigures` (None: no figures)."""
+    from .interrupts import received
     from .numerics.warmup import COLD, prepare, status
     from .simulate import case_steppers, print_summary
 
@@ -245,7 +187,7 @@ def _run_and_write(args: argparse.Namespace, case: Any, outdir: Path | None,
     elif figures is not None:
         figures.start()  # matplotlib's import overlaps the kernels' loading and the runs
     prepare(steppers, log=None if args.quiet else sys.stderr, meanwhile=meanwhile)
-    results, stores, trackers = _run_models(args, case)
+    results = _run_models(args, case, outputs)
     summary = {
         "case": case.name,
         "case_file": str(args.case),
@@ -254,12 +196,9 @@ def _run_and_write(args: argparse.Namespace, case: Any, outdir: Path | None,
         "parameters": {m: case.make_pde(m).parameters.to_dict() for m in case.models},
         "models": {m: r.summary for m, r in results.items()},
     }
-    with deferred_signals() as came:  # the results are written completely, or not
-        written = _write_run_outputs(args, case, summary, results, stores, trackers,
-                                     outdir, figures)
-    if came:
-        print("pdeflow: interrupted after the results were written", file=sys.stderr)
-        return 130
+    written = outputs.write(case, summary, results, figures)
+    if received():  # held back while the results were written: the command ends here
+        raise KeyboardInterrupt("after the results were written")
     if not args.quiet:
         print_summary(summary)
         for p in written:
@@ -380,24 +319,46 @@ def main(argv: list[str] | None = None) -> int:
         return _main(argv)
 
 
+def _interrupted(err: BaseException, session: Any) -> int:
+    """Ctrl-C or SIGTERM: one line saying what was kept; exit code 130. Temporary files
+    are gone (atomic writes, discarded trackers); either nothing was written or every
+    output is complete (:mod:`pdeflow.interrupts`)."""
+    from .interrupts import RunInterrupted
+
+    if session.written:
+        n = len(session.written)
+        print(f"pdeflow: interrupted after the results were written ({n} output"
+              f"{'s' if n > 1 else ''}, all complete)", file=sys.stderr)
+        return 130
+    t = getattr(err, "t", None)
+    when = f"at t = {t:.6g} s" if isinstance(err, RunInterrupted) and t is not None \
+        else "before the results were complete"
+    print(f"pdeflow: interrupted {when}; nothing written", file=sys.stderr)
+    return 130
+
+
 def _main(argv: list[str] | None = None) -> int:
     from .cases import CaseError
-    from .interrupts import RunInterrupted, signals_interrupt
+    from .interrupts import Session, signals_interrupt
     from .solvers.fv_split import SimulationBlowUp
 
     argv = sys.argv[1:] if argv is None else list(argv)
     command = next((a for a in argv if not a.startswith("-")), None)
     args = build_parser(command).parse_args(argv)
+    session = Session()
     try:
-        with signals_interrupt():
-            return args.func(args)
+        with signals_interrupt(session):
+            try:
+                code = args.func(args)
+            except Exception as err:
+                if session.signals:  # a failure a signal caused (e.g. a worker it ended)
+                    raise KeyboardInterrupt(str(err)) from None
+                raise
+            if session.signals:  # a Ctrl-C whose KeyboardInterrupt was swallowed
+                raise KeyboardInterrupt("a signal came")
+            return code
     except KeyboardInterrupt as err:
-        # Ctrl-C or SIGTERM: temporary files are gone (atomic writes, discarded trackers)
-        t = getattr(err, "t", None)
-        when = f"at t = {t:.6g} s" if isinstance(err, RunInterrupted) and t is not None \
-            else "before the results were complete"
-        print(f"pdeflow: interrupted {when}; nothing written", file=sys.stderr)
-        return 130
+        return _interrupted(err, session)
     except CaseError as err:
         print(f"pdeflow: error: {err}", file=sys.stderr)
         return 2

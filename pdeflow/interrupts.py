@@ -1,4 +1,5 @@
-"""Ctrl-C and SIGTERM: end a command with one line and no partial or hidden files.
+"""Ctrl-C and SIGTERM: end a command with one line that says what was kept, and no
+partial or hidden files.
 
 py-pde's controller turns a KeyboardInterrupt during the run into a normal return;
 :meth:`pdeflow.simulate.Run.execute` raises :class:`RunInterrupted` (with the time
@@ -6,8 +7,16 @@ reached) instead, so that a truncated run is never written out. SIGTERM (``kill`
 ``timeout``) would end the process without unwinding, leaving the temporary files of
 storage and movies behind: :func:`signals_interrupt` makes it raise KeyboardInterrupt
 like Ctrl-C, so the same clean-up runs. While the results are written,
-:func:`deferred_signals` holds both signals back (a result is then complete), and
-tells afterwards whether one came.
+:func:`deferred_signals` holds both signals back (the results are then complete).
+
+A :class:`Session` (one per command, the block of :func:`signals_interrupt`) records
+the signals that came and the outputs written (:func:`note_written`), so that the
+command's last line tells the truth: nothing written, or every output complete. It also
+keeps a Ctrl-C from being lost: a KeyboardInterrupt raised where Python cannot pass it
+on (a ``__del__`` or a weakref callback run by the garbage collector: "Exception ignored
+in ...") would let the command finish as if nothing had come; :func:`received` still
+says it came (:meth:`~pdeflow.simulate.Run.execute` then raises :class:`RunInterrupted`,
+the command ends as interrupted).
 
 The compiled stepping loop runs between two tracker interrupts without returning to
 Python, where signal handlers run: :class:`SignalCheck` gives the controller an
@@ -18,8 +27,11 @@ interrupt about once a wall-clock second (observers do not change the steps, see
 from __future__ import annotations
 
 import signal
-from collections.abc import Iterator
+import sys
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 from pde.trackers.base import TrackerBase
@@ -36,32 +48,89 @@ class RunInterrupted(KeyboardInterrupt):
         self.t = t
 
 
+@dataclass
+class Session:
+    """What one command met: the signals that came (numbers) and the outputs it wrote
+    (paths, as told by :func:`note_written`)."""
+
+    signals: list[int] = field(default_factory=list)
+    written: list[str] = field(default_factory=list)
+
+
+_ACTIVE: Session | None = None
+"""the session of the running :func:`signals_interrupt` block"""
+
+
+def received() -> bool:
+    """Whether SIGINT or SIGTERM came in the current session (even if its
+    KeyboardInterrupt was swallowed on the way, or held back)."""
+    return _ACTIVE is not None and bool(_ACTIVE.signals)
+
+
+def note_written(paths: Iterable[str | Path]) -> None:
+    """Record outputs that are now complete under their final names."""
+    if _ACTIVE is not None:
+        _ACTIVE.written.extend(str(p) for p in paths)
+
+
 def _raise_interrupt(signum: int, frame: Any) -> None:
+    if _ACTIVE is not None:
+        _ACTIVE.signals.append(signum)
     raise KeyboardInterrupt(signal.Signals(signum).name)
 
 
 @contextmanager
-def signals_interrupt() -> Iterator[None]:
-    """SIGTERM raises KeyboardInterrupt as SIGINT does, inside the block."""
+def signals_interrupt(session: Session | None = None) -> Iterator[Session]:
+    """SIGINT and SIGTERM raise KeyboardInterrupt inside the block and are recorded in
+    the yielded :class:`Session` (``session``, or a new one)."""
+    global _ACTIVE
+    session = Session() if session is None else session
     old = {s: signal.getsignal(s) for s in SIGNALS}
-    signal.signal(signal.SIGTERM, _raise_interrupt)
-    signal.signal(signal.SIGINT, signal.default_int_handler)
+    outer, _ACTIVE = _ACTIVE, session
+    old_hook = sys.unraisablehook
+    for s in SIGNALS:
+        signal.signal(s, _raise_interrupt)
+    sys.unraisablehook = _unraisable(old_hook)
     try:
-        yield
+        # signals recorded before the command started (pdeflow.__main__.EarlySignals)
+        early = [n for h in set(old.values()) for n in getattr(h, "came", ())]
+        if early:
+            session.signals.extend(early)
+            raise KeyboardInterrupt(signal.Signals(early[0]).name)
+        yield session
     finally:
         for s, handler in old.items():
             signal.signal(s, handler)
+        sys.unraisablehook = old_hook
+        _ACTIVE = outer
+
+
+def _unraisable(hook: Any) -> Any:
+    """``sys.unraisablehook`` that leaves out a KeyboardInterrupt (recorded in the
+    session, the command ends as interrupted) and passes the rest to ``hook``."""
+
+    def unraisable(info: Any) -> None:
+        if not isinstance(info.exc_value, KeyboardInterrupt):
+            hook(info)
+
+    return unraisable
 
 
 @contextmanager
 def deferred_signals() -> Iterator[list[int]]:
     """Hold SIGINT and SIGTERM back inside the block; the yielded list gets the signals
-    that came meanwhile (the caller then ends, after the block, with everything
-    written)."""
+    that came meanwhile, as does the session (the caller then ends, after the block,
+    with everything written)."""
     came: list[int] = []
+
+    def hold(signum: int, frame: Any) -> None:
+        came.append(signum)
+        if _ACTIVE is not None:
+            _ACTIVE.signals.append(signum)
+
     old = {s: signal.getsignal(s) for s in SIGNALS}
     for s in SIGNALS:
-        signal.signal(s, lambda signum, frame: came.append(signum))
+        signal.signal(s, hold)
     try:
         yield came
     finally:

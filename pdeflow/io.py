@@ -1,11 +1,22 @@
-"""Output files that are complete or absent: write to a temporary name, then rename."""
+"""Output files that are complete or absent: write to a temporary name, then rename.
+
+Every temporary file or directory (:class:`PendingFile`, :class:`PendingDir`) is
+registered until it is committed or discarded, so that a command that is interrupted
+anywhere, even while a writer is being set up, can remove them all
+(:func:`discard_pending`); SIGINT and SIGTERM are blocked while a temporary is created and
+registered, renamed or removed (:func:`signals_blocked`), so none is left unregistered or
+half-renamed.
+"""
 
 from __future__ import annotations
 
 import json
 import math
 import os
+import shutil
+import signal
 import tempfile
+import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -29,6 +40,36 @@ def check_output(path: str | Path | None, option: str) -> None:
                           "first)")
 
 
+_PENDING: dict[int, PendingFile | PendingDir] = {}
+"""the temporaries not yet committed or discarded, by id"""
+
+
+@contextmanager
+def signals_blocked() -> Iterator[None]:
+    """Hold SIGINT and SIGTERM back (at the operating system) inside the block: a
+    handler that raises runs after it, not half-way through (main thread only; elsewhere
+    signals do not reach Python code anyway)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    sigs = {signal.SIGINT, signal.SIGTERM}
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, sigs)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def discard_pending() -> int:
+    """Discard every temporary of this process not yet committed (an interrupted or
+    failed command); returns how many there were. Targets are left as they were."""
+    with signals_blocked():
+        left = list(_PENDING.values())
+        for pending in left:
+            pending.discard()
+    return len(left)
+
+
 class PendingFile:
     """A file written under a temporary name next to ``path`` and renamed onto ``path``
     on :meth:`commit`, so that a reader never sees a truncated file under the final name.
@@ -42,11 +83,14 @@ class PendingFile:
     def __init__(self, path: str | Path):
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.",
-                                   suffix=f".part{self.path.suffix}", dir=self.path.parent)
-        os.close(fd)
-        self.tmp = Path(tmp)
         self.done = False
+        with signals_blocked():
+            fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.",
+                                       suffix=f".part{self.path.suffix}",
+                                       dir=self.path.parent)
+            os.close(fd)
+            self.tmp = Path(tmp)
+            _PENDING[id(self)] = self
 
     def commit(self) -> Path:
         """Rename the temporary file onto the target; return the target.
@@ -54,17 +98,69 @@ class PendingFile:
         The file gets the permissions of a file created normally (mkstemp makes
         temporary files private to the user; results are ordinary files).
         """
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(self.tmp, 0o666 & ~umask)
-        os.replace(self.tmp, self.path)
-        self.done = True
+        with signals_blocked():
+            os.chmod(self.tmp, 0o666 & ~_umask())
+            os.replace(self.tmp, self.path)
+            self.done = True
+            _PENDING.pop(id(self), None)
         return self.path
 
     def discard(self) -> None:
         """Remove the temporary file (the target is left as it was)."""
-        self.tmp.unlink(missing_ok=True)
-        self.done = True
+        with signals_blocked():
+            self.tmp.unlink(missing_ok=True)
+            self.done = True
+            _PENDING.pop(id(self), None)
+
+
+class PendingDir:
+    """A directory filled under a temporary name next to ``path``
+    (``.NAME.XXXX.part``) and swapped onto ``path`` on :meth:`commit`: whatever
+    ``path`` held before (a previous run's files) is replaced as a whole, so that no
+    file of an older run stays beside the new ones, and no reader sees a half-filled
+    ``path``. Write into :attr:`tmp`."""
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self.done = False
+        with signals_blocked():
+            self.tmp = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.", suffix=".part",
+                                             dir=self.path.parent))
+            _PENDING[id(self)] = self
+
+    def commit(self) -> Path:
+        """Move the old ``path`` (if any) aside, rename the temporary directory onto it,
+        remove the old one; return ``path``. In between, ``path`` is briefly absent,
+        never half old and half new."""
+        with signals_blocked():
+            os.chmod(self.tmp, 0o777 & ~_umask())
+            old = None
+            if self.path.exists() or self.path.is_symlink():
+                old = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.",
+                                            suffix=".part-old", dir=self.path.parent))
+                os.replace(self.path, old / "old")
+            os.replace(self.tmp, self.path)
+            self.done = True
+            _PENDING.pop(id(self), None)
+            if old is not None:
+                shutil.rmtree(old, ignore_errors=True)
+        return self.path
+
+    def discard(self) -> None:
+        """Remove the temporary directory and everything in it (``path`` is left as it
+        was)."""
+        with signals_blocked():
+            shutil.rmtree(self.tmp, ignore_errors=True)
+            self.done = True
+            _PENDING.pop(id(self), None)
+
+
+def _umask() -> int:
+    """The process's umask (the permissions a file created normally would get)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    return umask
 
 
 @contextmanager
@@ -109,9 +205,14 @@ def write_text(path: str | Path, text: str) -> Path:
     return Path(path)
 
 
+def json_text(data: Any) -> str:
+    """``data`` as the indented JSON text of pdeflow's files (see :func:`jsonable`)."""
+    return json.dumps(jsonable(data), indent=2) + "\n"
+
+
 def write_json(path: str | Path, data: Any) -> Path:
     """Write ``data`` as indented JSON, atomically."""
-    return write_text(path, json.dumps(jsonable(data), indent=2) + "\n")
+    return write_text(path, json_text(data))
 
 
 def write_npz(path: str | Path, arrays: dict[str, np.ndarray]) -> Path:

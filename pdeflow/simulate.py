@@ -176,10 +176,11 @@ class Run:
                                      ret_info=True, **self.solver_arguments())
         wall = time.perf_counter() - wall0
         stop = str(info.get("controller", {}).get("stop_reason", ""))
-        if stop.startswith("User interrupted"):
+        from .interrupts import RunInterrupted, received
+
+        if stop.startswith("User interrupted") or received():
             # py-pde turns Ctrl-C into a normal return; a truncated run must not be
-            # written out as if it were complete
-            from .interrupts import RunInterrupted
+            # written out as if it were complete (nor one whose Ctrl-C was swallowed)
 
             t_stop = info["controller"].get("t_final")
             raise RunInterrupted(f"{model} run of {case.name} interrupted at t={t_stop}",

@@ -22,8 +22,11 @@ Example::
     eq.solve(state, t_range=5, solver="fv-split", tracker=live)
 
 The last frame is the final state (the rest time if the run stopped at rest). Movies
-and frames are complete or absent: a movie is written under a temporary name and
-renamed when the run ends; :meth:`LayersPlotTracker.discard` removes it if the run fails.
+and frames are complete or absent: a movie is written under a temporary name, the
+frames into a temporary directory, both renamed into place when the run ends (with
+``autocommit=False`` only on :meth:`LayersPlotTracker.commit`, as ``pdeflow run`` does
+once every model has run); :meth:`LayersPlotTracker.discard` removes them if the run
+fails or is interrupted.
 The tracker does not change the run: fv-split shows it the state interpolated at its
 interrupt times without shortening a step (:mod:`pdeflow.solvers.outputs`).
 """
@@ -39,7 +42,7 @@ import matplotlib
 import numpy as np
 from pde.trackers.base import InfoDict, TrackerBase
 
-from ..io import PendingFile
+from ..io import PendingDir, PendingFile
 from ..numerics.geometry import COORDINATES, geometry_of
 from ..plotting import RunFigure, Series
 from ..systems import of_fields
@@ -98,7 +101,7 @@ def check_movie_path(path: str | Path) -> str:
 
 class MovieFile:
     """Frames of a figure written to a movie through a matplotlib animation writer,
-    under a temporary name until :meth:`finish` (complete or absent)."""
+    under a temporary name until :meth:`commit` (complete or absent)."""
 
     def __init__(self, path: str | Path, fig: Any, *, fps: float = 10, dpi: int = 100):
         from matplotlib import animation
@@ -113,6 +116,7 @@ class MovieFile:
         else:
             self._writer = animation.PillowWriter(fps=fps)
         self._fig = fig
+        self.closed = False
         self._writer.setup(fig, str(self._pending.tmp), dpi=dpi)
         self.frames = 0
 
@@ -121,10 +125,20 @@ class MovieFile:
         self._writer.grab_frame()
         self.frames += 1
 
+    def close(self) -> None:
+        """Write the end of the movie (still under its temporary name)."""
+        if not self.closed:
+            self._writer.finish()
+            self.closed = True
+
+    def commit(self) -> Path:
+        """Rename the closed movie into place; return its path."""
+        return self._pending.commit()
+
     def finish(self) -> Path:
         """Close the movie and rename it into place."""
-        self._writer.finish()
-        return self._pending.commit()
+        self.close()
+        return self.commit()
 
     def discard(self) -> None:
         """Stop the writer and remove the temporary file."""
@@ -162,14 +176,17 @@ class LayersPlotTracker(TrackerBase):
         pause: seconds the window's event loop runs per frame (window display only).
         model: the registered name of the run's model (default: the first model whose
             state has the run's field labels, see :func:`pdeflow.systems.of_fields`).
+        autocommit: rename the movie and the frames' directory into place when the run
+            ends; with False, call :meth:`commit` or :meth:`discard`.
     """
 
     def __init__(self, interrupts: Any = 0.05, *, title: str = "",
                  display: str = "auto", movie: str | Path | None = None,
                  frames: str | Path | None = None, fps: float = 10, dpi: int = 100,
                  depth_max: float | None = None, pause: float = 1e-3,
-                 model: str | None = None):
+                 model: str | None = None, autocommit: bool = True):
         super().__init__(interrupts=interrupts)
+        self.autocommit = autocommit
         self.model = model
         self.title = title
         self.display = display_mode(display)
@@ -185,6 +202,7 @@ class LayersPlotTracker(TrackerBase):
         self.times: list[float] = []
         self.frame_paths: list[Path] = []
         self.movie: MovieFile | None = None
+        self._frames: PendingDir | None = None  # the frames until committed
         self._info: InfoDict | None = None
         self._field: Any = None
         self._handle: Any = None
@@ -200,7 +218,7 @@ class LayersPlotTracker(TrackerBase):
         self.figure = RunFigure(series, title=self.title, depth_max=self.depth_max,
                                 pyplot=self.display == "window")
         if self.frames_dir is not None:
-            self.frames_dir.mkdir(parents=True, exist_ok=True)
+            self._frames = PendingDir(self.frames_dir)
         if self.movie_path is not None:
             self.movie = MovieFile(self.movie_path, self.figure.fig, fps=self.fps,
                                    dpi=self.dpi)
@@ -221,9 +239,23 @@ class LayersPlotTracker(TrackerBase):
             return
         show_final_state(self, info)
         if self.movie is not None:
-            self.movie.finish()
+            self.movie.close()
         if self.display != "window":
             self.figure.close()
+        if self.autocommit:
+            self.commit()
+
+    def commit(self) -> list[Path]:
+        """Rename the movie and the frames' directory (each if asked for) into place; a
+        previous run's frames there are replaced as a whole. Returns what was
+        written: the movie and the frames' directory."""
+        written = []
+        if self.movie is not None:
+            self.movie.close()
+            written.append(self.movie.commit())
+        if self._frames is not None:
+            written.append(self._frames.commit())
+        return written
 
     # --- drawing --------------------------------------------------------------------------
     def draw(self, data: np.ndarray, t: float, fextra: np.ndarray | None = None) -> None:
@@ -250,14 +282,18 @@ class LayersPlotTracker(TrackerBase):
                 self._handle.update(image)
         if self.movie is not None:
             self.movie.grab()
-        if self.frames_dir is not None:
-            path = self.frames_dir / f"frame_{len(self.frame_paths):05d}.png"
-            self.frame_paths.append(self.figure.save(path, dpi=self.dpi))
+        if self._frames is not None:
+            name = f"frame_{len(self.frame_paths):05d}.png"
+            self.figure.save(self._frames.tmp / name, dpi=self.dpi)
+            self.frame_paths.append(self._frames.path / name)  # where it will be
 
     def discard(self) -> None:
-        """Abandon the movie of a failed run (no partial movie is left behind)."""
+        """Abandon the movie and frames of a failed or interrupted run (nothing of them
+        is left behind; an older movie or frames' directory stays as it was)."""
         if self.movie is not None:
             self.movie.discard()
+        if self._frames is not None and not self._frames.done:
+            self._frames.discard()
         if self.figure is not None and self.display != "window":
             self.figure.close()
 
