@@ -14,7 +14,9 @@ from rheology_sources import LAGREE, PARAMETERS
 
 GEOMETRY_TEXT = {
     "planar": ("Planar collapses (test 5.2)", "Lube et al. (2005), r = 1.9 a^(2/3) for "
-               "a > 2.8 (REFERENCE section 4)", "mean |ln(r/r_Lube)| over a > 2.8"),
+               "a > 2.8 (Lube, Huppert, Sparks & Freundt 2005, *Collapses of "
+               "two-dimensional granular columns*, Phys. Rev. E 72, 041301)",
+               "mean |ln(r/r_Lube)| over a > 2.8"),
     "axisymmetric": ("Axisymmetric collapses", "Lube et al. (2004) as docs/axisymmetric.md "
                      "uses it, r = 1.24 a below a = 1.7 and 1.6 a^(1/2) above (remembered, "
                      "not confirmed there)",

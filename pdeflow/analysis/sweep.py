@@ -45,7 +45,10 @@ neither law describes."""
 PUBLISHED_EXPONENTS = {"Balmforth & Kerswell 2005 (wide)": (0.9, 0.1),
                        "Balmforth & Kerswell 2005 (narrow)": (0.65, None),
                        "Lacaze et al. 2008 (DEM)": (DEM_EXPONENT, 0.03)}
-"""Laws given as an exponent only, r ~ a^e: name -> (e, its uncertainty or None)."""
+"""Laws given as an exponent only, r ~ a^e: name -> (e, its uncertainty or None).
+Balmforth & Kerswell 2005, Granular collapse in two dimensions, J. Fluid Mech. 538,
+399-428; Lacaze, Phillips & Kerswell 2008, Planar collapse of a granular column:
+experiments and discrete element simulations, Phys. Fluids 20, 063302."""
 
 
 def published_law(name: str, a: np.ndarray, bridge: bool = False) -> np.ndarray:
