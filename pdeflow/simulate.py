@@ -262,6 +262,30 @@ def summary_keys(model: str, series: bool = False) -> tuple[str, ...]:
     return (*_COMMON_KEYS, *systems.get(model).summary_keys, *extra)
 
 
+_LENGTH_KEYS = ("front_position", "runout", "front_mass_quantile", "runout_mass_quantile",
+                "max_fextra_x", "bed_max_erosion_x", "bed_max_erosion_depth")
+
+
+def summary_unit(key: str) -> str | None:
+    """The unit of the summary number ``key`` ('-' for counts and ratios; None for a key
+    that is no number, e.g. 'model' or 'warnings'); volumes are per unit width on a
+    planar grid (m^2) and m^3 on an axisymmetric one."""
+    if key in ("t_final", "wall_time_s", "flow_duration") or key.endswith("_time"):
+        return "s"
+    if key in _LENGTH_KEYS:
+        return "m"
+    if "_volume" in key:
+        return "m^2 or m^3"
+    units = {"max_fextra_over_rho1": "m^2/s^2", "front_velocity_max": "m/s"}
+    if key in units:
+        return units[key]
+    if key in ("steps", "mass_relative_error", "mass_change", "runout_mass_fraction",
+               "flux_fallback_steps", "positivity_retries", "hyperbolicity_events",
+               "hyperbolicity_bisections"):
+        return "-"
+    return None
+
+
 def mass_front(res: RunResult, bed: np.ndarray | None = None) -> float | None:
     """The mass-quantile front [m] of a run's final state: the position (a radius on an
     axisymmetric grid) from the domain's start within which ``case.runout_mass_fraction``
