@@ -326,7 +326,10 @@ def _how(numbers: dict[str, Any]) -> list[str]:
         f"a = {', '.join(f'{a:g}' for a in one['a'])}, radial flow on py-pde's PolarSymGrid "
         "over r = 0 .. 6 m (the axis a wall, the outer end open, never reached), first-order "
         "HLL, CFL 0.3, each run to rest; R_inf is the outer face of the last cell deeper "
-        "than 1 mm. Three parameter sets: the single layer (phi_B = 30 deg), the two-layer "
+        "than 1 mm (the threshold front, in every fit and figure of this page; the cached "
+        "runs predate the radius holding 99 % of the mass, `front_mass_quantile`, which "
+        "converges faster and which a regeneration without the cache would add). Three "
+        "parameter sets: the single layer (phi_B = 30 deg), the two-layer "
         "defaults (phi_B 41 deg, k 0.65, c 0.03, the lower layer a 60 deg cone), and the "
         "two-layer set of `cases/paper_5_2_two_layer_law.toml`. Every point on "
         f"dr = {', '.join(f'{g:g}' for g in numbers['grids'])} m (R0/20 .. "
@@ -363,11 +366,14 @@ def _how(numbers: dict[str, Any]) -> list[str]:
         "",
         f"**Deposits** (dr = {PROFILE_DX:g} m; lower layer dotted; the dashed line is the "
         "straight cone through Lube's final height and run-out, an outline, not a measured "
-        "profile). A deposit that keeps an undisturbed top at H0 is named a truncated "
-        "cone; the others by the ratio of the mean slope of the inner half of the deposit "
-        "to that of the outer half: below 0.7 flat-topped, 0.7-1.5 a cone, above 1.5 a "
-        "steep centre on a thin skirt (the look of the experiments' \"Mexican hat\", "
-        "whose description we could not check, see Sources).",
+        "profile; the grey line the initial column's edge; r shown to 15 % beyond the radius "
+        "holding 95 % of the two-layer deposits' mass or Lube's R_inf, a deposit reaching "
+        "farther named at the panel's edge). A deposit that keeps an undisturbed top at H0 "
+        "is named a truncated cone; the others by the ratio of the mean slope of the "
+        "inner half of the deposit to that of the outer half: below 0.7 flat-topped, "
+        "0.7-1.5 a cone, above 1.5 a steep centre on a thin skirt (the look of the "
+        "experiments' \"Mexican hat\", whose description we could not check, see "
+        "Sources).",
         "",
         "![deposits at a = 0.5, 2, 5, 10](axisymmetric/deposits.png)",
         "",

@@ -229,7 +229,10 @@ def render_page(numbers: dict[str, Any], figs: dict[str, str]) -> str:
         "6 m), on successively halved grids; the planar sweep also runs `mu_i` with the "
         "mu(I) constants of Lagree, Staron & Popinet (2011) (`mu_i_lagree`). The laws are "
         "not calibrated to the experiments: this compares their shapes at their papers' "
-        "values.\n",
+        "values. The run-out r = (R - L0)/L0 uses the threshold front R (the downstream "
+        "face of the last cell deeper than 1 mm) in every fit, distance and figure; the "
+        "cached rows predate the run-out holding 99 % of the mass (`runout_mass_quantile`), "
+        "which `--rerun` would be needed to add.\n",
         "## The answer\n", *summary_lines(numbers), "",
         f"Checks: every run ended at rest: {numbers['all_at_rest']}; largest relative mass "
         f"error {numbers['max_mass_error']:.1e}; run warnings other than the cost "

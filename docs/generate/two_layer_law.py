@@ -663,7 +663,10 @@ def experiments_section(dist_rows: list[tuple[str, dict]]) -> list[str]:
     lines = ["", "### Against experiments and DEM", "",
              "r = (R - L0)/L0 with R the front (last cell deeper than 1 mm) in every "
              "model; the experiments define R by the farthest grains of the deposit, "
-             "which a 1 mm threshold approximates for these 0.1 m columns. RMS distance "
+             "which a 1 mm threshold approximates for these 0.1 m columns. Every fit on "
+             "this page uses this threshold front (the stored tables predate the run-out "
+             "holding 99 % of the mass, r_mass, that `pdeflow sweep` now fits too). RMS "
+             "distance "
              "in log10 over a = 2 .. 30 (0.1 = a factor 1.26), and the fitted exponent "
              "against the exponent-only laws:", "",
              "| run | fit | " + " | ".join(LAWS) + " | "
