@@ -188,3 +188,18 @@ def test_a_smaller_fraction_gives_a_shorter_front():
                         "single_layer").summary["front_mass_quantile"]
               for q in (0.5, 0.9, 0.99)]
     assert fronts[0] < fronts[1] < fronts[2]
+
+
+def test_the_quantile_changes_less_with_the_grid_than_the_threshold_front():
+    """The single layer of 5.1 on dx = 0.05, 0.025, 0.0125 m: between the finest two the
+    run-out holding 99 % of the mass moves less than the threshold run-out (measured
+    3.6 % against 5.6 %; asserted only as an ordering, which is the claim the docs make)."""
+    from pdeflow.analysis.convergence import converge
+
+    case = load_case("cases/paper_5_1_dam_break.toml", ["case.models=['single_layer']"])
+    rows = converge(case, 3, "single_layer")["levels"]
+
+    def change(key: str) -> float:
+        return abs(rows[-1][key] - rows[-2][key]) / abs(rows[-1][key])
+
+    assert change("runout_mass_quantile") < change("runout")
