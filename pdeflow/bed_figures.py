@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from . import systems
-from .plotting import LAYER_STYLES, new_figure
+from .plotting import LAYER_STYLES, display_name, new_figure
 
 SIDE_VIEWS = 6
 """side views drawn, at evenly spaced frames from t = 0 to the end of the flow"""
@@ -31,7 +31,8 @@ def view_times(t: np.ndarray, duration: float | None, n: int = SIDE_VIEWS) -> li
 def _side_views(ax: Any, x: np.ndarray, t: np.ndarray, frames: Sequence[np.ndarray],
                 model: str, bed0: np.ndarray | None, picks: list[int]) -> None:
     """The layers of the frames ``picks`` stacked upwards with an offset each, the
-    original bed surface dashed."""
+    original bed surface dashed; each view's base is a y tick labelled with its time
+    (the offsets are no depths), and a bar at the right gives the depth scale."""
     system = systems.get(model)
     top = max(float(np.max(np.sum(np.maximum(frames[i][::2], 0), axis=0))) for i in picks)
     offset = 1.15 * top
@@ -50,9 +51,25 @@ def _side_views(ax: Any, x: np.ndarray, t: np.ndarray, frames: Sequence[np.ndarr
         if bed0 is not None:
             ax.plot(x, base + bed0, color="k", ls="--", lw=0.7,
                     label="original bed surface" if row == 0 else None)
-        ax.text(x[-1], base + 0.2 * offset, f"t = {t[i]:.2f} s", ha="right", fontsize=8)
-    ax.set_ylabel("depth [m] (views offset)")
-    ax.legend(loc="upper left", fontsize=7)
+    ax.set_yticks([row * offset for row in range(len(picks))],
+                  [f"t = {t[i]:.2f} s" for i in picks], fontsize=8)
+    ax.set_ylabel("side views (depths to the scale bar)")
+    scale = _scale_bar(top)
+    x_bar = x[-1] - 0.01 * (x[-1] - x[0])
+    ax.plot([x_bar, x_bar], [0.0, scale], color="k", lw=2)
+    ax.text(x_bar, 0.5 * scale, f"{scale:g} m ", ha="right", va="center", fontsize=8)
+    # above the panel, under the title: never over a profile
+    ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncols=3, fontsize=7,
+              frameon=False)
+
+
+def _scale_bar(top: float) -> float:
+    """The depth [m] of the scale bar: the largest 1, 2 or 5 times a power of ten that is
+    at most ``top`` [m] (the deepest view), so that the bar fits in one view."""
+    if not top > 0:
+        return 1.0
+    power = 10.0 ** np.floor(np.log10(top))
+    return float(max(m * power for m in (1, 2, 5) if m * power <= top))
 
 
 def _space_time(ax: Any, fig: Any, x: np.ndarray, t: np.ndarray,
@@ -102,11 +119,13 @@ def bed_figure(x: np.ndarray, t: np.ndarray, frames: Sequence[np.ndarray], model
     sub = [f[:, keep] for f in frames]
     b0 = None if bed0 is None else bed0[keep]
     _side_views(axes[0], x[keep], t, sub, model, b0, picks)
-    axes[0].set_title(f"{title}: {model.replace('_', ' ')}".strip(": "), fontsize=10)
+    label = systems.get(model).label
+    fig.suptitle(f"{display_name(title)}: {label}" if title else label, fontsize=10)
     for ax in axes:
         ax.grid(alpha=0.3)
-    # margins by hand: the colour bar sits beside the lower panel, outside the grid
-    fig.subplots_adjust(left=0.1, right=0.86, top=0.95, bottom=0.08, hspace=0.12)
+    # margins by hand: the colour bar sits beside the lower panel, outside the grid; the
+    # legend of the side views between the title and the panel
+    fig.subplots_adjust(left=0.12, right=0.86, top=0.92, bottom=0.08, hspace=0.12)
     _space_time(axes[1], fig, x[keep], t, sub, model, b0, series,
                 None if region is None else region[keep])
     return fig

@@ -29,6 +29,7 @@ from .plotting import (
     _short,
     _symbol,
     _velocity,
+    display_name,
     fixed_margins,
     new_figure,
     save,
@@ -143,18 +144,56 @@ class SnapshotFigures:
         return self.fig
 
 
+DEPOSIT_EDGE = 1e-3
+"""the deposit figure shows x up to 10 % beyond the last cell deeper than this fraction
+of the deepest deposit (or of the initial state): the deposit, not a thin tail or an
+empty domain"""
+
+
 def deposit_figure(x: np.ndarray, runs: Sequence[tuple[str, np.ndarray]],
-                   title: str = "", times: str = "", coordinate: str = "x") -> Any:
-    """Final deposits of the runs (model name, state data): the paper's Fig. 7."""
+                   title: str = "", times: str = "", coordinate: str = "x",
+                   initial: np.ndarray | None = None) -> Any:
+    """Final deposits of the runs (model name, state data): the paper's Fig. 7, with the
+    ``initial`` total depth [m] per cell (the released column) outlined if given, and
+    zoomed to the deposits (:data:`DEPOSIT_EDGE`)."""
     fig = new_figure((7, 3.2))
     ax = fig.subplots()
     plot_depths(ax, x, runs)
+    depths = [d[::2].sum(axis=0) for _, d in runs]
+    if initial is not None:
+        ax.plot(x, initial, color="0.35", ls="--", lw=1, label="initial state")
+        depths.append(initial)
     ax.legend(loc="upper right", fontsize=8)
+    deepest = max(float(np.max(h)) for h in depths)
+    wet = np.nonzero(np.max(depths, axis=0) > DEPOSIT_EDGE * deepest)[0]
+    if wet.size and deepest > 0:
+        dx = float(x[1] - x[0]) if x.size > 1 else 0.0
+        start, end = float(x[0]) - dx / 2, float(x[-1]) + dx / 2
+        ax.set_xlim(start, min(end, start + 1.1 * (float(x[wet[-1]]) + dx / 2 - start)))
+    ax.set_ylim(0, 1.25 * deepest if deepest > 0 else 1)  # room for the legend
     ax.set_xlabel(f"{coordinate} [m]")
     ax.grid(alpha=0.3)
     ax.set_title(f"{title}: final deposits\n{times}".strip(), fontsize=10)
     fixed_margins(fig, top=0.55)
     return fig
+
+
+def _initial_depth(res: Any) -> np.ndarray:
+    """The total depth [m] per cell of a run's initial state (its case's shape)."""
+    profiles = res.case.initial_profiles(res.model, res.state.grid)
+    return sum(profiles[layer.depth] for layer in res.pde.system.layers)
+
+
+def _stops(runs: Sequence[Any]) -> str:
+    """'(two layers at rest at t = 1.35 s, single layer at rest at 1.37 s)': each run's
+    state at the end, by its model's label."""
+    parts = []
+    for res in runs:
+        st = res.summary.get("stop_time")
+        label = res.pde.system.label
+        parts.append(f"{label} at rest at t = {st:.2f} s" if st
+                     else f"{label} still moving at t = {res.t_final:.2f} s")
+    return "(" + ", ".join(parts) + ")"
 
 
 def case_figures(results: dict[str, Any], outdir: str | Path, prefix: str = "",
@@ -172,8 +211,9 @@ def run_figure_jobs(results: dict[str, Any], outdir: str | Path | None = None,
     if plot:
         runs = list(results.values())
         jobs.append((deposit_figure, (runs[0].x, [(r.model, r.state.data) for r in runs],
-                                      runs[0].case.name, "",
-                                      COORDINATES[runs[0].case.geometry]), Path(plot)))
+                                      display_name(runs[0].case.name), _stops(runs),
+                                      COORDINATES[runs[0].case.geometry],
+                                      _initial_depth(runs[0])), Path(plot)))
     if outdir:
         jobs.extend(figure_jobs(results, outdir))
     return jobs
@@ -187,7 +227,8 @@ def figure_jobs(results: dict[str, Any], outdir: str | Path,
     outdir.mkdir(parents=True, exist_ok=True)
     runs = list(results.values())
     first = runs[0]
-    snapshots = SnapshotFigures(first.x, first.case.name, COORDINATES[first.case.geometry])
+    snapshots = SnapshotFigures(first.x, display_name(first.case.name),
+                                COORDINATES[first.case.geometry])
     jobs: list[Job] = []
     for t in sorted(set().union(*(res.snapshots for res in runs))):
         shown = [res for res in runs if t in res.snapshots]
@@ -196,13 +237,9 @@ def figure_jobs(results: dict[str, Any], outdir: str | Path,
         jobs.append((snapshots.draw, (t, [(res.model, res.snapshots[t][0])
                                           for res in shown], fextra),
                      outdir / f"{prefix}snapshot_t{t:g}.png"))
-    stop = []
-    for res in runs:
-        st = res.summary.get("stop_time")
-        stop.append(f"{res.model}: t={st:.2f} s" if st else f"{res.model}: moving")
     jobs.append((deposit_figure, (first.x, [(res.model, res.state.data) for res in runs],
-                                  first.case.name, "(" + ", ".join(stop) + ")",
-                                  snapshots.coordinate),
+                                  display_name(first.case.name), _stops(runs),
+                                  snapshots.coordinate, _initial_depth(first)),
                  outdir / f"{prefix}final_deposits.png"))
     jobs.extend(bed_jobs(runs, outdir, prefix))
     return jobs

@@ -41,6 +41,8 @@ def validate(case: Case) -> None:
             check_range("output.snapshot_times", t, 0, case.t_end, unit="s")
         check_range("output.front_threshold", case.front_threshold, 0, math.inf,
                     low_open=True, unit="m")
+        check_range("output.runout_mass_fraction", case.runout_mass_fraction, 0, 1,
+                    low_open=True, high_open=True)
         check_range("output.series_every", case.series_every, 0, case.t_end,
                     low_open=True, unit="s")
     except ValueError as err:

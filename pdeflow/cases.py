@@ -14,7 +14,7 @@ names the key and the file. Sections (all optional except ``[initial]``)::
                   "muscl", limiter = "minmod" | "mc", splitting = "lie" | "strang"
     [two_layer]   any field of TwoLayerParameters
     [single_layer] any field of SingleLayerParameters
-    [output]      snapshot_times [s], front_threshold [m]
+    [output]      snapshot_times [s], front_threshold [m], runout_mass_fraction
     [sweep]       aspect_ratios = [a, ...] (H0 = a L0; see pdeflow.analysis.sweep)
 
 Initial shapes (x measured from the left end of the domain):
@@ -60,6 +60,7 @@ from .initial_shapes import (
     profiles_from_file,
     total_depth,
 )
+from .metrics import RUNOUT_MASS_FRACTION
 from .variant import Variant, variant_of
 
 PAPER_MODEL = "two_layer"
@@ -92,7 +93,8 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
                  "flux": (str,), "reconstruction": (str,), "limiter": (str,),
                  "splitting": (str,)},
     "output": {"snapshot_times": (list,), "front_threshold": (float, int),
-               "frames": (str,), "erosion_series": (str,), "series_every": (float, int)},
+               "runout_mass_fraction": (float, int), "frames": (str,),
+               "erosion_series": (str,), "series_every": (float, int)},
     "sweep": {"aspect_ratios": (list,)},
 }
 
@@ -239,6 +241,12 @@ class Case:
     @property
     def front_threshold(self) -> float:
         return float(self._get("output", "front_threshold", 1e-3))
+
+    @property
+    def runout_mass_fraction(self) -> float:
+        """The fraction of the mass within the mass-quantile front (0 < f < 1; default
+        :data:`pdeflow.metrics.RUNOUT_MASS_FRACTION`, 0.99)."""
+        return float(self._get("output", "runout_mass_fraction", RUNOUT_MASS_FRACTION))
 
     @property
     def erosion_series(self) -> bool:

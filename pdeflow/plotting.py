@@ -10,6 +10,7 @@ in m^2/s^2, times in s.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -49,6 +50,12 @@ def _symbol(name: str) -> str:
 
 def _short(layer: Any) -> str:
     return layer.label.replace(" layer", "")
+
+
+def display_name(name: str) -> str:
+    """A case's name as a figure's title shows it, not as its file is named:
+    'paper_5_1_dam_break' -> 'paper 5.1 dam break'."""
+    return re.sub(r"(?<=\d)_(?=\d)", ".", name).replace("_", " ")
 
 
 def fixed_margins(fig: Any, top: float, left: float = 0.9, right: float = 0.2,

@@ -29,7 +29,13 @@ from .analysis.erosion import (
 )
 from .cases import Case
 from .checks import RunWarning, cost_warning, domain_ends, result_warnings, solver_warning
-from .metrics import front_position, mass
+from .metrics import (
+    front_position,
+    mass,
+    mass_quantile_position,
+    total_depth,
+    weighted_depth,
+)
 from .models.base import GranularPDE
 from .numerics import layout as L
 from .numerics.layout import GEOMETRIES
@@ -239,7 +245,9 @@ def run_model(case: Case, model: str, *, tracker: Any = None,
 
 
 _COMMON_KEYS = ("model", "solver", "geometry", "bed", "t_final", "at_rest", "front_position",
-                "runout", "mass_relative_error", "steps", "wall_time_s", "stop_reason", "stop_time",
+                "runout", "front_mass_quantile", "runout_mass_quantile",
+                "runout_mass_fraction", "mass_relative_error", "steps", "wall_time_s",
+                "stop_reason", "stop_time",
                 "max_fextra_over_rho1", "flux_fallback_steps", "positivity_retries",
                 "mass_change", "runout_lower_bound", "domain_ends", "warnings")
 
@@ -255,6 +263,46 @@ def summary_keys(model: str, series: bool = False) -> tuple[str, ...]:
     return (*_COMMON_KEYS, *systems.get(model).summary_keys, *extra)
 
 
+_LENGTH_KEYS = ("front_position", "runout", "front_mass_quantile", "runout_mass_quantile",
+                "max_fextra_x", "bed_max_erosion_x", "bed_max_erosion_depth")
+
+
+def summary_unit(key: str) -> str | None:
+    """The unit of the summary number ``key`` ('-' for counts and ratios; None for a key
+    that is no number, e.g. 'model' or 'warnings'); volumes are per unit width on a
+    planar grid (m^2) and m^3 on an axisymmetric one."""
+    if key in ("t_final", "wall_time_s", "flow_duration") or key.endswith("_time"):
+        return "s"
+    if key in _LENGTH_KEYS:
+        return "m"
+    if "_volume" in key:
+        return "m^2 or m^3"
+    units = {"max_fextra_over_rho1": "m^2/s^2", "front_velocity_max": "m/s"}
+    if key in units:
+        return units[key]
+    if key in ("steps", "mass_relative_error", "mass_change", "runout_mass_fraction",
+               "flux_fallback_steps", "positivity_retries", "hyperbolicity_events",
+               "hyperbolicity_bisections"):
+        return "-"
+    return None
+
+
+def mass_front(res: RunResult, bed: np.ndarray | None = None) -> float | None:
+    """The mass-quantile front [m] of a run's final state: the position (a radius on an
+    axisymmetric grid) from the domain's start within which ``case.runout_mass_fraction``
+    of the mass lies (:func:`pdeflow.metrics.mass_quantile_position`); with an initial
+    ``bed`` [m], of the material above it (the deposit on the bed, clipped at 0, as
+    :func:`pdeflow.metrics.front_position` measures above the bed), else of the
+    layers' mass (relative densities)."""
+    d = res.state.data
+    metric = res.pde.metric(res.state.grid)
+    depth = (weighted_depth(d, res.pde.system.densities(res.pde.parameters)) if bed is None
+             else total_depth(d) - bed)
+    return mass_quantile_position(metric.faces, metric.volumes, depth,
+                                  res.case.runout_mass_fraction,
+                                  radial=metric.geometry == "axisymmetric")
+
+
 def summarize(res: RunResult, mass0: float, wall: float,
               initial: np.ndarray | None = None) -> dict[str, Any]:
     """The per-model summary written to the JSON summary file; ``initial`` (the initial
@@ -267,6 +315,7 @@ def summarize(res: RunResult, mass0: float, wall: float,
     cells = metric.cells
     bed = case.bed(res.model, res.x - case.x_start)
     front = front_position(res.x, d, case.front_threshold, dx, bed)
+    front_q = mass_front(res, bed)
     at_rest = "rest_time" in res.info.get("solver", {})
     diag = res.diagnostics
     out: dict[str, Any] = {
@@ -279,6 +328,12 @@ def summarize(res: RunResult, mass0: float, wall: float,
         "front_position": front,
         "runout": (front - case.x_start - case.L0) if (front is not None and case.L0)
         else None,
+        # the front that holds runout_mass_fraction of the mass: it converges with the
+        # grid, where the threshold front follows the last per mille of a thin tail
+        "front_mass_quantile": front_q,
+        "runout_mass_quantile": (front_q - case.x_start - case.L0)
+        if (front_q is not None and case.L0) else None,
+        "runout_mass_fraction": case.runout_mass_fraction,
         "mass_relative_error": abs(mass(d, cells, weights) - mass0) / mass0 if mass0 else 0.0,
         "mass_change": (mass(d, cells, weights) - mass0) / mass0 if mass0 else 0.0,
         "steps": int(res.info.get("solver", {}).get("steps", 0)),
@@ -319,8 +374,10 @@ def print_summary(summary: dict[str, Any], out: Any = None) -> None:
     out = out or sys.stdout
     rows = [("stop time", "stop_time", " s"), ("lower stop", "lower_stop_time", " s"),
             ("upper stop", "upper_stop_time", " s"), ("front", "front_position", " m"),
-            ("run-out", "runout", " m"), ("max F_extra/rho1", "max_fextra_over_rho1",
-                                           " m2/s2"),
+            ("run-out", "runout", " m"),
+            ("front {q} mass", "front_mass_quantile", " m"),
+            ("run-out {q} mass", "runout_mass_quantile", " m"),
+            ("max F_extra/rho1", "max_fextra_over_rho1", " m2/s2"),
             ("flow duration", "flow_duration", " s"),
             ("front speed max", "front_velocity_max", " m/s"),
             ("bed eroded", "bed_eroded_volume", " m2"),
@@ -334,8 +391,13 @@ def print_summary(summary: dict[str, Any], out: Any = None) -> None:
     models = summary["models"]
     if any(s.get("geometry") == "axisymmetric" for s in models.values()):
         # the front and the run-out are radii: R_f and R_f - R0
-        rows = [("front radius" if k == "front_position" else label, k, u)
+        rows = [("front radius" if k == "front_position" else
+                 "radius {q} mass" if k == "front_mass_quantile" else label, k, u)
                 for label, k, u in rows]
+    # the fraction of the mass-quantile rows, e.g. '99%' (the case's, one for all models)
+    q = next((s["runout_mass_fraction"] for s in models.values()
+              if s.get("runout_mass_fraction") is not None), None)
+    rows = [(label.format(q=f"{100 * q:.4g}%" if q else ""), k, u) for label, k, u in rows]
     # rows no model of the run has (a single-layer case: no lower/upper stop)
     rows = [row for row in rows if any(row[1] in s for s in models.values())]
     print(f"case {summary['case']}", file=out)
@@ -348,6 +410,7 @@ def print_summary(summary: dict[str, Any], out: Any = None) -> None:
 def _cell(model_summary: dict[str, Any], key: str, unit: str) -> str:
     """A table cell; a front or run-out cut off by the end of the domain reads '>= ...'."""
     text = _fmt(model_summary.get(key), unit)
-    if key in ("front_position", "runout") and model_summary.get("runout_lower_bound"):
+    if key in ("front_position", "runout", "front_mass_quantile", "runout_mass_quantile") \
+            and model_summary.get("runout_lower_bound"):
         return ">= " + text
     return text

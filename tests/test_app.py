@@ -530,3 +530,19 @@ def test_the_runout_page_shows_no_warnings_box_for_runs_at_rest(tmp_path):
     page = RunoutPage(tmp_path)
     assert len(page.points["two_layer"]) == 3 and page.warning_lines() == []
     assert not page.warnings.visible
+
+
+def test_runout_page_shows_the_mass_quantile_run_out_and_its_fit():
+    page = RunoutPage(CASES)
+    sweep_case = CASES / "collapse_sweep.toml"
+    ratios = sorted(set(load_case(sweep_case).data["sweep"]["aspect_ratios"]) | {5.0})
+    api = run_sweep(load_case(sweep_case), [float(a) for a in ratios])
+    for model, res in api["models"].items():
+        p, e = page.fit(model, "r_mass")
+        # the same runs, the same fit: only the summation order of the fit differs
+        assert (p, e) == pytest.approx((res["prefactor_mass"], res["exponent_mass"]),
+                                       rel=1e-12)
+        assert f"r_mass = {p:.3g} a^{e:.3f}" in page.fits.object
+        assert f"r_mass = {format_r(res['points_mass'][ratios.index(5.0)][1])}" in \
+            page.current.object
+    assert "99% of the mass" in page.fits.object

@@ -80,5 +80,5 @@ def test_an_axisymmetric_sweep_reports_the_deposit():
     planar = run_sweep(load_case(ROOT / "cases" / "collapse_sweep.toml",
                                  ["grid.dx=0.05", "grid.length=3", "sweep.aspect_ratios=[2]"]))
     assert set(planar["models"]["two_layer"]["runs"][0]) == {
-        "a", "r", "runout", "stop_time", "at_rest", "steps", "wall_time_s",
-        "mass_relative_error"}
+        "a", "r", "runout", "r_mass", "runout_mass", "stop_time", "at_rest", "steps",
+        "wall_time_s", "mass_relative_error"}

@@ -69,3 +69,26 @@ def test_the_figure_worker_draws_what_it_is_sent_and_says_why_not(runs, tmp_path
     idle = FigureWorker.start()  # a run that fails before its figures
     idle.close()
     assert idle.process.exitcode == 0
+
+
+def test_the_deposit_figure_names_the_case_and_models_outlines_the_release_and_zooms(
+        runs, tmp_path):
+    """Titles read as text (no file or model names with underscores); the initial column
+    is drawn; x ends 10 % beyond the deposit (the single layer's front, 5.95 m on this
+    grid, below the 7 m domain)."""
+    from pdeflow.case_figures import figure_jobs
+
+    jobs = figure_jobs(runs, tmp_path)
+    make, args, path = jobs[-1]
+    assert path.name == "final_deposits.png"
+    ax = make(*args).axes[0]
+    title = ax.get_title()
+    assert title.startswith("paper 5.1 dam break: final deposits")
+    assert "two layers at rest at t = " in title and "single layer at rest" in title
+    assert "_" not in title
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "initial state" in labels
+    line = next(ln for ln in ax.get_lines() if ln.get_label() == "initial state")
+    assert np.max(line.get_ydata()) == pytest.approx(2.0)  # H0 of the case, exactly set
+    front = runs["single_layer"].summary["front_position"]
+    assert ax.get_xlim()[1] == pytest.approx(1.1 * front, rel=0.02)  # a cell (0.05 m)

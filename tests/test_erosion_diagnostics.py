@@ -162,6 +162,24 @@ def test_bed_figures_are_written(eroding_run, tmp_path):
     assert (tmp_path / "bed_two_layer.png").stat().st_size > 10_000
 
 
+def test_bed_figure_labels_views_by_time_and_keeps_its_legend_off_the_profiles(eroding_run):
+    """The side views' y ticks are their times, not offset depths; the legend sits above
+    the panel (its bottom at or above the panel's top, in axes coordinates)."""
+    from pdeflow.bed_figures import bed_figure
+
+    case, res = eroding_run
+    xs = res.x - case.x_start
+    t, frames = res.frames
+    fig = bed_figure(res.x, t, frames, res.model, case.bed(res.model, xs), res.series,
+                     case.name, res.summary["flow_duration"], case.bed_region(xs))
+    ax = fig.axes[0]
+    fig.canvas.draw()
+    assert all(tick.get_text().startswith("t = ") for tick in ax.get_yticklabels())
+    box = ax.get_legend().get_window_extent().transformed(ax.transAxes.inverted())
+    assert box.y0 >= 1.0 - 1e-9
+    assert "_" not in fig._suptitle.get_text() and "two layers" in fig._suptitle.get_text()
+
+
 @pytest.mark.parametrize("override, message", [
     ("output.erosion_series='maybe'", "output.erosion_series must be one of"),
     ("output.series_every=0", "output.series_every"),

@@ -71,7 +71,7 @@ def test_exchange_limited_never_negative_nor_overshooting(h1, h2, du, dt, c, k, 
 
 
 def test_paper_closure_deposits_everything_at_zero_relative_velocity():
-    """The singularity of closure (25) at du = 0 (REFERENCE section 6), documented."""
+    """The singularity of closure (25) at du = 0 (docs/model.md), documented."""
     r, g, tan = 0.67, 9.81, np.tan(np.radians(30))
     assert exchange_depth(0.5, 0.5, 0.0, 1e-3, r, g, tan, 0.8, 0.01, 0.0, 1e-3, 0.0) == -0.5
     bounded = exchange_depth(0.5, 0.5, 0.0, 1e-3, r, g, tan, 0.8, 0.01, 0.3, 1e-3, 0.0)

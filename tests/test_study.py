@@ -333,3 +333,22 @@ def test_study_kernels_are_prepared_for_every_model_before_the_workers():
     before, after = json.loads(line[len("SIGNATURES"):])
     assert before == 0
     assert set(after) == {1}
+
+
+def test_the_scatter_labels_carry_units():
+    """The report's scatter axes name each column's unit: model parameters from their
+    dataclass's docstrings, run quantities from the summary, case keys by table."""
+    from pdeflow.study.report import _label, unit_of
+
+    assert unit_of("two_layer.phi_b_deg") == "deg"
+    assert unit_of("two_layer.du_reg") == "m/s"
+    assert unit_of("two_layer.c") == "-"
+    assert unit_of("two_layer.runout") == "m"
+    assert unit_of("two_layer.runout_mass_quantile") == "m"
+    assert unit_of("two_layer.lower_stop_time") == "s"
+    assert unit_of("single_layer.max_fextra_over_rho1") == "m^2/s^2"
+    assert unit_of("initial.wedge_angle_deg") == "deg"
+    assert unit_of("grid.dx") == "m"
+    assert unit_of("sweep.two_layer.exponent") == "-"
+    assert unit_of("score") is None
+    assert _label("two_layer.runout") == "two_layer.runout [m]"

@@ -13,6 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from axisymmetric import BREAK, PROFILE_RATIOS, R0, SETS, lube_height, lube_runout  # noqa: E402
 
+from pdeflow.metrics import mass_quantile_position  # noqa: E402
 from pdeflow.plotting import log_ticks, save  # noqa: E402
 
 STYLE = {"single layer": ("tab:red", "o"), "two layers, defaults": ("tab:blue", "s"),
@@ -20,6 +21,22 @@ STYLE = {"single layer": ("tab:red", "o"), "two layers, defaults": ("tab:blue", 
 """set -> (colour, marker)"""
 A_TICKS = (0.5, 1, 2, 5, 10, 20)
 LUBE = "Lube et al. 2004 (as remembered, not confirmed)"
+ZOOM_FRACTION = 0.95
+"""the deposit figure's r axis ends 15 % beyond the radius holding this fraction of the
+two-layer deposits' mass (or Lube's R_inf): the deposits the page compares with the
+experiments; a deposit reaching farther (the single layer's spreads 90 % of its mass
+over 16 R0 at a = 10) runs off the panel, its radius written at the edge"""
+ZOOMED_SETS = ("two layers, defaults", "two layers, planar law set")
+
+
+def deposit_radius(x: np.ndarray, h: np.ndarray, fraction: float = ZOOM_FRACTION) -> float:
+    """The radius [units of ``x``] holding ``fraction`` of the mass of a radial deposit of
+    depth ``h`` at the uniform cell centres ``x`` (pdeflow's mass quantile)."""
+    dr = float(x[1] - x[0])
+    faces = np.concatenate([[x[0] - dr / 2], x + dr / 2])
+    radius = mass_quantile_position(faces, np.pi * np.diff(faces**2), h, fraction,
+                                    radial=True)
+    return float(faces[-1]) if radius is None else radius
 
 
 def _loglog(ax: Any, ylabel: str, yticks: list[float]) -> None:
@@ -66,7 +83,9 @@ def figure_height(numbers: dict[str, Any], path: Path) -> Path:
 
 def figure_profiles(numbers: dict[str, Any], profiles: dict[str, Any], path: Path) -> Path:
     """Deposits h/R0 against r/R0 for a = 0.5, 2, 5, 10; the lower layer dotted; the
-    straight cone through Lube's final height and run-out as the experiments' outline."""
+    straight cone through Lube's final height and run-out as the experiments' outline;
+    the initial column's edge (its top, h/R0 = a, named where it is above the panel);
+    r zoomed to the deposits (:data:`ZOOM_FRACTION`)."""
     fig, axes = plt.subplots(len(PROFILE_RATIOS), 1, figsize=(6.5, 8.5))
     for ax, a in zip(axes, PROFILE_RATIOS, strict=True):
         H, rr = float(lube_height(np.array([a]))[0]), float(lube_runout(np.array([a]))[0])
@@ -75,6 +94,7 @@ def figure_profiles(numbers: dict[str, Any], profiles: dict[str, Any], path: Pat
         ax.plot([0, 1, 1], [a, a, 0], color="gray", lw=0.8,
                 label="initial column" if a == PROFILE_RATIOS[0] else None)
         xmax, ymax = 1.0, min(H, a)
+        radius: dict[str, float] = {}
         for name in SETS:
             p = profiles[f"{name}|{a:g}"]
             colour = STYLE[name][0]
@@ -82,11 +102,20 @@ def figure_profiles(numbers: dict[str, Any], profiles: dict[str, Any], path: Pat
             ax.plot(x, h, color=colour, lw=1.2, label=name if a == PROFILE_RATIOS[0] else None)
             if name != "single layer":
                 ax.plot(x, p["h_lower"] / R0, ":", color=colour, lw=1)
-            wet = np.nonzero(p["h"] > 1e-3)[0]
-            xmax = max(xmax, x[wet[-1]] if wet.size else 1.0, 1 + rr)
+            radius[name] = deposit_radius(x, h)
+            if name in ZOOMED_SETS:
+                xmax = max(xmax, radius[name], 1 + rr)
             ymax = max(ymax, float(h.max()))
-        ax.set_xlim(0, 1.1 * xmax)
+        ax.set_xlim(0, 1.15 * xmax)
         ax.set_ylim(0, 1.2 * ymax)
+        beyond = [name for name in SETS if radius[name] > 1.15 * xmax]
+        for k, name in enumerate(beyond):  # in the set's colour, one line each
+            ax.text(1.15 * xmax, (0.55 - 0.12 * k) * ymax, f"{name}: {100 * ZOOM_FRACTION:g}"
+                    f" % of its mass within r/R0 = {radius[name]:.1f} \u2192", ha="right",
+                    fontsize=7, color=STYLE[name][0])
+        if a > 1.2 * ymax:  # the column's top is above the panel: say where
+            ax.text(1.02, 1.15 * ymax, f"initial column: r < R0, h/R0 = {a:g}",
+                    fontsize=7, va="top", color="gray")
         ax.set_ylabel("h/R0")
         ax.set_title(f"a = {a:g}", fontsize=9, loc="left")
     axes[-1].set_xlabel("r/R0")

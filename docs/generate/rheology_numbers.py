@@ -3,7 +3,7 @@
 the run-outs per grid halving and the ranking of the laws on every grid.
 
 The experiments' laws: planar, Lube et al. (2005), r = 1.9 a^(2/3) above a = 2.8
-(REFERENCE section 4; :data:`pdeflow.analysis.sweep.PUBLISHED_LAWS`); axisymmetric, Lube et
+(:data:`pdeflow.analysis.sweep.PUBLISHED_LAWS`, which cites the paper); axisymmetric, Lube et
 al. (2004) as docs/axisymmetric.md uses it (:func:`axisymmetric.lube_runout`, not confirmed
 there). The distances are those of docs/rheology.md's planar table before (mean |ln(r /
 r_Lube)| over a > 2.8) and of docs/axisymmetric.md (exp of the rms of ln(r / r_Lube) minus 1).

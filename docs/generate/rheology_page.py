@@ -14,7 +14,9 @@ from rheology_sources import LAGREE, PARAMETERS
 
 GEOMETRY_TEXT = {
     "planar": ("Planar collapses (test 5.2)", "Lube et al. (2005), r = 1.9 a^(2/3) for "
-               "a > 2.8 (REFERENCE section 4)", "mean |ln(r/r_Lube)| over a > 2.8"),
+               "a > 2.8 (Lube, Huppert, Sparks & Freundt 2005, *Collapses of "
+               "two-dimensional granular columns*, Phys. Rev. E 72, 041301)",
+               "mean |ln(r/r_Lube)| over a > 2.8"),
     "axisymmetric": ("Axisymmetric collapses", "Lube et al. (2004) as docs/axisymmetric.md "
                      "uses it, r = 1.24 a below a = 1.7 and 1.6 a^(1/2) above (remembered, "
                      "not confirmed there)",
@@ -227,7 +229,10 @@ def render_page(numbers: dict[str, Any], figs: dict[str, str]) -> str:
         "6 m), on successively halved grids; the planar sweep also runs `mu_i` with the "
         "mu(I) constants of Lagree, Staron & Popinet (2011) (`mu_i_lagree`). The laws are "
         "not calibrated to the experiments: this compares their shapes at their papers' "
-        "values.\n",
+        "values. The run-out r = (R - L0)/L0 uses the threshold front R (the downstream "
+        "face of the last cell deeper than 1 mm) in every fit, distance and figure; the "
+        "cached rows predate the run-out holding 99 % of the mass (`runout_mass_quantile`), "
+        "which `--rerun` would be needed to add.\n",
         "## The answer\n", *summary_lines(numbers), "",
         f"Checks: every run ended at rest: {numbers['all_at_rest']}; largest relative mass "
         f"error {numbers['max_mass_error']:.1e}; run warnings other than the cost "

@@ -14,7 +14,8 @@ checked on finer grids, and set against published laws.
 2. Grid convergence of the 5.2 fit for representative sets (dx = 0.01 .. 0.00125 m), the
    converged-grid map and the study maps, and the single layer on the same grids
    (two_layer_law_single.py, cached in docs/two_layer_law_single_layer.csv).
-3. The computed r(a) against the published planar-collapse laws (REFERENCE section 4).
+3. The computed r(a) against the published planar-collapse laws
+   (:data:`pdeflow.analysis.sweep.PUBLISHED_LAWS`, which cites the papers).
 
 The page opens with the question and the answer (two_layer_law_answer.py), then how
 we know, then the tables as an appendix.
@@ -103,7 +104,8 @@ MAP_DX = [0.0025, 0.00125]
 REFINE_DX = 0.000625
 MUSCL = ["numerics.reconstruction='muscl'", "numerics.limiter='mc'"]
 
-# Published planar-collapse laws, r = (R - L0)/L0 against a = H0/L0 (REFERENCE section 4)
+# Published planar-collapse laws, r = (R - L0)/L0 against a = H0/L0 (cited in
+# pdeflow.analysis.sweep.PUBLISHED_LAWS and PUBLISHED_EXPONENTS)
 LAWS = {name: partial(published_law, name, bridge=True) for name in PUBLISHED_LAWS}
 EXPONENTS = PUBLISHED_EXPONENTS
 
@@ -661,7 +663,10 @@ def experiments_section(dist_rows: list[tuple[str, dict]]) -> list[str]:
     lines = ["", "### Against experiments and DEM", "",
              "r = (R - L0)/L0 with R the front (last cell deeper than 1 mm) in every "
              "model; the experiments define R by the farthest grains of the deposit, "
-             "which a 1 mm threshold approximates for these 0.1 m columns. RMS distance "
+             "which a 1 mm threshold approximates for these 0.1 m columns. Every fit on "
+             "this page uses this threshold front (the stored tables predate the run-out "
+             "holding 99 % of the mass, r_mass, that `pdeflow sweep` now fits too). RMS "
+             "distance "
              "in log10 over a = 2 .. 30 (0.1 = a factor 1.26), and the fitted exponent "
              "against the exponent-only laws:", "",
              "| run | fit | " + " | ".join(LAWS) + " | "

@@ -40,7 +40,7 @@ from ..study.core import Executor, Study, serial
 from .points import Point, refined
 
 QOI_KEYS = ("lower_stop_time", "upper_stop_time", "lower_slow_time", "upper_slow_time",
-            "stop_time", "runout", "max_fextra_over_rho1")
+            "stop_time", "runout", "runout_mass_quantile", "max_fextra_over_rho1")
 
 
 def qoi_row(point: Point, volume_times: tuple[float, ...]) -> dict[str, Any]:
@@ -159,7 +159,8 @@ def fit_row(point: Point) -> dict[str, Any]:
     t0 = time.perf_counter()
     res = run_sweep(point.case, models=[point.model])["models"][point.model]
     return {"dx": point.case.dx, "prefactor": res["prefactor"],
-            "exponent": res["exponent"], "all_at_rest": res["all_at_rest"],
+            "exponent": res["exponent"], "prefactor_mass": res["prefactor_mass"],
+            "exponent_mass": res["exponent_mass"], "all_at_rest": res["all_at_rest"],
             "points": res["points"], "wall_time_s": time.perf_counter() - t0}
 
 
@@ -171,7 +172,8 @@ def converge_sweep(case: Case, levels: int, model: str = PAPER_MODEL,
     rows = Study(points, fit_row).execute(executor, "grid levels" if progress else None)
     return {"case": case.name, "model": model, "levels": rows,
             "analysis": {k: richardson([r[k] for r in rows])
-                         for k in ("prefactor", "exponent")}}
+                         for k in ("prefactor", "exponent", "prefactor_mass",
+                                   "exponent_mass")}}
 
 
 def _fmt(v: Any) -> str:
@@ -183,12 +185,13 @@ def _fmt(v: Any) -> str:
 
 
 #: units of the quantities, for table headers
-UNITS = {"dx": "m", "wall_time_s": "s", "runout": "m", "max_fextra_over_rho1": "m^2/s^2",
+UNITS = {"dx": "m", "wall_time_s": "s", "runout": "m", "runout_mass_quantile": "m",
+         "max_fextra_over_rho1": "m^2/s^2",
          "max_fextra_x": "m", "max_fextra_time": "s"}
 #: the columns ``pdeflow converge`` prints by default (``--all``: every quantity)
 SHORT_VIEW = ("dx", "cells", "stop_time", "lower_stop_time", "upper_stop_time", "runout",
-              "max_fextra_over_rho1", "wall_time_s")
-SWEEP_VIEW = ("dx", "prefactor", "exponent", "all_at_rest", "wall_time_s")
+              "runout_mass_quantile", "max_fextra_over_rho1", "wall_time_s")
+SWEEP_VIEW = ("dx", "prefactor", "exponent", "exponent_mass", "all_at_rest", "wall_time_s")
 
 
 def header(key: str) -> str:

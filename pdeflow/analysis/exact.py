@@ -1,4 +1,8 @@
-"""Exact solutions used to verify the schemes (REFERENCE formulas, restated here)."""
+"""Exact solutions used to verify the schemes, their formulas restated here: Ritter's
+frictionless dam break (Ritter 1892, Die Fortpflanzung der
+Wasserwellen, Z. Ver. Dtsch. Ing. 36, 947-954) and its extension to a
+slope with Coulomb friction (Mangeney, Heinrich & Roche 2000, Analytical solution for
+testing debris avalanche numerical models, Pure Appl. Geophys. 157, 1081-1096)."""
 
 from __future__ import annotations
 

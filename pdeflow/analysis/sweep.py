@@ -7,8 +7,13 @@ A sweep case is an ordinary case file with a ``[sweep]`` section::
 
 For every a the column height is set to H0 = a L0 and every model of the case is run to
 rest; the normalised run-out r = (R - L0)/L0 uses the front position R (downstream face
-of the last cell with total depth above ``output.front_threshold``). A power law
-r = p a^e is fitted by least squares on log r against log a. The paper reports
+of the last cell with total depth above ``output.front_threshold``), and
+r_mass = (R_mass - L0)/L0 the mass-quantile front R_mass (the distance from the rear
+wall, or the axis, that holds ``output.runout_mass_fraction`` of the mass, 99 % by
+default; :func:`pdeflow.metrics.mass_quantile_position`), which converges with the grid
+where R follows a thin tail. A power law r = p a^e is fitted by least squares on log r
+against log a, for each measure (``prefactor``, ``exponent``; ``prefactor_mass``,
+``exponent_mass``). The paper reports
 r = 2.25 a^1.06 (single layer, phi_B = 30 deg) and r = 1.61 a^0.84 (two layers); the DEM
 of Lacaze et al. (2008) gives the exponent 0.83 +- 0.03.
 """
@@ -32,12 +37,18 @@ from .points import Point, with_sets
 DEM_EXPONENT = 0.83
 
 PUBLISHED_LAWS = {"Lube et al. 2005": (1.8, 2.8), "Lajeunesse et al. 2005": (2.3, 2.3)}
-"""Planar-collapse experiments (REFERENCE section 4): r = 1.2 a below the first a given,
-r = 1.9 a^(2/3) above the second; in between a transition that neither law describes."""
+"""Planar-collapse experiments (Lube, Huppert, Sparks & Freundt 2005, "Collapses of
+two-dimensional granular columns", Phys. Rev. E 72, 041301; Lajeunesse, Monnier & Homsy
+2005, "Granular slumping on a horizontal surface", Phys. Fluids 17, 103302): r = 1.2 a
+below the first a given, r = 1.9 a^(2/3) above the second; in between a transition that
+neither law describes."""
 PUBLISHED_EXPONENTS = {"Balmforth & Kerswell 2005 (wide)": (0.9, 0.1),
                        "Balmforth & Kerswell 2005 (narrow)": (0.65, None),
                        "Lacaze et al. 2008 (DEM)": (DEM_EXPONENT, 0.03)}
-"""Laws given as an exponent only, r ~ a^e: name -> (e, its uncertainty or None)."""
+"""Laws given as an exponent only, r ~ a^e: name -> (e, its uncertainty or None).
+Balmforth & Kerswell 2005, Granular collapse in two dimensions, J. Fluid Mech. 538,
+399-428; Lacaze, Phillips & Kerswell 2008, Planar collapse of a granular column:
+experiments and discrete element simulations, Phys. Fluids 20, 063302."""
 
 
 def published_law(name: str, a: np.ndarray, bridge: bool = False) -> np.ndarray:
@@ -79,7 +90,9 @@ def sweep_ratios(case: Case) -> list[float]:
 def _runout_numbers(s: dict[str, Any], L0: float) -> dict[str, Any]:
     """The run-out numbers of one run's summary ``s`` (L0 [m]: column length or radius)."""
     r = None if s["runout"] is None else s["runout"] / L0
-    return {"r": r, "runout": s["runout"], "stop_time": s["stop_time"],
+    q = s["runout_mass_quantile"]
+    return {"r": r, "runout": s["runout"], "r_mass": None if q is None else q / L0,
+            "runout_mass": q, "stop_time": s["stop_time"],
             "at_rest": s["at_rest"], "steps": s["steps"], "wall_time_s": s["wall_time_s"],
             "mass_relative_error": s["mass_relative_error"]}
 
@@ -116,6 +129,13 @@ def deposit_row(point: Point) -> dict[str, Any]:
     return row
 
 
+def _fit(rows: list[dict[str, Any]], key: str) -> tuple[float | None, float | None]:
+    """(p, e) of r = p a^e over the ``rows`` at rest with a run-out ``key`` ('r' or
+    'r_mass'), or (None, None) with fewer than two."""
+    good = [(row["a"], row[key]) for row in rows if row[key] and row["at_rest"]]
+    return fit_power_law(*zip(*good, strict=True)) if len(good) >= 2 else (None, None)
+
+
 def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
               models: list[str] | None = None,
               executor: Executor = serial, progress: bool = False) -> dict[str, Any]:
@@ -132,7 +152,8 @@ def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
         raise CaseError(f"{case.source}: a sweep needs initial.L0 (shape = 'column')")
     models = models or case.models
     out: dict[str, Any] = {"case": case.name, "L0": L0, "dx": case.dx,
-                           "front_threshold": case.front_threshold, "models": {}}
+                           "front_threshold": case.front_threshold,
+                           "runout_mass_fraction": case.runout_mass_fraction, "models": {}}
     points = [Point(with_sets(case, [f"initial.H0={float(a) * L0!r}",
                                      "output.snapshot_times=[]"]), model,
                     labels={"model": model, "a": float(a)})
@@ -143,13 +164,16 @@ def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
     for model in models:
         rows = [{k: v for k, v in row.items() if k != "model"} for row in table
                 if row["model"] == model]
-        good = [(row["a"], row["r"]) for row in rows if row["r"] and row["at_rest"]]
-        p, e = fit_power_law(*zip(*good, strict=True)) if len(good) >= 2 else (None, None)
+        p, e = _fit(rows, "r")
+        p_mass, e_mass = _fit(rows, "r_mass")
         out["models"][model] = {
             "points": [[row["a"], row["r"]] for row in rows],
+            "points_mass": [[row["a"], row["r_mass"]] for row in rows],
             "runs": rows,
             "prefactor": p,
             "exponent": e,
+            "prefactor_mass": p_mass,
+            "exponent_mass": e_mass,
             "paper_prefactor": (systems.get(model).paper_runout_law or (None, None))[0],
             "paper_exponent": (systems.get(model).paper_runout_law or (None, None))[1],
             "all_at_rest": all(row["at_rest"] for row in rows),
@@ -159,7 +183,8 @@ def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
 
 
 def sweep_figure(summary: dict[str, Any], path: str | Path) -> Path:
-    """Log-log plot of r against a with the fits, the paper's fits and the DEM slope."""
+    """Log-log plot of r against a with the fits, the paper's fits and the DEM slope; the
+    mass-quantile run-outs r_mass hollow (summaries without them: left out)."""
     import matplotlib.pyplot as plt
 
     from ..plotting import ASPECT_TICKS, log_ticks, save
@@ -181,6 +206,14 @@ def sweep_figure(summary: dict[str, Any], path: str | Path) -> Path:
         amin, amax = min(amin, pts[:, 0].min()), max(amax, pts[:, 0].max())
         rs.extend(pts[:, 1])
         ax.loglog(pts[:, 0], pts[:, 1], marker, color=color, label=f"{label}")
+        mass_pts = np.array([p for p in res.get("points_mass", []) if p[1]], dtype=float)
+        if mass_pts.size:  # the mass-quantile run-outs: hollow, the same colour
+            rs.extend(mass_pts[:, 1])
+            fit = (f", fit {res['prefactor_mass']:.2f} a^{res['exponent_mass']:.2f}"
+                   if res.get("prefactor_mass") else "")
+            ax.loglog(mass_pts[:, 0], mass_pts[:, 1], marker, color=color, mfc="none",
+                      label=f"{label}, {100 * summary['runout_mass_fraction']:.4g}% of "
+                            f"the mass{fit}")
         aa = np.geomspace(pts[:, 0].min(), pts[:, 0].max(), 50)
         if res["prefactor"]:
             ax.loglog(aa, res["prefactor"] * aa ** res["exponent"], "-", color=color,
@@ -238,6 +271,7 @@ def cmd_sweep(args: Any) -> int:
                    if res["prefactor"] else "no fit")
             print(f"{model:13} {fit}   (paper {res['paper_prefactor']} "
                   f"a^{res['paper_exponent']})   a:r {pts}")
+            _print_mass_fit(model, res, summary["runout_mass_fraction"])
             if res["runs"] and "H_inf_over_L0" in res["runs"][0]:  # axisymmetric
                 print(f"{'':13} a:H_inf/R0 " + ", ".join(
                     f"{row['a']:g}:{row['H_inf_over_L0']:.3g}" for row in res["runs"])
@@ -246,6 +280,15 @@ def cmd_sweep(args: Any) -> int:
                     else f"{row['a']:g}:-" for row in res["runs"]))
         print(f"wall time {summary['wall_time_s']:.2f} s")
     return 0
+
+
+def _print_mass_fit(model: str, res: dict[str, Any], fraction: float) -> None:
+    """The line of the mass-quantile run-outs of one model's sweep."""
+    pts = ", ".join(f"{a:g}:{r:.3g}" if r else f"{a:g}:-" for a, r in res["points_mass"])
+    fit = (f"r_mass = {res['prefactor_mass']:.3g} a^{res['exponent_mass']:.3f}"
+           if res["prefactor_mass"] else "r_mass: no fit")
+    print(f"{'':13} {fit}   (front holding {100 * fraction:.4g}% of the mass)   "
+          f"a:r_mass {pts}")
 
 
 if __name__ == "__main__":  # python -m: the command's errors and exit codes

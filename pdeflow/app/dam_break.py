@@ -390,7 +390,9 @@ class DamBreakPage:
                 f"<p>The same numbers from the command line:<br>"
                 f"<code class='pdeflow-command'>"
                 f"{escape(command_line(run.case_path, run.overrides))}</code></p>"
-                f"<p style='color:#666'>run-out = front - L0. The runs took "
+                f"<p style='color:#666'>run-out = front - L0 (front: the last cell "
+                f"deeper than the front threshold; '% mass': the distance from the wall "
+                f"or the axis that holds that share of the mass). The runs took "
                 f"{1000 * run.wall_time_s:.0f} ms; the animation's frames before the end "
                 f"come from a second run that stops at every frame time.</p>")
 

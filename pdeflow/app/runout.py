@@ -2,10 +2,11 @@
 and the published planar-collapse laws, with the fit of the set updating live.
 
 A point is :func:`pdeflow.analysis.sweep.run_sweep` of the selected sweep case at one aspect ratio
-a = H0/L0 (r = (R - L0)/L0, R the front), exactly what ``pdeflow sweep`` computes; the
-fit is :func:`pdeflow.analysis.sweep.fit_power_law` over the points at rest. The set starts as
-the case's ``sweep.aspect_ratios``; moving the a slider adds a point; changing a
-parameter recomputes every point of the set (they appear one by one).
+a = H0/L0 (r = (R - L0)/L0, R the threshold front; r_mass the same with the front that
+holds 99 % of the mass), exactly what ``pdeflow sweep`` computes; the fits are
+:func:`pdeflow.analysis.sweep.fit_power_law` over the points at rest, of each measure.
+The set starts as the case's ``sweep.aspect_ratios``; moving the a slider adds a point;
+changing a parameter recomputes every point of the set (they appear one by one).
 """
 
 from __future__ import annotations
@@ -146,10 +147,11 @@ class RunoutPage:
         self.status.object = ""
         return True
 
-    def fit(self, model: str) -> tuple[float, float] | None:
-        """(prefactor, exponent) of the set's points at rest, or None (< 2 points)."""
-        good = [(a, row["r"]) for a, row in sorted(self.points.get(model, {}).items())
-                if row["r"] and row["at_rest"]]
+    def fit(self, model: str, key: str = "r") -> tuple[float, float] | None:
+        """(prefactor, exponent) of the set's points at rest, or None (< 2 points), of
+        the threshold run-out (``key`` 'r') or the mass-quantile one ('r_mass')."""
+        good = [(a, row[key]) for a, row in sorted(self.points.get(model, {}).items())
+                if row[key] and row["at_rest"]]
         if len(good) < 2:
             return None
         return fit_power_law(*zip(*good, strict=True))
@@ -227,7 +229,8 @@ class RunoutPage:
             p, e = PAPER_FITS[model]
             rest = "" if row["at_rest"] else " (still moving at t_end)"
             parts.append(f"<li>{label}: <b class='pdeflow-r-{model}'>r = "
-                         f"{format_r(row['r'])}</b>{rest}; paper's fit {p * a**e:.3g}</li>")
+                         f"{format_r(row['r'])}</b>{rest}; paper's fit {p * a**e:.3g}; "
+                         f"r_mass = {format_r(row['r_mass'])}</li>")
         if not parts:
             return f"<p>a = {a:g}: computing ...</p>" if self._todo else ""
         return f"<p><b>a = {a:g}</b></p><ul>{''.join(parts)}</ul>"
@@ -239,9 +242,17 @@ class RunoutPage:
             n = len(self.points.get(model, {}))
             p, e = PAPER_FITS[model]
             got = f"r = {fit[0]:.3g} a^{fit[1]:.3f}" if fit else "needs two points at rest"
-            rows.append(f"<li>{label}: <b>{got}</b> ({n} points; paper {p} a^{e})</li>")
+            fit_m = self.fit(model, "r_mass")
+            mass = f"; r_mass = {fit_m[0]:.3g} a^{fit_m[1]:.3f}" if fit_m else ""
+            rows.append(f"<li>{label}: <b>{got}</b> ({n} points; paper {p} a^{e}){mass}"
+                        f"</li>")
         todo = f"<p>computing {len(self._todo)} more ...</p>" if self._todo else ""
-        return f"<p>fit of the set:</p><ul>{''.join(rows)}</ul>{todo}"
+        return (f"<p>fit of the set:</p><ul>{''.join(rows)}</ul>{todo}"
+                f"<p style='color:#666'>r = (R - L0)/L0 with R the front (the last cell "
+                f"deeper than the case's front threshold), as the paper measures it; "
+                f"r_mass with R the distance from the wall that holds "
+                f"{100 * self.controls.case.runout_mass_fraction:.4g}% of the mass "
+                f"(it changes less with the grid).</p>")
 
     def warning_lines(self) -> list[str]:
         """The command line's warnings about the set's runs, each prefixed by its a."""

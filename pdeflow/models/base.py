@@ -13,6 +13,7 @@ only assembles the kernels into what py-pde expects:
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, fields
@@ -32,6 +33,33 @@ MAX_CFL = {"first-order": 1.0, "muscl": 0.5}
 """The largest Courant number of each reconstruction: the first-order update is positive
 up to 1; MUSCL's SSP-RK2 update with limited slopes keeps depths non-negative only up to
 1/2 (docs/stability.md)."""
+
+
+@functools.cache
+def field_units(cls: type) -> dict[str, str]:
+    """The unit of each field of a parameter dataclass, as its attribute docstring gives
+    it: the first bracket without a comma ('[deg]', '[m/s]', '[-]'; a range such as
+    '[0, 1)' is no unit); fields without one are left out."""
+    import ast
+    import inspect
+    import re
+
+    out: dict[str, str] = {}
+    for klass in reversed(cls.__mro__):
+        try:
+            tree = ast.parse(inspect.getsource(klass).lstrip())
+        except (OSError, TypeError, SyntaxError):
+            continue  # builtins, or no source
+        body = tree.body[0].body if tree.body and isinstance(tree.body[0], ast.ClassDef) \
+            else []
+        for stmt, doc in zip(body, body[1:], strict=False):
+            if (isinstance(stmt, ast.AnnAssign) and isinstance(stmt.target, ast.Name)
+                    and isinstance(doc, ast.Expr) and isinstance(doc.value, ast.Constant)
+                    and isinstance(doc.value.value, str)):
+                unit = re.search(r"\[([^\],]+)\]", doc.value.value)
+                if unit:
+                    out[stmt.target.id] = unit.group(1).strip()
+    return out
 
 
 def check_range(name: str, value: Any, low: float, high: float, *,

@@ -27,8 +27,8 @@ classical HLL flux; for S_L >= 0 (S_R <= 0) everything goes right (left).
 Layers at rest
 --------------
 HLL's numerical diffusion S_L S_R Delta h / (S_R - S_L) moves mass across a face even
-where the layer is at rest on both sides, so a Coulomb heap below its friction angle
-would creep (REFERENCE section 3). Where a layer has zero momentum on both sides of a
+where the layer is at rest on both sides, so a Coulomb heap below its friction angle would
+creep (tests/test_scheme_invariants.py). Where a layer has zero momentum on both sides of a
 face, its mass fluctuation is therefore zero and its hydrostatic jump is split by each
 side's *own* depth: for layer 1, D^-_{m1} = g_z h_{1L} Delta H / 2,
 D^+_{m1} = g_z h_{1R} Delta H / 2 (sum: Delta(g h1^2/2) + g h1bar Delta h2, unchanged).

@@ -6,7 +6,7 @@ The characteristic polynomial of the pseudo-Jacobian of (28) (g = g_z, r = rho1/
 
 The two external roots are always real; the inner pair (lambda_2, lambda_3) turns
 complex inside a band F_c1 < |du| < F_c2 of the relative velocity du = u1 - u2.
-Cheap closed-form screens (Castro-Diaz et al. 2023, REFERENCE section 2):
+Cheap closed-form screens (Castro-Díaz et al. 2023, Adv. Water Resour. 182, 104587):
 
 .. math::  F_L^2 = \frac{g H^3}{2 h_1 h_2}\Bigl[1 - \sqrt{1 - 4(1-r) h_1 h_2 / H^2}\Bigr]
            \le F_{c1}, \qquad F_R^2 = 2 g H (1 + \sqrt r) \ge F_{c2},

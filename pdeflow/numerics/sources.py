@@ -14,8 +14,8 @@ hydrostatic interface pressure -t_zz = rho1 g h1 from (20)-(21):
 .. math::  M/\rho_2 = \frac{t_1 - t_2}{\rho_2\, du}
            = \frac{c\, du^2 - (1-k)\, r g h_1 \tan\varphi_{int}}{\max(|du|, du_{reg})}.
 
-M > 0 erodes the lower layer into the upper one, M < 0 deposits. du_reg = 0 is the
-paper's closure, singular at du = 0 (REFERENCE section 6); du_reg > 0 bounds the rate.
+M > 0 erodes the lower layer into the upper one, M < 0 deposits. du_reg = 0 is the paper's
+closure, singular at du = 0 (docs/model.md, convergence.md); du_reg > 0 bounds the rate.
 The *equilibrium depth* at which M vanishes for the current du is
 h1_eq = c du^2 / ((1 - k) r g tan(phi_int)).
 

@@ -17,7 +17,7 @@ import warnings
 from dataclasses import dataclass
 from typing import Any
 
-from .spec import StudySpec
+from .spec import SWEEP_KEYS, StudySpec
 
 
 def _silence_run_warnings() -> None:
@@ -54,8 +54,7 @@ def _quantities(spec: StudySpec, point: dict[str, Any]) -> dict[str, Any]:
         case = spec.case_for(spec.sweep_case, point, sweep_models)
         fits = run_sweep(case, models=sweep_models)["models"]
         for model, fit in fits.items():
-            values.update({f"sweep.{model}.{k}": fit[k] for k in
-                           ("prefactor", "exponent", "all_at_rest")})
+            values.update({f"sweep.{model}.{k}": fit[k] for k in SWEEP_KEYS})
     return {q: values.get(q) for q in spec.quantities}
 
 

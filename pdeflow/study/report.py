@@ -124,6 +124,37 @@ def _quantities_section(ok: Any, cols: list[str]) -> list[str]:
     return out
 
 
+CASE_UNITS = {"grid.dx": "m", "grid.length": "m", "initial.L0": "m", "initial.H0": "m",
+              "initial.bed_thickness": "m", "initial.bed_length": "m",
+              "numerics.cfl": "-", "output.front_threshold": "m"}
+"""units of the case keys a study's parameters vary most (model keys: their dataclass's)"""
+
+
+def unit_of(key: str) -> str | None:
+    """The unit of a study column: a parameter ('two_layer.c', 'initial.H0', any
+    '*_deg'), a run quantity ('two_layer.runout') or a sweep's fit ('sweep.m.exponent':
+    '-'); None where none is known (derived expressions, objectives)."""
+    from .. import systems
+    from ..models.base import field_units
+    from ..simulate import summary_unit
+
+    parts = key.split(".")
+    if parts[0] == "sweep":
+        return "-" if parts[-1] != "all_at_rest" else None
+    if key.endswith("_deg"):
+        return "deg"
+    if len(parts) == 2 and parts[0] in systems.names():
+        params = field_units(systems.get(parts[0]).parameters_class)
+        return params.get(parts[1]) or summary_unit(parts[1])
+    return CASE_UNITS.get(key)
+
+
+def _label(key: str) -> str:
+    """An axis label: the column's name and its unit, 'two_layer.runout [m]'."""
+    unit = unit_of(key)
+    return f"{key} [{unit}]" if unit else key
+
+
 def _scatter_section(spec: StudySpec, ok: Any, num_params: list[str], shown: list[str],
                      outdir: Path, plt: Any, save: Any) -> list[str]:
     """scatter.png: every shown quantity against every numeric parameter."""
@@ -137,9 +168,9 @@ def _scatter_section(spec: StudySpec, ok: Any, num_params: list[str], shown: lis
             if p.scale == "log":
                 ax.set_xscale("log")
             if i == len(shown) - 1:
-                ax.set_xlabel(k, fontsize=7)
+                ax.set_xlabel(_label(k), fontsize=7)
             if j == 0:
-                ax.set_ylabel(q, fontsize=7)
+                ax.set_ylabel(_label(q), fontsize=7)
             ax.tick_params(labelsize=6)
     fig.tight_layout()
     save(fig, outdir / "scatter.png")

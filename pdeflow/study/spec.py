@@ -13,7 +13,8 @@ A study file is TOML, read and checked once; every error names the key (exit 2):
                                       # optimize: trials (population: generation size)
     seed = 1
     quantities = ["two_layer.runout"] # <model>.<summary key>, sweep.<model>.exponent|
-                                      # prefactor|all_at_rest; or the function's outputs
+                                      # prefactor|exponent_mass|prefactor_mass|
+                                      # all_at_rest; or the function's outputs
     [parameters]                      # any case key "section.key"
     "two_layer.c" = { range = [0.01, 3], scale = "log", points = 4 }
     "two_layer.k" = { values = [0.3, 0.5, 0.8] }
@@ -49,7 +50,9 @@ from ..simulate import summary_keys
 from .expressions import Expression, StudyError
 
 DESIGNS = ("grid", "lhs", "sobol", "optimize")
-SWEEP_KEYS = ("prefactor", "exponent", "all_at_rest")
+SWEEP_KEYS = ("prefactor", "exponent", "prefactor_mass", "exponent_mass", "all_at_rest")
+"""a sweep's numbers a study can ask for (sweep.<model>.<key>): the fits of the threshold
+run-out and of the mass-quantile run-out (:func:`pdeflow.analysis.sweep.run_sweep`)"""
 STUDY_KEYS = {"name", "description", "case", "set", "sweep_case", "function", "design",
               "samples", "seed", "population", "batch", "quantities"}
 SECTIONS = {"study", "base_case", "parameters", "derived", "objectives"}
