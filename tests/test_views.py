@@ -98,6 +98,7 @@ def test_plot_of_final_deposits_looks_like_the_runs_figure(stored_51, tmp_path,
     # both runs at rest: one panel of depths (no flat velocity and F_extra panels)
     assert len(fig.fig.axes) == 1 and fig.ax_u is None
     assert "final deposits" in fig.fig._suptitle.get_text()
+    assert fig.fig._suptitle.get_text().startswith("paper 5.1 dam break")  # not a file name
     texts = [t.get_text() for t in fig.ax_h.get_legend().get_texts()]
     assert texts == ["lower layer $h_2$", "upper layer $h_1$", "single layer"]
     single = fig._lines[1]["surface"]
