@@ -81,12 +81,14 @@ def plot_velocities(ax, x: np.ndarray, runs: Sequence[tuple[str, np.ndarray]]) -
 
 def snapshot_figure(x: np.ndarray, t: float, runs: Sequence[tuple[str, np.ndarray]],
                     fextra: np.ndarray | None, title: str = "",
-                    coordinate: str = "x") -> Any:
+                    coordinate: str = "x",
+                    xlim: tuple[float, float] | None = None) -> Any:
     """Three stacked panels at time t, like the paper's Figs. 3-6: depths and velocities
-    of the runs (model name, state data), F_extra/rho1 [m^2/s^2]."""
+    of the runs (model name, state data), F_extra/rho1 [m^2/s^2]; x limited to ``xlim``
+    [m] if given (:func:`reach`)."""
     fig = new_figure((7, 7.5))
     axes = fig.subplots(3, 1, sharex=True)
-    _snapshot_data(fig, x, t, runs, fextra, title)
+    _snapshot_data(fig, x, t, runs, fextra, title, xlim)
     axes[2].set_ylabel(r"$F_{extra}/\rho_1$ [m$^2$/s$^2$]")
     axes[2].set_xlabel(f"{coordinate} [m]")
     for ax in axes:
@@ -97,7 +99,7 @@ def snapshot_figure(x: np.ndarray, t: float, runs: Sequence[tuple[str, np.ndarra
 
 def _snapshot_data(fig: Any, x: np.ndarray, t: float,
                    runs: Sequence[tuple[str, np.ndarray]], fextra: np.ndarray | None,
-                   title: str) -> None:
+                   title: str, xlim: tuple[float, float] | None = None) -> None:
     """The runs' layers, velocities and F_extra/rho1 [m^2/s^2] at t [s] in the panels of
     a snapshot figure, their legends and the title."""
     axes = fig.axes
@@ -106,6 +108,8 @@ def _snapshot_data(fig: Any, x: np.ndarray, t: float,
     axes[2].plot(x, fextra if fextra is not None else np.zeros_like(x), color="tab:red")
     axes[0].legend(loc="upper right", fontsize=8)
     axes[1].legend(loc="upper right", fontsize=8)
+    if xlim is not None:
+        axes[0].set_xlim(*xlim)  # shared by the panels
     fig.suptitle(f"{title} t = {t:g} s".strip())
 
 
@@ -120,10 +124,12 @@ class SnapshotFigures:
         x: cell centres [m].
         title: the case's name (before "t = ... s").
         coordinate: the grid's coordinate, 'x' or 'r'.
+        xlim: the x range of every figure [m] (:func:`reach`), or None: the domain.
     """
 
-    def __init__(self, x: np.ndarray, title: str = "", coordinate: str = "x"):
-        self.x, self.title, self.coordinate = x, title, coordinate
+    def __init__(self, x: np.ndarray, title: str = "", coordinate: str = "x",
+                 xlim: tuple[float, float] | None = None):
+        self.x, self.title, self.coordinate, self.xlim = x, title, coordinate, xlim
         self.fig: Any = None
 
     def draw(self, t: float, runs: Sequence[tuple[str, np.ndarray]],
@@ -132,7 +138,7 @@ class SnapshotFigures:
         [m^2/s^2]: valid until the next call."""
         if self.fig is None:
             self.fig = snapshot_figure(self.x, t, runs, fextra, self.title,
-                                       self.coordinate)
+                                       self.coordinate, self.xlim)
             return self.fig
         for ax in self.fig.axes:
             for artist in [*ax.lines, *ax.collections, *ax.patches, *ax.texts]:
@@ -140,14 +146,27 @@ class SnapshotFigures:
             if ax.get_legend() is not None:
                 ax.get_legend().remove()
             ax.relim()  # no artist left: the limits of a new axes
-        _snapshot_data(self.fig, self.x, t, runs, fextra, self.title)
+        _snapshot_data(self.fig, self.x, t, runs, fextra, self.title, self.xlim)
         return self.fig
 
 
 DEPOSIT_EDGE = 1e-3
-"""the deposit figure shows x up to 10 % beyond the last cell deeper than this fraction
-of the deepest deposit (or of the initial state): the deposit, not a thin tail or an
-empty domain"""
+"""the figures show x up to 10 % beyond the last cell deeper than this fraction of the
+deepest state drawn (or of the initial state): the material, not a thin tail or an
+empty domain (:func:`reach`)"""
+
+
+def reach(x: np.ndarray, depths: Sequence[np.ndarray]) -> tuple[float, float] | None:
+    """The x range [m] of figures of the total ``depths`` [m] per cell (at the uniform
+    cell centres ``x``): from the domain's start to 10 % beyond the last cell deeper than
+    :data:`DEPOSIT_EDGE` of the deepest, at most the domain's end; None without material."""
+    deepest = max((float(np.max(h)) for h in depths), default=0.0)
+    if not deepest > 0:
+        return None
+    wet = np.nonzero(np.max(depths, axis=0) > DEPOSIT_EDGE * deepest)[0]
+    dx = float(x[1] - x[0]) if x.size > 1 else 0.0
+    start, end = float(x[0]) - dx / 2, float(x[-1]) + dx / 2
+    return start, min(end, start + 1.1 * (float(x[wet[-1]]) + dx / 2 - start))
 
 
 def deposit_figure(x: np.ndarray, runs: Sequence[tuple[str, np.ndarray]],
@@ -164,12 +183,10 @@ def deposit_figure(x: np.ndarray, runs: Sequence[tuple[str, np.ndarray]],
         ax.plot(x, initial, color="0.35", ls="--", lw=1, label="initial state")
         depths.append(initial)
     ax.legend(loc="upper right", fontsize=8)
+    xlim = reach(x, depths)
+    if xlim is not None:
+        ax.set_xlim(*xlim)
     deepest = max(float(np.max(h)) for h in depths)
-    wet = np.nonzero(np.max(depths, axis=0) > DEPOSIT_EDGE * deepest)[0]
-    if wet.size and deepest > 0:
-        dx = float(x[1] - x[0]) if x.size > 1 else 0.0
-        start, end = float(x[0]) - dx / 2, float(x[-1]) + dx / 2
-        ax.set_xlim(start, min(end, start + 1.1 * (float(x[wet[-1]]) + dx / 2 - start)))
     ax.set_ylim(0, 1.25 * deepest if deepest > 0 else 1)  # room for the legend
     ax.set_xlabel(f"{coordinate} [m]")
     ax.grid(alpha=0.3)
@@ -227,8 +244,12 @@ def figure_jobs(results: dict[str, Any], outdir: str | Path,
     outdir.mkdir(parents=True, exist_ok=True)
     runs = list(results.values())
     first = runs[0]
+    # every snapshot on the x range the material reached at any of them or at the end
+    states = [s[0] for res in runs for s in res.snapshots.values()]
+    states += [res.state.data for res in runs]
     snapshots = SnapshotFigures(first.x, display_name(first.case.name),
-                                COORDINATES[first.case.geometry])
+                                COORDINATES[first.case.geometry],
+                                reach(first.x, [d[::2].sum(axis=0) for d in states]))
     jobs: list[Job] = []
     for t in sorted(set().union(*(res.snapshots for res in runs))):
         shown = [res for res in runs if t in res.snapshots]

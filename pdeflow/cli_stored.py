@@ -49,7 +49,7 @@ def _say_nearest_frames(runs: list[Any], idx: list[int], t: float | None) -> Non
 
 def cmd_plot(args: argparse.Namespace) -> int:
     from .outpaths import FIGURE_SUFFIXES, check_file
-    from .plotting import RunFigure, Series
+    from .plotting import RunFigure, Series, display_name
     from .storage import open_run
 
     _positive("--fps", args.fps)
@@ -62,8 +62,8 @@ def cmd_plot(args: argparse.Namespace) -> int:
     runs = [open_run(p) for p in args.runs]
     series = [Series(r.x, r.model, lab, r.dry_tolerance, r.coordinate)
               for r, lab in zip(runs, _plot_labels(runs), strict=True)]
-    title = args.title if args.title is not None else runs[0].metadata.get(
-        "case_name", runs[0].path.stem)
+    title = args.title if args.title is not None else display_name(
+        runs[0].metadata.get("case_name", runs[0].path.stem))
     written = []
     if args.movie:
         from .trackers.live import replay

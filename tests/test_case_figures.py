@@ -35,11 +35,13 @@ def test_a_snapshot_redrawn_in_place_is_the_image_of_a_new_figure(runs, tmp_path
     assert len(jobs) >= 3
     series = jobs[0][0].__self__
     assert isinstance(series, SnapshotFigures)
-    fresh = [_pixels(snapshot_figure(series.x, *args, series.title, series.coordinate))
+    assert series.xlim is not None  # zoomed to the material (5.95 m of the 7 m domain)
+    fresh = [_pixels(snapshot_figure(series.x, *args, series.title, series.coordinate,
+                                     series.xlim))
              for _, args, _ in jobs]
     # in the jobs' order and backwards: what was drawn before does not show
     for order in (list(range(len(jobs))), list(range(len(jobs)))[::-1]):
-        again = SnapshotFigures(series.x, series.title, series.coordinate)
+        again = SnapshotFigures(series.x, series.title, series.coordinate, series.xlim)
         for i in order:
             assert np.array_equal(_pixels(again.draw(*jobs[i][1])), fresh[i]), i
 

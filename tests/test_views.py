@@ -59,7 +59,8 @@ def test_converge_prints_a_short_table_by_default(capsys):
     out = capsys.readouterr().out
     head = out.splitlines()[0]
     assert head.startswith("| dx [m] | cells | stop_time [s] |") and "V1(" not in head
-    assert head.count("|") - 1 <= 8 and "--all" in out
+    # 9 columns: the two run-outs (threshold and 99 % of the mass) side by side
+    assert head.count("|") - 1 <= 9 and "--all" in out
     assert main([*argv, "--all"]) == 0
     assert "V1(0.1) [m^2]" in capsys.readouterr().out.splitlines()[0]
 
@@ -97,6 +98,7 @@ def test_plot_of_final_deposits_looks_like_the_runs_figure(stored_51, tmp_path,
     # both runs at rest: one panel of depths (no flat velocity and F_extra panels)
     assert len(fig.fig.axes) == 1 and fig.ax_u is None
     assert "final deposits" in fig.fig._suptitle.get_text()
+    assert fig.fig._suptitle.get_text().startswith("paper 5.1 dam break")  # not a file name
     texts = [t.get_text() for t in fig.ax_h.get_legend().get_texts()]
     assert texts == ["lower layer $h_2$", "upper layer $h_1$", "single layer"]
     single = fig._lines[1]["surface"]

@@ -126,8 +126,9 @@ def markdown(res: dict[str, Any], figure: str | None) -> str:
           f"L0 = {sw['L0']} m, dx = {sw['dx']} m, front threshold {sw['front_threshold']} m, "
           "both models to rest (`pdeflow sweep cases/collapse_sweep.toml`). r = (R - L0)/L0 "
           "with R the threshold front (the downstream face of the last cell deeper than "
-          "the threshold), the paper's measure; the fits below are of it. `pdeflow sweep` "
-          "also fits r_mass, with R the distance from the wall holding 99 % of the mass "
+          "the threshold), a front as the paper's figures show it; the fits below are of "
+          "it. `pdeflow sweep` also fits r_mass, with R the distance from the wall "
+          "holding 99 % of the mass "
           "([user_guide.md](user_guide.md#studies-sweep-converge-compare)).", "",
           "| model | fit | paper | target | met? | (a, r) |", "|---|---|---|---|---|---|"]
     for model, m in sw["models"].items():

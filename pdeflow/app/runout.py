@@ -249,7 +249,8 @@ class RunoutPage:
         todo = f"<p>computing {len(self._todo)} more ...</p>" if self._todo else ""
         return (f"<p>fit of the set:</p><ul>{''.join(rows)}</ul>{todo}"
                 f"<p style='color:#666'>r = (R - L0)/L0 with R the front (the last cell "
-                f"deeper than the case's front threshold), as the paper measures it; "
+                f"deeper than the case's front threshold), a front as the paper's figures "
+                f"show it; "
                 f"r_mass with R the distance from the wall that holds "
                 f"{100 * self.controls.case.runout_mass_fraction:.4g}% of the mass "
                 f"(it changes less with the grid).</p>")
