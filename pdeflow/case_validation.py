@@ -37,8 +37,8 @@ def validate(case: Case) -> None:
         if "dt" in case.data.get("numerics", {}):
             check_range("numerics.dt", case.data["numerics"]["dt"], 0, math.inf,
                         low_open=True, unit="s")
-        for t in case.snapshot_times:
-            check_range("output.snapshot_times", t, 0, case.t_end, unit="s")
+        for t in case._all_snapshot_times():  # those past t_end are dropped
+            check_range("output.snapshot_times", t, 0, math.inf, unit="s")
         check_range("output.front_threshold", case.front_threshold, 0, math.inf,
                     low_open=True, unit="m")
         check_range("output.runout_mass_fraction", case.runout_mass_fraction, 0, 1,
@@ -99,10 +99,15 @@ def _check_sections(case: Case) -> None:
             systems.get(name).parameters_class.from_dict(case.data.get(name, {}))
         except (ValueError, TypeError) as err:
             raise _err(case, f"[{name}] {err}") from None
+    if not case.models:
+        raise _err(case, f"case.models must name at least one model of "
+                        f"{list(systems.names())}, got []")
     for model in case.models:
         if model not in systems.names():
             raise _err(case, f"case.models: unknown model {model!r}; allowed: "
                             f"{list(systems.names())}")
+    if len(set(case.models)) < len(case.models):
+        raise _err(case, f"case.models names a model twice: {case.models}")
 
 
 def _check_geometry(case: Case) -> None:
@@ -119,6 +124,12 @@ def _check_geometry(case: Case) -> None:
     if case.bc[0] != "wall":
         raise _err(case, "boundaries.left is the axis on an axisymmetric grid and must "
                         f"be 'wall' (symmetry: no flux), got {case.bc[0]!r}")
+    for model in case.models:
+        theta = systems.get(model).parameters_class.from_dict(
+            case.data.get(model, {})).theta_deg
+        if theta != 0.0:
+            raise _err(case, f"{model}.theta_deg must be 0 on an axisymmetric grid "
+                            f"(radial flow on a horizontal plane), got {theta:g}")
 
 def _check_finite(case: Case, key: str, value: Any) -> None:
     """Numbers (also inside lists) must be finite: TOML allows nan and inf."""

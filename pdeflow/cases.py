@@ -117,13 +117,7 @@ class Case:
     def from_file(cls, path: str | Path, overrides: list[str] | None = None) -> Case:
         """Read a TOML case file, apply ``section.key=value`` overrides, validate."""
         path = Path(path)
-        if not path.is_file():
-            raise CaseError(f"case file {path} does not exist")
-        try:
-            with path.open("rb") as fh:
-                data = tomllib.load(fh)
-        except tomllib.TOMLDecodeError as err:
-            raise CaseError(f"{path}: not valid TOML: {err}") from None
+        data = read_toml(path, "case file")
         case = cls(data, str(path), path.resolve().parent)
         for item in overrides or []:
             case.set(item)
@@ -228,6 +222,17 @@ class Case:
 
     @property
     def snapshot_times(self) -> list[float]:
+        """``output.snapshot_times`` up to ``t_end`` [s]: a short check of a case
+        (``--set case.t_end=0.1``) keeps its snapshots before t_end and drops the later
+        ones (:attr:`dropped_snapshot_times`)."""
+        return [t for t in self._all_snapshot_times() if t <= self.t_end]
+
+    @property
+    def dropped_snapshot_times(self) -> list[float]:
+        """``output.snapshot_times`` past ``t_end`` [s]: not taken (the run ends first)."""
+        return [t for t in self._all_snapshot_times() if t > self.t_end]
+
+    def _all_snapshot_times(self) -> list[float]:
         return [float(t) for t in self._get("output", "snapshot_times", [])]
 
     @property
@@ -388,6 +393,37 @@ def _hyperbolicity_sections() -> list[str]:
     """Models whose parameters have a ``hyperbolicity`` treatment (a Variant's choice)."""
     return [name for name in systems.names()
             if "hyperbolicity" in {f.name for f in fields(systems.get(name).parameters_class)}]
+
+
+def read_text(path: str | Path, what: str,
+              error: type[Exception] = CaseError) -> str:
+    """The text of the file ``path`` (``what``: 'case file', 'study file', for the
+    messages); a missing file, a directory or bytes that are not UTF-8 (TOML is UTF-8)
+    raise ``error`` with one line."""
+    path = Path(path)
+    if path.is_dir():
+        raise error(f"{path} is a directory; give a {what} (e.g. cases/*.toml)")
+    if not path.is_file():
+        raise error(f"{what} {path} does not exist")
+    try:
+        raw = path.read_bytes()
+    except OSError as err:
+        raise error(f"{what} {path} cannot be read ({err.strerror or err})") from None
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = raw[:err.start].count(b"\n") + 1
+        raise error(f"{path}: not UTF-8 text (byte {raw[err.start]:#04x} on line "
+                    f"{line}); save the file as UTF-8") from None
+
+
+def read_toml(path: str | Path, what: str) -> dict[str, Any]:
+    """The TOML table of the file ``path`` (:func:`read_text`; invalid TOML is a
+    one-line :class:`CaseError` too)."""
+    try:
+        return tomllib.loads(read_text(path, what))
+    except tomllib.TOMLDecodeError as err:
+        raise CaseError(f"{path}: not valid TOML: {err}") from None
 
 
 def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:

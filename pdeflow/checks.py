@@ -10,7 +10,8 @@ Before a run, from the case alone (no arrays are made):
 * :func:`check_memory` refuses a grid that needs more memory than the machine has
   (``Case.validate`` calls it), :func:`cost_warning` describes a long run;
 * :func:`solver_warning`: py-pde's method-of-lines solvers do not keep the model's
-  set-valued Coulomb friction and never stop at rest.
+  set-valued Coulomb friction and never stop at rest;
+* :func:`slope_warning`: the models of one case set on different slopes.
 
 After a run, :func:`domain_ends` finds material that reached an end of the domain and
 :func:`result_warnings` says what would mislead in the summary: a run still moving at
@@ -227,6 +228,21 @@ def solver_warning(case: Any) -> str | None:
             "scheme) for them")
 
 
+def slope_warning(case: Any) -> str | None:
+    """Why the models of ``case`` cannot be compared if they run on different slopes
+    (their ``theta_deg``; e.g. one model's slope set on the command line), else None."""
+    slopes = {m: systems.get(m).parameters_class.from_dict(case.data.get(m, {})).theta_deg
+              for m in case.models}
+    if len(set(slopes.values())) < 2:
+        return None
+    steepest = max(slopes.values())
+    listed = ", ".join(f"{m}.theta_deg = {t:g}" for m, t in slopes.items())
+    fix = " ".join(f"--set {m}.theta_deg={steepest:g}" for m, t in slopes.items()
+                   if t != steepest)
+    return (f"{case.name}: the models run on different slopes ({listed} deg), so their "
+            f"results are not comparable; set them alike (e.g. {fix})")
+
+
 def domain_ends(case: Any, initial: np.ndarray, final: np.ndarray,
                 mass_change: float, bed: np.ndarray | None = None) -> dict[str, Any]:
     """Where material reached an end of the domain that was clear of it initially.
@@ -261,6 +277,18 @@ def domain_ends(case: Any, initial: np.ndarray, final: np.ndarray,
             "open_through_material": reservoirs}
 
 
+def mass_through_ends(summary: dict[str, Any]) -> float | None:
+    """The relative mass that left (> 0) or entered (< 0) the domain through its open
+    ends in a run with ``summary``, where that is what changed the mass: material
+    reached an open end and the mass fell, or an open end cuts material from the start
+    (a reservoir), by more than :data:`MASS_WARN`. None otherwise: the mass change is
+    then the conservation error."""
+    ends = summary.get("domain_ends") or {}
+    change = summary.get("mass_change", 0.0)
+    through = (ends.get("outflow") and change < 0) or ends.get("open_through_material")
+    return -change if through and abs(change) > MASS_WARN else None
+
+
 def _end(case: Any, side: str) -> str:
     """'the open right end (x = 7 m)' or 'the wall at the left end (x = 0 m)' ('r' on an
     axisymmetric grid)."""
@@ -291,8 +319,7 @@ def result_warnings(case: Any, model: str, summary: dict[str, Any]) -> list[str]
                  "domain (grid.length)" if ends.get("runout_lower_bound") else "")
         out.append(f"{name}: material reached {where}{left}{bound}")
     change = summary.get("mass_change", 0.0)
-    explained = (ends.get("outflow") and change < 0) or ends.get("open_through_material")
-    if abs(change) > MASS_WARN and not explained:
+    if abs(change) > MASS_WARN and mass_through_ends(summary) is None:
         why = (" (py-pde's solvers clip negative depths)" if case.solver != "fv-split"
                else "")
         out.append(f"{name}: the mass changed by {100 * change:+.3g} % during the "

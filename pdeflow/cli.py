@@ -86,20 +86,35 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
 
 
 def _load_run_case(args: argparse.Namespace) -> Any:
-    """The case of ``pdeflow run``; a study file is pointed to ``pdeflow study``."""
-    import tomllib
+    """The case of ``pdeflow run``; a study file is pointed to ``pdeflow study``; what
+    the run leaves out of the file is said in notes on stderr (:func:`_case_notes`)."""
+    from .cases import CaseError, load_case, read_toml
 
-    from .cases import CaseError, load_case
-
-    try:
-        with open(args.case, "rb") as fh:
-            is_study = "study" in tomllib.load(fh)
-    except (OSError, tomllib.TOMLDecodeError):
-        is_study = False  # load_case says what is wrong with the file
-    if is_study:
+    data = read_toml(args.case, "case file")
+    if "study" in data:
         raise CaseError(f"{args.case} is a study file ([study]): run it with "
                         f"`pdeflow study {args.case}`")
-    return load_case(args.case, args.set)
+    case = load_case(args.case, args.set)
+    if not args.quiet:
+        for note in _case_notes(case, "sweep" in data, args.case):
+            print(f"pdeflow: note: {note}", file=sys.stderr)
+    return case
+
+
+def _case_notes(case: Any, sweep: bool, path: str) -> list[str]:
+    """What ``pdeflow run`` of the case file ``path`` does not do although the file
+    asks for it: the sweep of a sweep file (``sweep``: it has a [sweep]), snapshots
+    past t_end (a short check, ``--set case.t_end=0.1``)."""
+    notes = []
+    if sweep:
+        notes.append(f"{path} is a sweep file: `pdeflow run` runs its one column "
+                     f"(initial.H0 = {case.initial.get('H0', '-')} m), not its "
+                     f"sweep.aspect_ratios; `pdeflow sweep {path}` runs the sweep")
+    if case.dropped_snapshot_times:
+        times = ", ".join(f"{t:g}" for t in case.dropped_snapshot_times)
+        notes.append(f"output.snapshot_times {times} s lie past case.t_end = "
+                     f"{case.t_end:g} s: those snapshots are not taken")
+    return notes
 
 
 def _live_display() -> bool:

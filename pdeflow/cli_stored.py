@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from typing import Any
 
@@ -53,6 +54,10 @@ def cmd_plot(args: argparse.Namespace) -> int:
     from .storage import open_run
 
     _positive("--fps", args.fps)
+    if args.time is not None and not math.isfinite(args.time):
+        from .cases import CaseError
+
+        raise CaseError(f"--time must be a finite time [s], got {args.time!r}")
     check_file(args.out, "--out", FIGURE_SUFFIXES)
     check_file(args.movie, "--movie")
     if args.movie:

@@ -12,6 +12,7 @@ error is an :class:`pdeflow.io.OutputError`: one line naming the option and the 
 
 from __future__ import annotations
 
+import errno
 import os
 import tempfile
 from collections.abc import Iterable
@@ -31,8 +32,12 @@ def _probe(directory: Path, option: str, path: str | Path) -> None:
     try:
         fd, tmp = tempfile.mkstemp(prefix=".pdeflow-probe.", dir=directory)
     except OSError as err:
+        # a directory that exists but refuses new files with ENOENT is a kernel's
+        # (/proc, /sys): "No such file or directory" would be the wrong reason
+        reason = ("its file system takes no new files" if err.errno == errno.ENOENT
+                  and directory.is_dir() else err.strerror or str(err))
         raise OutputError(f"{option} {path}: cannot write in {directory} "
-                          f"({err.strerror or err})") from None
+                          f"({reason})") from None
     os.close(fd)
     os.unlink(tmp)
 

@@ -12,6 +12,8 @@ from __future__ import annotations
 import sys
 import time
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -28,7 +30,15 @@ from .analysis.erosion import (
     series_numbers,
 )
 from .cases import Case
-from .checks import RunWarning, cost_warning, domain_ends, result_warnings, solver_warning
+from .checks import (
+    RunWarning,
+    cost_warning,
+    domain_ends,
+    mass_through_ends,
+    result_warnings,
+    slope_warning,
+    solver_warning,
+)
 from .metrics import (
     front_position,
     mass,
@@ -160,7 +170,8 @@ class Run:
         mass) are issued as :class:`~pdeflow.checks.RunWarning`.
         """
         case, model = self.case, self.model
-        for message in (solver_warning(case), cost_warning(case, model)):
+        for message in (solver_warning(case), slope_warning(case),
+                        cost_warning(case, model)):
             if message:
                 warnings.warn(message, RunWarning, stacklevel=2)
         mass0 = mass(self.state.data, self.pde.metric(self.state.grid).cells,
@@ -170,17 +181,21 @@ class Run:
         series = SeriesTracker(case.series_every) if case.erosion_series else None
         if series is not None:
             trackers.append(series)
-        if tracker is not None:
-            trackers.extend(tracker if isinstance(tracker, list) else [tracker])
+        observers = [] if tracker is None else (
+            tracker if isinstance(tracker, list) else [tracker])
+        trackers.extend(observers)
         if not self.variant.is_mol and self.backend == "numba":
             # compiling (first run on a machine) or loading the kernels is not the run's
             # wall time, nor should it hold up its progress bar
             prepare(scheme_stepper(*scheme_codes(self.pde, self.variant.splitting,
                                                  GEOMETRIES[case.geometry])))
-        wall0 = time.perf_counter()
-        final, info = self.pde.solve(self.state, t_range=case.t_end, tracker=trackers,
-                                     ret_info=True, **self.solver_arguments())
-        wall = time.perf_counter() - wall0
+        with _observer_clock(observers) as observed:
+            wall0 = time.perf_counter()
+            final, info = self.pde.solve(self.state, t_range=case.t_end,
+                                         tracker=trackers, ret_info=True,
+                                         **self.solver_arguments())
+            # the run alone: a movie or a live plot takes longer than the run itself
+            wall = time.perf_counter() - wall0 - observed[0]
         stop = str(info.get("controller", {}).get("stop_reason", ""))
         from .interrupts import RunInterrupted, received
 
@@ -218,6 +233,42 @@ class Run:
         for message in result.summary["warnings"]:
             warnings.warn(message, RunWarning, stacklevel=2)
         return result
+
+
+@contextmanager
+def _observer_clock(trackers: list[Any]) -> Iterator[list[float]]:
+    """Within the block, the wall time [s] the ``trackers`` spend in their py-pde calls
+    (initialize, handle, finalize) adds up in the list's one item: the time of a run's
+    observers (movie, live plot, progress, storage), which the run's wall time leaves
+    out."""
+    spent = [0.0]
+    depth = [0]  # a tracker's call may make another (e.g. finalize a handle): once
+
+    def timed(call: Any) -> Any:
+        def wrapper(*args: Any, **kwargs: Any) -> Any:
+            depth[0] += 1
+            t0 = time.perf_counter()
+            try:
+                return call(*args, **kwargs)
+            finally:
+                depth[0] -= 1
+                if depth[0] == 0:
+                    spent[0] += time.perf_counter() - t0
+        return wrapper
+
+    from pde.trackers.base import TrackerBase
+
+    trackers = [t for t in trackers if isinstance(t, TrackerBase)]  # not names
+    names = ("initialize", "handle", "finalize")
+    for t in trackers:
+        for name in names:
+            setattr(t, name, timed(getattr(t, name)))
+    try:
+        yield spent
+    finally:
+        for t in trackers:  # the instance's wrappers go; its class's methods remain
+            for name in names:
+                t.__dict__.pop(name, None)
 
 
 def run_series(res: RunResult, tracker: SeriesTracker) -> ErosionSeries:
@@ -386,7 +437,8 @@ def print_summary(summary: dict[str, Any], out: Any = None) -> None:
             ("erosion depth", "bed_max_erosion_depth", " m"),
             ("  at x", "bed_max_erosion_x", " m"), ("  at t", "bed_max_erosion_time", " s"),
             ("bed moving max", "bed_moving_volume_max", " m2"),
-            ("mass error", "mass_relative_error", ""), ("steps", "steps", ""),
+            ("mass error", "mass_relative_error", ""),
+            ("mass outflow", "mass_outflow", ""), ("steps", "steps", ""),
             ("wall time", "wall_time_s", " s")]
     models = summary["models"]
     if any(s.get("geometry") == "axisymmetric" for s in models.values()):
@@ -399,7 +451,9 @@ def print_summary(summary: dict[str, Any], out: Any = None) -> None:
               if s.get("runout_mass_fraction") is not None), None)
     rows = [(label.format(q=f"{100 * q:.4g}%" if q else ""), k, u) for label, k, u in rows]
     # rows no model of the run has (a single-layer case: no lower/upper stop)
-    rows = [row for row in rows if any(row[1] in s for s in models.values())]
+    rows = [row for row in rows if any(row[1] in s for s in models.values())
+            or (row[1] == "mass_outflow" and any(mass_through_ends(s) is not None
+                                                 for s in models.values()))]
     print(f"case {summary['case']}", file=out)
     print(f"{'':18}" + "".join(f"{m:>16}" for m in models), file=out)
     for label, key, unit in rows:
@@ -408,7 +462,15 @@ def print_summary(summary: dict[str, Any], out: Any = None) -> None:
 
 
 def _cell(model_summary: dict[str, Any], key: str, unit: str) -> str:
-    """A table cell; a front or run-out cut off by the end of the domain reads '>= ...'."""
+    """A table cell; a front or run-out cut off by the end of the domain reads '>= ...';
+    where mass left or entered through an open end, its share is the 'mass outflow'
+    [%] and the 'mass error' (then no conservation error) is '-'."""
+    through = mass_through_ends(model_summary)
+    if key in ("mass_relative_error", "mass_outflow"):
+        if (through is None) == (key == "mass_outflow"):
+            return "-"
+        if through is not None:
+            return f"{100 * through:.4g} %"
     text = _fmt(model_summary.get(key), unit)
     if key in ("front_position", "runout", "front_mass_quantile", "runout_mass_quantile") \
             and model_summary.get("runout_lower_bound"):

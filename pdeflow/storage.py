@@ -382,6 +382,8 @@ def open_storage(path: str | Path) -> Any:
 
     require_h5py()
     path = Path(path)
+    if path.is_dir():
+        raise StorageError(f"{path} is a directory; give a stored run (.h5)")
     if not path.is_file():
         raise StorageError(f"stored run {path} does not exist")
     import h5py

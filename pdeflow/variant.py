@@ -45,14 +45,28 @@ GRAMMAR = ("FLUX/RECONSTRUCTION[/LIMITER][+SPLITTING][@HYPERBOLICITY] or "
            "mol-SOLVER[:FLUX/RECONSTRUCTION[/LIMITER]][@HYPERBOLICITY]")
 
 
+UNFIT_SOLVERS: dict[str, str] = {
+    "milstein": "a stochastic solver, and the models have no noise",
+    "explicit_mpi": "it runs only under MPI (mpi4py, mpiexec) on a grid split across "
+                    "processes",
+    "implicit": "its fixed-point iteration does not converge on the friction sources "
+                "(a ConvergenceError on test 5.1)",
+    "crank-nicolson": "its fixed-point iteration does not converge on the friction "
+                      "sources (a ConvergenceError on test 5.1)",
+}
+"""py-pde's registered solvers that cannot run a case, and why: they are not offered"""
+
+
 def solver_names() -> list[str]:
     """Solvers a variant can name: fv-split first, then py-pde's registered solvers
-    (each integrates the method-of-lines rate)."""
+    that can run a case (each integrates the method-of-lines rate; not
+    :data:`UNFIT_SOLVERS`)."""
     import pde.solvers
 
     from . import solvers  # noqa: F401 - registers fv-split
 
-    names = [n for n in pde.solvers.registered_solvers() if not n.endswith("Solver")]
+    names = [n for n in pde.solvers.registered_solvers()
+             if not n.endswith("Solver") and n not in UNFIT_SOLVERS]
     return sorted(names, key=lambda n: (n != "fv-split", n))
 
 
@@ -63,7 +77,10 @@ class VariantError(ValueError):
 def _choice(what: str, value: str, allowed: tuple[str, ...], name: str | None) -> None:
     if value not in allowed:
         where = f"variant {name!r}: " if name else ""
-        raise VariantError(f"{where}{what} must be one of {list(allowed)}, got {value!r}")
+        why = (f" (py-pde's {value!r} cannot run a case: {UNFIT_SOLVERS[value]})"
+               if what.endswith("solver") and value in UNFIT_SOLVERS else "")
+        raise VariantError(f"{where}{what} must be one of {list(allowed)}, got "
+                           f"{value!r}{why}")
 
 
 @dataclass(frozen=True)
@@ -114,9 +131,12 @@ class Variant:
         if parts.get("mol"):
             solver = MOL_SOLVERS.get(parts["mol"], parts["mol"][4:])
             if solver not in solver_names() or solver == "fv-split":
-                known = [*MOL_SOLVERS, *(f"mol-{n}" for n in solver_names()[1:])]
+                known = list(dict.fromkeys(
+                    [*MOL_SOLVERS, *(f"mol-{n}" for n in solver_names()[1:])]))
+                why = (f" (py-pde's {solver!r} cannot run a case: "
+                       f"{UNFIT_SOLVERS[solver]})" if solver in UNFIT_SOLVERS else "")
                 raise VariantError(f"variant {text!r}: the method of lines must be one "
-                                   f"of {known}, got {parts['mol']!r}")
+                                   f"of {known}, got {parts['mol']!r}{why}")
             kwargs["solver"] = solver
         else:
             kwargs["splitting"] = parts.get("split") or "lie"

@@ -12,6 +12,7 @@ each::
     <!-- test: before pdeflow run cases/x.toml --store run.h5 -q -->   run first, not shown
     <!-- test: output pdeflow sweep cases/collapse_sweep.toml -->  (text block) its output
     <!-- test: vary wall -->      (output block) numbers in lines / columns naming it differ
+    <!-- test: whole -->          (output block) all it prints: no printed line left out
     <!-- test: slow -->           run only by the slow test (minutes or more)
     <!-- test: parse -->          pdeflow commands parsed, not run
     <!-- test: skip REASON -->    nothing run or checked (say why)
@@ -213,12 +214,15 @@ def _line_agrees(doc: str, out: str, skip_columns: set[int], vary: list[str]) ->
     return True
 
 
-def compare_output(doc_text: str, output: str, vary: list[str]) -> list[str]:
+def compare_output(doc_text: str, output: str, vary: list[str],
+                   whole: bool = False) -> list[str]:
     """The lines of a documented output that the printed output does not have, in order
-    (an excerpt may leave lines out); numbers compared within their printed digits, not
-    at all in lines naming a ``vary`` word or in table columns whose header names one."""
+    (an excerpt may leave lines out; with ``whole`` it may not: printed lines that it
+    leaves out are problems too); numbers compared within their printed digits, not at
+    all in lines naming a ``vary`` word or in table columns whose header names one."""
     out_lines = [ln for ln in output.splitlines() if ln.strip()]
     problems, pos, skip_columns = [], 0, set()
+    matched: list[int] = []
     for doc in (ln for ln in doc_text.splitlines() if ln.strip()):
         if doc.strip().startswith("|") and not skip_columns and "---" not in doc:
             skip_columns = {i for i, c in enumerate(_cells(doc))
@@ -232,4 +236,8 @@ def compare_output(doc_text: str, output: str, vary: list[str]) -> list[str]:
             problems.append(f"documented: {doc.strip()}\n    printed:    {near.strip()}")
         else:
             pos = match + 1
+            matched.append(match)
+    if whole and not problems:
+        problems.extend(f"printed but not documented: {out_lines[j].strip()}"
+                        for j in range(len(out_lines)) if j not in matched)
     return problems

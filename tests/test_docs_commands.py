@@ -22,7 +22,8 @@ Each fenced ``bash`` block of a page is taken line by line (tests/doc_commands.p
 A ``text`` block under ``<!-- test: output CMD -->`` is CMD's printed output: each of its
 lines must appear, in order, in what CMD prints now, every number equal within the digits
 printed (``<!-- test: vary wall -->``: lines and table columns naming "wall" are not
-compared). Identical commands run once per session.
+compared; ``<!-- test: whole -->``: the block is all it prints, no line left out).
+Identical commands run once per session.
 """
 
 from __future__ import annotations
@@ -196,7 +197,7 @@ def check_block(block: Block, cwd: Path, slow: bool = False) -> int:
             run_command(commands(before)[0], block, cwd)
         printed = run_command(cmd, block, cwd)
         problems = compare_output(block.text, printed, block.get("vary")[0].split()
-                                  if block.get("vary") else [])
+                                  if block.get("vary") else [], whole=block.has("whole"))
         assert not problems, (f"{block.where()}: the documented output of `{command}` is "
                               "not what it prints now:\n  " + "\n  ".join(problems))
         ran += 1
@@ -227,7 +228,7 @@ def test_page_slow_commands(page: Path, tmp_path: Path) -> None:
 
 def test_convention_is_documented_and_parsed() -> None:
     """The directives are the documented ones, and every page's shell blocks parse."""
-    known = {"set", "before", "output", "vary", "slow", "parse", "skip"}
+    known = {"set", "before", "output", "vary", "whole", "slow", "parse", "skip"}
     text = (ROOT / "docs" / "architecture.md").read_text()
     assert "## Commands in the docs are tested" in text
     for page in PAGES:

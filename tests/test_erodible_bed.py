@@ -91,6 +91,7 @@ def test_radial_bed_beyond_the_deposit_is_left_exactly_as_laid():
     """On py-pde's polar grid the bed is a ring of radius > L0; past the deposit's front
     it has not moved by a bit."""
     case = load_case(CASE, ["grid.geometry='axisymmetric'", "output.snapshot_times=[]",
+                            "two_layer.theta_deg=0",  # radial flow: no slope
                             "case.models=['two_layer']"])
     eq, state = case.make_state("two_layer")
     res = run_model(case, "two_layer")

@@ -213,8 +213,8 @@ def write_case(tmp_path: Path, text: str) -> Path:
      ["[single_layer] phi_b_deg must lie in (0, 90) deg"]),
     ('[output]\nsnapshot_times = [0.1, "late"]\n[initial]\nshape = "column"\nL0 = 1\n'
      'H0 = 1\n', ["output.snapshot_times must be a list of numbers [s], got 'late'"]),
-    ('[case]\nt_end = 1\n[output]\nsnapshot_times = [2.0]\n[initial]\nshape = "column"\n'
-     'L0 = 1\nH0 = 1\n', ["output.snapshot_times must lie in [0, 1.0] s"]),
+    ('[case]\nt_end = 1\n[output]\nsnapshot_times = [-0.5]\n[initial]\nshape = "column"\n'
+     'L0 = 1\nH0 = 1\n', ["output.snapshot_times must lie in [0, inf] s"]),
     ('[initial]\nshape = "column"\nL0 = 1\n', ["initial.H0 is required"]),
     ('[grid]\nlength = 2\n', ["[initial] with a 'shape' is required"]),
     ('[initial]\nshape = "column"\nL0 = 1\nH0 = 1\n[[grid]]\n', ["[grid] must be a table"]),

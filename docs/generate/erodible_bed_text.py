@@ -272,7 +272,8 @@ def render(n: dict[str, Any], answer: list[str], trend: list[str],
         "```bash\npython docs/generate/erodible_bed.py              # the page (runs what "
         "the cache lacks)\npdeflow run cases/erodible_bed.toml               # one case: "
         "summary, figures incl. bed_<model>.png\npdeflow run cases/erodible_bed.toml "
-        "--set two_layer.theta_deg=22 --set initial.bed_thickness=0.014\n```\n",
+        "--set two_layer.theta_deg=22 --set single_layer.theta_deg=22 --set "
+        "initial.bed_thickness=0.014\n```\n",
         f"Slopes 1-{max(NEAR):g} deg below phi_B run on an 8 m channel for up to 30 s; "
         "the others on 3 m for up to 10 s.\n",
     ]

@@ -260,10 +260,11 @@ def cmd_sweep(args: Any) -> int:
     sweep_ratios(case)  # before any run
     prepare(case_steppers(case), log=None if args.quiet else sys.stderr)
     summary = run_sweep(case, progress=not args.quiet and sys.stderr.isatty())
+    written = []
     if args.summary:
-        io.write_json(args.summary, summary)
+        written.append(io.write_json(args.summary, summary))
     if args.plot:
-        sweep_figure(summary, args.plot)
+        written.append(sweep_figure(summary, args.plot))
     if not args.quiet:
         for model, res in summary["models"].items():
             pts = ", ".join(f"{a:g}:{r:.3g}" if r else f"{a:g}:-" for a, r in res["points"])
@@ -279,6 +280,8 @@ def cmd_sweep(args: Any) -> int:
                     f"{row['a']:g}:{row['arrest_time_scaled']:.3g}" if row["arrest_time_scaled"]
                     else f"{row['a']:g}:-" for row in res["runs"]))
         print(f"wall time {summary['wall_time_s']:.2f} s")
+        for path in written:
+            print(f"wrote {path}")
     return 0
 
 

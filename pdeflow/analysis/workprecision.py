@@ -163,6 +163,7 @@ def compare(case_path: str | Path | Case, variants: Sequence[str] | None = None,
         raise ValueError(f"reference must be auto, exact, fine or fine:VARIANT, got "
                          f"{reference!r}")
     grids = list(grids or [base.dx, base.dx / 2, base.dx / 4])
+    _check_options(base, grids, repeats, cfl)
     harness = _Harness(base, float(t if t is not None else base.t_end), reference,
                        reference_dx or min(_dx_of(base, gr) for gr in grids) / 4,
                        repeats, cfl, mol_cap, log)
@@ -173,6 +174,21 @@ def compare(case_path: str | Path | Case, variants: Sequence[str] | None = None,
     if out_dir is not None:
         write_outputs(result, Path(out_dir))
     return result
+
+
+def _check_options(case: Case, grids: list[float | int], repeats: int,
+                   cfl: float | None) -> None:
+    """One-line ValueError naming the option before any run: a grid is a number of
+    cells >= 1 or a dx in (0, length] [m]; repeats >= 1; cfl in (0, 1]."""
+    for gr in grids:
+        cells = isinstance(gr, (int, np.integer)) and not isinstance(gr, bool)
+        if (cells and gr < 1) or (not cells and not 0 < gr <= case.length):
+            raise ValueError(f"grids (--grids): each is a number of cells >= 1 or a dx "
+                             f"in (0, {case.length:g}] m, got {gr!r}")
+    if repeats < 1:
+        raise ValueError(f"repeats (--repeats) must be an integer >= 1, got {repeats!r}")
+    if cfl is not None and not 0 < cfl <= 1:
+        raise ValueError(f"cfl (--cfl) must lie in (0, 1], got {cfl!r}")
 
 
 def _dx_of(case: Case, grid: float | int) -> float:
@@ -197,6 +213,8 @@ class _Harness:
     log: Any
     fine: dict[tuple[str, str], tuple[np.ndarray, np.ndarray, str]] = field(
         default_factory=dict)
+    capped: set[str] = field(default_factory=set)
+    """variants whose CFL cap has been announced (once each, not once per grid)"""
 
     def say(self, msg: str) -> None:
         if self.log is not None:
@@ -229,8 +247,10 @@ class _Harness:
         limit = MAX_CFL[v.reconstruction]
         if self.base.cfl <= limit:
             return None
-        self.say(f"  {v.name} at CFL {limit:g}: the case's {self.base.cfl:g} is above the "
-                 f"limit of {v.reconstruction}")
+        if v.name not in self.capped:
+            self.capped.add(v.name)
+            self.say(f"  {v.name} at CFL {limit:g}: the case's {self.base.cfl:g} is above "
+                     f"the limit of {v.reconstruction}")
         return limit
 
     def timed(self, point: Point) -> dict[str, Any]:

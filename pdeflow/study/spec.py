@@ -45,7 +45,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from .. import systems
-from ..cases import Case, CaseError, load_case
+from ..cases import Case, CaseError, load_case, read_text
 from ..simulate import summary_keys
 from .expressions import Expression, StudyError
 
@@ -236,9 +236,7 @@ def _check_quantity(q: str, function: str | None) -> None:
 def load_study(path: str | Path) -> StudySpec:
     """Read and check a study file; raise :class:`StudyError` naming the key."""
     path = Path(path)
-    if not path.is_file():
-        raise StudyError(f"study file {path} does not exist")
-    text = path.read_text()
+    text = read_text(path, "study file", StudyError)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:

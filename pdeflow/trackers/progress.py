@@ -33,7 +33,8 @@ class ProgressBar(ProgressTracker):
     While the ``fv-split`` kernels are compiled (the first run on a machine) or loaded
     (the first run in a process), the bar says so; its clock and its estimate of the
     remaining time start once the first interval has been computed, so the estimate is
-    simulated time per wall time of the run itself.
+    simulated time per wall time of the run itself. The bar shows the simulated time
+    reached of t_end [s] and the rate in simulated seconds per wall second.
 
     Args:
         interrupts: simulation time between updates [s] (or anything py-pde accepts).
@@ -56,9 +57,15 @@ class ProgressBar(ProgressTracker):
             waiting = _WAITING.get(warmup.status(), "")
         self._waiting = ": ".join(p for p in (self.label, waiting) if p)
         controller = (info or {}).get("controller", {})
+        total = controller.get("t_end")
+        # the bar counts simulated seconds: its rate is simulated time per wall second
+        # (tqdm's default would read "it/s", or "s/it" when slow); the count is the time
+        bar_format = (None if total is None else "{l_bar}{bar}| {n:.4g}/{total:.4g} s "
+                      "[{elapsed}<{remaining}, {rate_noinv_fmt}{postfix}]")
         self.progress_bar = get_progress_bar_class(self.fancy)(
-            total=controller.get("t_end"), initial=controller.get("t_start", 0),
-            leave=self.leave, desc=self._waiting)
+            total=total, initial=controller.get("t_start", 0), leave=self.leave,
+            desc=self._waiting, unit=" s simulated", bar_format=bar_format)
+        self._drawn = (self.progress_bar.n, self._waiting)  # tqdm drew it just now
         return result
 
     def handle(self, field: Any, t: float) -> None:
@@ -73,8 +80,10 @@ class ProgressBar(ProgressTracker):
                 bar.start_t = bar.last_print_t = bar._time()
                 bar.initial = bar.n
             self._clock_started = True
-        bar.set_postfix_str(f"t = {t:.4g} s", refresh=False)
-        bar.set_description(self.label if self._clock_started else self._waiting)
+        desc = self.label if self._clock_started else self._waiting
+        if (bar.n, desc) != self._drawn:  # py-pde's call at t_start would repeat a draw
+            bar.set_description(desc)  # draws the bar
+            self._drawn = (bar.n, desc)
 
     def finalize(self, info: InfoDict | None = None) -> None:
         TrackerBase.finalize(self, info)
