@@ -108,7 +108,7 @@ def runs_laws_bed_mol() -> Iterator[tuple[str, Callable[[], Record]]]:
     bed = _case(ROOT / "cases" / "erodible_bed.toml", [])
     for model in MODELS:
         yield f"erodible_bed/{model}", (lambda m=model: _record(bed, m))
-    mol = _case(CASE_51, ["grid.dx=0.1", "case.t_end=0.2", "numerics.dt=0.001",
+    mol = _case(CASE_51, ["grid.dx=0.1", "case.t_end=0.1", "numerics.dt=1e-4",
                           "output.snapshot_times=[]"])
     for model in MODELS:
         yield f"mol-rk/{model}", (lambda m=model: _record(mol, m, "mol-rk"))
