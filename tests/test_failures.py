@@ -21,8 +21,8 @@ import pdeflow
 from pdeflow import FVSplitSolver, SimulationBlowUp
 from pdeflow.cases import CaseError, load_case
 from pdeflow.io import atomic_path, write_json, write_npz
+from pdeflow.models.two_layer import layout as T
 from pdeflow.numerics import layout as L
-from pdeflow.numerics import layout_two_layer as T
 from pdeflow.numerics.vectorized import advection_rate
 from pdeflow.solvers.fv_split import diagnose_blowup
 

@@ -6,16 +6,16 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import pdeflow
-from pdeflow.numerics import layout as L
-from pdeflow.numerics import layout_two_layer as T
-from pdeflow.numerics.hyperbolicity import (
+from pdeflow.models.two_layer import layout as T
+from pdeflow.models.two_layer.exchange import exchange_step, friction_two_layer
+from pdeflow.models.two_layer.hyperbolicity import (
     band_lower_edge,
     discriminant,
     eigenvalues,
     is_hyperbolic,
     lower_bound_fl,
 )
-from pdeflow.numerics.sources import exchange_step, friction_two_layer
+from pdeflow.numerics import layout as L
 
 pos = st.floats(0.01, 2.0)
 
@@ -187,7 +187,7 @@ def test_direct_restoration_is_the_bisection_limit(mode):
     """The closed-form inversion of the friction step lands |du| on the band edge:
     hyperbolic, never more F_extra than bisection to w = 1e-3, and |du| within 1e-8
     (relative) of bisection to w = 1e-12."""
-    from pdeflow.numerics.friction import (
+    from pdeflow.models.two_layer.friction import (
         bisect_fextra,
         friction_params,
         implicit_friction,

@@ -22,11 +22,10 @@ from pdeflow import systems
 from pdeflow.analysis.exact import ritter
 from pdeflow.cases import load_case
 from pdeflow.models.base import GranularPDE, SharedParameters, stop_time
+from pdeflow.models.single_layer import flux as saint_venant
 from pdeflow.numerics import layout as L
-from pdeflow.numerics.advection import cell_jump_single
 from pdeflow.numerics.compiled import FIELDS, PARAMS, STATE, VECTOR, f8, i8, kernel
 from pdeflow.numerics.model_kernels import ModelKernels
-from pdeflow.numerics.pvm import face_single, fluctuations_single
 from pdeflow.numerics.state import velocity
 from pdeflow.numerics.vectorized import advection_rate
 
@@ -100,8 +99,8 @@ def sw_numpy_sources(q: np.ndarray, P: np.ndarray) -> np.ndarray:
 
 
 KERNELS = ModelKernels(
-    fields=2, face=face_single, fluctuations=fluctuations_single,
-    cell_jump=cell_jump_single, sources=sw_sources, source_stage=sw_source_stage,
+    fields=2, face=saint_venant.face, fluctuations=saint_venant.fluctuations,
+    cell_jump=saint_venant.cell_jump, sources=sw_sources, source_stage=sw_source_stage,
     predictor=sw_predictor, mol_sources=sw_mol_sources,
     numpy_advection=lambda q, dx, bc, P: advection_rate(q, dx, bc, P[L.G_Z], P[DRY], None),
     numpy_sources=sw_numpy_sources,

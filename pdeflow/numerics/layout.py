@@ -2,9 +2,10 @@
 
 Numba kernels receive the physical and numerical parameters as one float64 array, so
 that a single compiled kernel (cached on disk) serves every parameter set and grid of
-a sweep. Each model has its own parameter layout (:mod:`.layout_two_layer`,
-:mod:`.layout_single_layer`); every layout starts with the header below, which the
-model-independent kernels (the stepping loop) read. The model classes in
+a sweep. Each model has its own parameter layout in its package
+(:mod:`pdeflow.models.two_layer.layout`, :mod:`pdeflow.models.single_layer.layout`);
+every layout starts with the header below, which the model-independent kernels (the
+stepping loop) read. The model classes in
 :mod:`pdeflow.models` fill these arrays; nothing else indexes them by number.
 
 All stresses and mass fluxes inside the kernels are *kinematic*, i.e. divided by the

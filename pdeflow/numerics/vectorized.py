@@ -1,8 +1,9 @@
 """Vectorised numpy implementation of the method-of-lines rate (py-pde's numpy backend).
 
 An independent second implementation of the same formulas as the numba kernels in
-:mod:`pdeflow.numerics.hll`, :mod:`pdeflow.numerics.advection` and
-:mod:`pdeflow.numerics.mol`, written over whole arrays of faces. It serves py-pde's
+:mod:`pdeflow.numerics.hll` and :mod:`pdeflow.numerics.advection`, written over whole
+arrays of faces (the models' source rates have their numpy twins beside their kernels,
+e.g. :func:`pdeflow.models.two_layer.rates.source_rate_two_layer_np`). It serves py-pde's
 ``numpy`` backend and, in the tests, as a cross-check of the compiled kernels.
 """
 
@@ -11,11 +12,10 @@ from __future__ import annotations
 import numpy as np
 
 from . import layout as L
-from . import layout_single_layer as S
-from . import layout_two_layer as T
 
 
-def _vel(h: np.ndarray, m: np.ndarray, dry: float) -> np.ndarray:
+def velocity_np(h: np.ndarray, m: np.ndarray, dry: float) -> np.ndarray:
+    """Depth-averaged velocity m/h [m/s] where h > dry [m], else 0 (over arrays)."""
     return np.where(h > dry, m / np.where(h > dry, h, 1.0), 0.0)
 
 
@@ -41,7 +41,7 @@ def _hll_split(sL, sR, dq, a):
 
 def _at_uncovered_steps(left, right, ul, ur, sL, sR, a0, a1, dH, g, dry, fluct):
     """The upper layer's fluctuations (D-_h1, D+_h1, D-_h1u1, D+_h1u1) with those of
-    :func:`pdeflow.numerics.pvm.upper_layer_at_uncovered_step` where the lower layer is
+    :func:`pdeflow.models.two_layer.flux.upper_layer_at_uncovered_step` where the lower layer is
     at rest on both sides of a face and steps above the upper layer's surface on one
     side; ``fluct`` (the flux's own) elsewhere."""
     h1l, h1r, h2l, h2r = left[0], right[0], left[2], right[2]
@@ -88,8 +88,8 @@ def advection_rate(q: np.ndarray, dx: float, bc: tuple[int, int], g: float,
     n_layers = q.shape[0] // 2
     hs_l = [np.maximum(left[2 * k], 0.0) for k in range(n_layers)]
     hs_r = [np.maximum(right[2 * k], 0.0) for k in range(n_layers)]
-    us_l = [_vel(left[2 * k], left[2 * k + 1], dry) for k in range(n_layers)]
-    us_r = [_vel(right[2 * k], right[2 * k + 1], dry) for k in range(n_layers)]
+    us_l = [velocity_np(left[2 * k], left[2 * k + 1], dry) for k in range(n_layers)]
+    us_r = [velocity_np(right[2 * k], right[2 * k + 1], dry) for k in range(n_layers)]
     HL = sum(hs_l)
     HR = sum(hs_r)
     cL = np.sqrt(g * HL)
@@ -159,60 +159,3 @@ def basal_accel_np(P: np.ndarray, base: int, h: np.ndarray, gw: np.ndarray,
             mu = np.where(s < P[base + L.LAW_BETA_G] * np.sqrt(hp), mu_static, mu)
     mu = np.where(s > 0.0, mu, mu_static)
     return gw * mu + P[base + L.LAW_DRAG] * s * s / np.maximum(hm, 1e-300)
-
-
-def source_rate_single_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
-    """Gravity along the bed and regularised Coulomb friction of the single layer (the
-    numpy twin of :func:`pdeflow.numerics.mol.source_rate_single`)."""
-    rate = np.zeros_like(q)
-    h = np.maximum(q[0], 0.0)
-    u = _vel(h, q[1], P[S.DRY])
-    eps = P[S.MOL_EPS]
-    wet = h > P[S.DRY]
-    if int(P[S.LAW + L.LAW_CODE]) == L.FRICTION_COULOMB:
-        fric = P[S.G_Z] * h * P[S.TAN_B] * u / np.maximum(np.abs(u), eps)
-    else:
-        fric = h * basal_accel_np(P, S.LAW, h, P[S.G_Z], h, np.abs(u)) * u / np.maximum(
-            np.abs(u), eps)
-    rate[1] = np.where(wet, P[S.G_X] * h - fric, 0.0)
-    return rate
-
-
-def source_rate_two_layer_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
-    """Regularised source rate of (26)-(27) of the two layers (the numpy twin of
-    :func:`pdeflow.numerics.mol.source_rate_two_layer`)."""
-    rate = np.zeros_like(q)
-    r, g, gx, dry, eps = P[T.R], P[T.G_Z], P[T.G_X], P[T.DRY], P[T.MOL_EPS]
-    h1 = np.maximum(q[0], 0.0)
-    h2 = np.maximum(q[2], 0.0)
-    u1 = _vel(h1, q[1], dry)
-    u2 = _vel(h2, q[3], dry)
-    wet1 = h1 > dry
-    wet2 = h2 > dry
-    du = u1 - u2
-    num = P[T.C] * du * du - (1.0 - P[T.K]) * r * g * h1 * P[T.TAN_INT]
-    m = num / np.maximum(np.abs(du), max(P[T.DU_REG], eps))
-    closure = int(P[T.CLOSURE])
-    if closure == L.CLOSURE_RELAXED:
-        # relaxed closure: bounded by the relaxation towards h1_eq on tau
-        tau = P[T.TAU_STAR] * np.sqrt(np.maximum(h1 + h2, 1e-300) / g)
-        denom = (1.0 - P[T.K]) * r * g * P[T.TAN_INT]
-        h1_eq = P[T.C] * du * du / denom if denom > 0 else np.full_like(h1, np.inf)
-        dep = r * (np.minimum(h1_eq, h1) - h1) / tau
-        ero = np.maximum(r * (np.minimum(h1_eq, h1 + h2 / r) - h1) / tau, 0.0)
-        m = np.where(m < 0, np.maximum(m, dep), np.where(m > 0, np.minimum(m, ero), m))
-    m = np.where(wet1 & ((m <= 0) | wet2) & (closure != L.CLOSURE_NONE), m, 0.0)
-    sgn_du = du / np.maximum(np.abs(du), eps)
-    t1 = np.where(wet1, (P[T.K] * r * g * h1 * P[T.TAN_INT] + P[T.C] * du * du) * sgn_du,
-                  0.0)
-    rate[0] = m / r
-    rate[1] = np.where(wet1, gx * h1 + u1 * m / r - t1 / r, 0.0)
-    rate[2] = -m
-    if int(P[T.LAW + L.LAW_CODE]) == L.FRICTION_COULOMB:
-        bf = g * (r * h1 + h2) * P[T.TAN_B] * u2 / np.maximum(np.abs(u2), eps)
-    else:
-        gw = g * (r * h1 + h2) / np.maximum(h2, 1e-300)
-        bf = h2 * basal_accel_np(P, T.LAW, h1 + h2, gw, h2, np.abs(u2)) * u2 / np.maximum(
-            np.abs(u2), eps)
-    rate[3] = np.where(wet2, gx * h2 - u1 * m + t1 - bf, -u1 * m)
-    return rate

@@ -20,12 +20,11 @@ from typing import Any
 
 import numpy as np
 
-from .. import systems
-from ..numerics import layout_single_layer as S
-from ..numerics.bundles import SINGLE_LAYER as KERNELS
-from ..numerics.bundles import SINGLE_LAYER_LAWS as LAW_KERNELS
-from .base import GranularPDE, SharedParameters, check_range, stop_time
-from .friction_laws import FrictionLawParameters
+from ... import systems
+from ..base import GranularPDE, SharedParameters, check_range, stop_time
+from ..friction_laws import FrictionLawParameters
+from . import layout as S
+from .kernels import KERNELS, LAW_KERNELS
 
 
 @dataclass
@@ -44,7 +43,7 @@ class SingleLayerParameters(FrictionLawParameters, SharedParameters):
         self.validate_law()
 
     def to_array(self) -> np.ndarray:
-        """Kernel parameter vector (layout in :mod:`pdeflow.numerics.layout_single_layer`)."""
+        """Kernel parameter vector (layout in :mod:`.layout`)."""
         th = math.radians(self.theta_deg)
         P = np.zeros(S.SIZE)
         P[S.G_Z] = self.g * math.cos(th)

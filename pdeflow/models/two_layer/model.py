@@ -23,15 +23,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import systems
-from ..initial_shapes import is_column
-from ..numerics import layout as L
-from ..numerics import layout_two_layer as T
-from ..numerics.bundles import TWO_LAYER as KERNELS
-from ..numerics.bundles import TWO_LAYER_LAWS as LAW_KERNELS
-from ..numerics.geometry import Metric
-from .base import GranularPDE, SharedParameters, check_range, stop_time
-from .friction_laws import FrictionLawParameters
+from ... import systems
+from ...initial_shapes import is_column
+from ...numerics import layout as L
+from ...numerics.geometry import Metric
+from ..base import GranularPDE, SharedParameters, check_range, stop_time
+from ..friction_laws import FrictionLawParameters
+from . import layout as T
+from .kernels import KERNELS, LAW_KERNELS
 
 HYPERBOLICITY_MODES = L.HYPERBOLICITY_MODES
 
@@ -66,7 +65,7 @@ class TwoLayerParameters(FrictionLawParameters, SharedParameters):
     exchange_closure: str = "paper"
     """'paper': closure (25) as published (singular at du = 0); 'relaxed': its rate
     bounded by a relaxation towards the equilibrium depth on the time scale
-    tau_star sqrt(H/g) (see pdeflow.numerics.sources); 'none': no mass exchange (two
+    tau_star sqrt(H/g) (see pdeflow.models.two_layer.exchange); 'none': no mass exchange (two
     immiscible layers, for verification and teaching)"""
     tau_star: float = 1.0
     """relaxation time of the 'relaxed' closure in units of sqrt(H/g) [-]"""
@@ -95,7 +94,7 @@ class TwoLayerParameters(FrictionLawParameters, SharedParameters):
         self.validate_law()
 
     def to_array(self) -> np.ndarray:
-        """Kernel parameter vector (layout in :mod:`pdeflow.numerics.layout_two_layer`)."""
+        """Kernel parameter vector (layout in :mod:`.layout`)."""
         th = math.radians(self.theta_deg)
         P = np.zeros(T.SIZE)
         P[T.G_Z] = self.g * math.cos(th)

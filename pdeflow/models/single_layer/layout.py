@@ -1,9 +1,9 @@
 """Parameter vector of the single-layer model (:class:`pdeflow.models.SingleLayerGranular`).
 
-Starts with the header of :mod:`.layout`.
+Starts with the header of :mod:`pdeflow.numerics.layout`.
 """
 
-from .layout import G_X, G_Z, N_HEADER, N_LAW
+from ...numerics.layout import G_X, G_Z, N_HEADER, N_LAW
 
 __all__ = ["G_Z", "G_X"]
 

@@ -6,13 +6,13 @@ finite (both documented parameters): sgn(v) is replaced by v / max(|v|, eps) wit
 eps = ``mol_eps`` (for a rate-dependent basal law, mu(h, |u|) sgn_eps(u), see
 :mod:`pdeflow.numerics.rheology`), and the closure's denominator is max(|du|, du_reg, eps). With
 ``exchange_closure = "relaxed"`` the rate is bounded by the relaxation towards h1_eq
-(:func:`pdeflow.numerics.sources.relaxed_rate`), the rate form of the relaxed stage. A state at
+(:func:`.exchange.relaxed_rate`), the rate form of the relaxed stage. A state at
 rest is therefore *not* held by static friction in this form: that is the price of
 the method of lines, and why the paper splits the sources.
 
 Kinematic form (divided by rho2), with the exchanged mass carrying u1 (as a rate this is
 (27) exactly; the split exchange stage carries the velocity of the layer the mass leaves,
-which is the same equation rewritten through (25), see :mod:`pdeflow.numerics.sources`):
+which is the same equation rewritten through (25), see :mod:`.exchange`):
 
 .. math::  \dot h_1 = M/r,\quad \dot h_2 = -M,\quad
            \dot m_1 = g_x h_1 + u_1 M / r - t_1/r,\quad
@@ -25,13 +25,13 @@ import math
 
 import numpy as np
 
-from . import layout as L
-from . import layout_single_layer as S
-from . import layout_two_layer as T
-from .compiled import FIELDS, PARAMS, STATE, kernel
-from .rheology import basal_accel, law_block
-from .sources import closure_rate, relaxed_rate
-from .state import velocity
+from ...numerics import layout as L
+from ...numerics.compiled import FIELDS, PARAMS, STATE, kernel
+from ...numerics.rheology import basal_accel, law_block
+from ...numerics.state import velocity
+from ...numerics.vectorized import basal_accel_np, velocity_np
+from . import layout as T
+from .exchange import closure_rate, relaxed_rate
 
 
 @kernel(STATE, FIELDS, PARAMS)
@@ -79,18 +79,41 @@ def source_rate_two_layer(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> Non
             rate[3, i] -= u1 * m
 
 
-@kernel(STATE, FIELDS, PARAMS)
-def source_rate_single(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> None:
-    """Add gravity along the bed and regularised basal friction (single layer)."""
-    coulomb = int(P[S.LAW + L.LAW_CODE]) == L.FRICTION_COULOMB
-    for i in range(q.shape[1]):
-        h = max(q[0, i], 0.0)
-        if h > P[S.DRY]:
-            u = q[1, i] / h
-            if coulomb:
-                rate[1, i] += P[S.G_X] * h - P[S.G_Z] * h * P[S.TAN_B] * u / max(
-                    abs(u), P[S.MOL_EPS])
-            else:
-                rate[1, i] += P[S.G_X] * h - h * basal_accel(
-                    law_block(P, S.LAW), h, P[S.G_Z], h, abs(u)) * u / max(
-                        abs(u), P[S.MOL_EPS])
+def source_rate_two_layer_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """Regularised source rate of (26)-(27) of the two layers (the numpy twin of
+    :func:`source_rate_two_layer`)."""
+    rate = np.zeros_like(q)
+    r, g, gx, dry, eps = P[T.R], P[T.G_Z], P[T.G_X], P[T.DRY], P[T.MOL_EPS]
+    h1 = np.maximum(q[0], 0.0)
+    h2 = np.maximum(q[2], 0.0)
+    u1 = velocity_np(h1, q[1], dry)
+    u2 = velocity_np(h2, q[3], dry)
+    wet1 = h1 > dry
+    wet2 = h2 > dry
+    du = u1 - u2
+    num = P[T.C] * du * du - (1.0 - P[T.K]) * r * g * h1 * P[T.TAN_INT]
+    m = num / np.maximum(np.abs(du), max(P[T.DU_REG], eps))
+    closure = int(P[T.CLOSURE])
+    if closure == L.CLOSURE_RELAXED:
+        # relaxed closure: bounded by the relaxation towards h1_eq on tau
+        tau = P[T.TAU_STAR] * np.sqrt(np.maximum(h1 + h2, 1e-300) / g)
+        denom = (1.0 - P[T.K]) * r * g * P[T.TAN_INT]
+        h1_eq = P[T.C] * du * du / denom if denom > 0 else np.full_like(h1, np.inf)
+        dep = r * (np.minimum(h1_eq, h1) - h1) / tau
+        ero = np.maximum(r * (np.minimum(h1_eq, h1 + h2 / r) - h1) / tau, 0.0)
+        m = np.where(m < 0, np.maximum(m, dep), np.where(m > 0, np.minimum(m, ero), m))
+    m = np.where(wet1 & ((m <= 0) | wet2) & (closure != L.CLOSURE_NONE), m, 0.0)
+    sgn_du = du / np.maximum(np.abs(du), eps)
+    t1 = np.where(wet1, (P[T.K] * r * g * h1 * P[T.TAN_INT] + P[T.C] * du * du) * sgn_du,
+                  0.0)
+    rate[0] = m / r
+    rate[1] = np.where(wet1, gx * h1 + u1 * m / r - t1 / r, 0.0)
+    rate[2] = -m
+    if int(P[T.LAW + L.LAW_CODE]) == L.FRICTION_COULOMB:
+        bf = g * (r * h1 + h2) * P[T.TAN_B] * u2 / np.maximum(np.abs(u2), eps)
+    else:
+        gw = g * (r * h1 + h2) / np.maximum(h2, 1e-300)
+        bf = h2 * basal_accel_np(P, T.LAW, h1 + h2, gw, h2, np.abs(u2)) * u2 / np.maximum(
+            np.abs(u2), eps)
+    rate[3] = np.where(wet2, gx * h2 - u1 * m + t1 - bf, -u1 * m)
+    return rate
