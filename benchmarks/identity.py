@@ -161,7 +161,10 @@ def save(directory: Path, record: Record, name: str) -> None:
 
 
 def _same(a: Any, b: Any) -> bool:
-    """Exact equality, NaN equal to NaN (a run's NaN summary numbers are its numbers)."""
+    """Exact equality of value and type (an int printed as 3.0 is a change), NaN equal
+    to NaN (a run's NaN summary numbers are its numbers)."""
+    if type(a) is not type(b):
+        return False
     if isinstance(a, float) and isinstance(b, float):
         return a == b or (math.isnan(a) and math.isnan(b))
     if isinstance(a, dict) and isinstance(b, dict):

@@ -78,9 +78,9 @@ def _close_stage(diag, t, moving, fast):
     (``moving``: the layer has momentum; ``fast``: faster than SLOW_U where deeper than
     SLOW_H), whether it changed anything."""
     if moving:
-        diag[L.D_MOVE_UPPER] = t
+        diag[S.D_MOVE] = t
     if fast:
-        diag[L.D_FAST_UPPER] = t
+        diag[S.D_FAST] = t
     diag[L.D_CHANGED] = 1.0 if moving else 0.0
     diag[L.D_T] = t
     diag[L.D_STEPS] += 1.0

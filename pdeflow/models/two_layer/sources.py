@@ -115,9 +115,9 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
                             u1 = mom / (r * h1)
                     changed = True
                     if dh1 < 0.0:
-                        diag[L.D_DEPOSITED] -= dh1
+                        diag[T.D_DEPOSITED] -= dh1
                     else:
-                        diag[L.D_ERODED] += dh1
+                        diag[T.D_ERODED] += dh1
             # --- (32) implicit momentum sources ------------------------------------------
             b1 = u1 + dt * gx if h1 > dry else 0.0
             b2 = u2 + dt * gx if h2 > dry else 0.0
@@ -129,13 +129,13 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
                     f, v1, v2, bisected = restore_to_edge(b1, b2, h1, h2, v1, v2, dt, fp,
                                                           k_eff, c_eff, edge)
                     if bisected:
-                        diag[L.D_HYP_BISECTIONS] += 1.0
+                        diag[T.D_HYP_BISECTIONS] += 1.0
                     fex[i] = abs(f) / r
-                    diag[L.D_HYP_EVENTS] += 1.0
-                    if fex[i] > diag[L.D_FEXTRA_MAX]:
-                        diag[L.D_FEXTRA_MAX] = fex[i]
-                        diag[L.D_FEXTRA_CELL] = i
-                        diag[L.D_FEXTRA_TIME] = t
+                    diag[T.D_HYP_EVENTS] += 1.0
+                    if fex[i] > diag[T.D_FEXTRA_MAX]:
+                        diag[T.D_FEXTRA_MAX] = fex[i]
+                        diag[T.D_FEXTRA_CELL] = i
+                        diag[T.D_FEXTRA_TIME] = t
             u1 = v1
             u2 = v2
         m1 = h1 * u1 if h1 > dry else 0.0
@@ -161,13 +161,13 @@ def _close_stage(diag, t, moving1, fast1, moving2, fast2, changed):
     (``moving``: a layer has momentum; ``fast``: faster than SLOW_U where deeper than
     SLOW_H) of layer 1 and 2, whether it changed anything."""
     if moving1:
-        diag[L.D_MOVE_UPPER] = t
+        diag[T.D_MOVE_UPPER] = t
     if moving2:
-        diag[L.D_MOVE_LOWER] = t
+        diag[T.D_MOVE_LOWER] = t
     if fast1:
-        diag[L.D_FAST_UPPER] = t
+        diag[T.D_FAST_UPPER] = t
     if fast2:
-        diag[L.D_FAST_LOWER] = t
+        diag[T.D_FAST_LOWER] = t
     diag[L.D_CHANGED] = 1.0 if (changed or moving1 or moving2) else 0.0
     diag[L.D_T] = t
     diag[L.D_STEPS] += 1.0
