@@ -49,6 +49,7 @@ FLUX_HLL = 0
 FLUX_RUSANOV = 1
 FLUX_IFCP = 2
 FLUXES = {"hll": FLUX_HLL, "rusanov": FLUX_RUSANOV, "ifcp": FLUX_IFCP}
+RECONSTRUCTIONS = {"first-order": 1, "muscl": 2}  #: name -> order of accuracy
 LIMITER_MINMOD = 0
 LIMITER_MC = 1
 LIMITERS = {"minmod": LIMITER_MINMOD, "mc": LIMITER_MC}

@@ -18,7 +18,7 @@ import numpy as np
 from ...numerics import layout as L
 from ...numerics.compiled import cached, f8, specialise, types
 from ...numerics.hll import hll_coefficients
-from ...numerics.ifcp import ifcp_coefficients, internal_speed
+from ...numerics.ifcp import ifcp_coefficients
 from ...numerics.pvm import roe_velocity
 from ...numerics.rusanov import rusanov_coefficients
 from ...numerics.state import velocity
@@ -101,6 +101,21 @@ def upper_layer_at_uncovered_step(h1L: float, u1L: float, sL: float, h1R: float,
             wL = 1.0 - wR
     return (mass - h1L * u1L, mom - h1L * u1L * u1L + wL * pressure,
             h1R * u1R - mass, h1R * u1R * u1R - mom + wR * pressure)
+
+
+@cached
+def internal_speed(h1: float, u1: float, h2: float, u2: float, g: float,
+                   r: float) -> float:
+    """IFCP's intermediate node S_int: the approximate internal eigenvalue of larger
+    magnitude [m/s], U_c -+ c_int (see :mod:`pdeflow.numerics.ifcp`)."""
+    H = h1 + h2
+    if H <= 0.0:
+        return 0.0
+    du = u1 - u2
+    uc = (h1 * u2 + h2 * u1) / H
+    c2 = (1.0 - r) * g * h1 * h2 / H * (1.0 - du * du / ((1.0 - r) * g * H))
+    c = math.sqrt(c2) if c2 > 0.0 else 0.0
+    return uc + c if abs(uc + c) >= abs(uc - c) else uc - c
 
 
 @cached(inline="always")
