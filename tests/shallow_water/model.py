@@ -11,6 +11,7 @@ import numpy as np
 from pdeflow import systems
 from pdeflow.models.base import GranularPDE, SharedParameters, stop_time
 from pdeflow.models.single_layer import flux as saint_venant
+from pdeflow.models.single_layer.rates import fluctuations_np
 from pdeflow.numerics.model_kernels import ModelKernels
 from pdeflow.numerics.vectorized import advection_rate
 
@@ -39,7 +40,8 @@ KERNELS = ModelKernels(
     fields=2, face=saint_venant.face, fluctuations=saint_venant.fluctuations,
     cell_jump=saint_venant.cell_jump, sources=sw_sources, source_stage=sw_source_stage,
     predictor=sw_predictor, mol_sources=sw_mol_sources,
-    numpy_advection=lambda q, dx, bc, P: advection_rate(q, dx, bc, P[W.G_Z], P[W.DRY], None),
+    numpy_advection=lambda q, dx, bc, P: advection_rate(q, dx, bc, fluctuations_np, P[W.G_Z],
+                                                        P[W.DRY]),
     numpy_sources=sw_numpy_sources,
     constants=lambda P: (float(P[W.G_Z]), 0.0, float(P[W.DRY])))
 

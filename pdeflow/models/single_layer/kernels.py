@@ -12,7 +12,7 @@ from ...numerics.model_kernels import ModelKernels
 from ...numerics.vectorized import advection_rate
 from . import layout as S
 from .flux import cell_jump, face, fluctuations
-from .rates import source_rate_single, source_rate_single_np
+from .rates import fluctuations_np, source_rate_single, source_rate_single_np
 from .sources import (
     predictor_single,
     predictor_single_law,
@@ -29,7 +29,7 @@ def _constants(P: np.ndarray) -> tuple[float, float, float]:
 
 def _numpy_advection(q: np.ndarray, dx: float, bc: tuple[int, int],
                      P: np.ndarray) -> tuple[np.ndarray, float]:
-    return advection_rate(q, dx, bc, P[S.G_Z], P[S.DRY], None)
+    return advection_rate(q, dx, bc, fluctuations_np, P[S.G_Z], P[S.DRY])
 
 
 KERNELS = ModelKernels(

@@ -9,7 +9,7 @@ import numpy as np
 from ...numerics import layout as L
 from ...numerics.compiled import FIELDS, PARAMS, STATE, kernel
 from ...numerics.rheology import basal_accel, law_block
-from ...numerics.vectorized import basal_accel_np, velocity_np
+from ...numerics.vectorized import at_rest, basal_accel_np, layer_fluctuations, velocity_np
 from . import layout as S
 
 
@@ -45,3 +45,23 @@ def source_rate_single_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
             np.abs(u), eps)
     rate[1] = np.where(wet, P[S.G_X] * h - fric, 0.0)
     return rate
+
+
+def fluctuations_np(left: np.ndarray, right: np.ndarray, g: float,
+                    dry: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """HLL fluctuations of the single layer over all faces between the states ``left``
+    and ``right`` (the numpy twin of :func:`.flux.fluctuations` for HLL):
+    (D^-, D^+, S_L, S_R)."""
+    hl, hr = left[0], right[0]
+    ml, mr = left[1], right[1]
+    ul = velocity_np(hl, ml, dry)
+    ur = velocity_np(hr, mr, dry)
+    cL = np.sqrt(g * sum([np.maximum(hl, 0.0)]))
+    cR = np.sqrt(g * sum([np.maximum(hr, 0.0)]))
+    sL = np.minimum(ul - cL, ur - cR)
+    sR = np.maximum(ul + cL, ur + cR)
+    dH = sum([np.maximum(hr, 0.0)]) - sum([np.maximum(hl, 0.0)])
+    a1 = ur * ur * hr + 0.5 * g * hr * hr - ul * ul * hl - 0.5 * g * hl * hl
+    fluct = layer_fluctuations(hl, hr, ml, mr, ul, ur, a1, sL, sR)
+    dm0, dp0, dm1, dp1 = at_rest(fluct, hl, hr, ml, mr, g, dH)
+    return np.array([dm0, dm1]), np.array([dp0, dp1]), sL, sR

@@ -14,7 +14,7 @@ from . import layout as T
 from .flux import cell_jump, face, fluctuations
 from .friction import predictor_two_layer
 from .laws import predictor_two_layer_law, source_stage_two_layer_law, sources_two_layer_law
-from .rates import source_rate_two_layer, source_rate_two_layer_np
+from .rates import fluctuations_np, source_rate_two_layer, source_rate_two_layer_np
 from .sources import source_stage_two_layer, sources_two_layer
 
 
@@ -24,7 +24,7 @@ def _constants(P: np.ndarray) -> tuple[float, float, float]:
 
 def _numpy_advection(q: np.ndarray, dx: float, bc: tuple[int, int],
                      P: np.ndarray) -> tuple[np.ndarray, float]:
-    return advection_rate(q, dx, bc, P[T.G_Z], P[T.DRY], P[T.R])
+    return advection_rate(q, dx, bc, fluctuations_np, P[T.G_Z], P[T.DRY], P[T.R])
 
 
 KERNELS = ModelKernels(

@@ -29,7 +29,13 @@ from ...numerics import layout as L
 from ...numerics.compiled import FIELDS, PARAMS, STATE, kernel
 from ...numerics.rheology import basal_accel, law_block
 from ...numerics.state import velocity
-from ...numerics.vectorized import basal_accel_np, velocity_np
+from ...numerics.vectorized import (
+    at_rest,
+    basal_accel_np,
+    hll_split,
+    layer_fluctuations,
+    velocity_np,
+)
 from . import layout as T
 from .exchange import closure_rate, relaxed_rate
 
@@ -117,3 +123,86 @@ def source_rate_two_layer_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
             np.abs(u2), eps)
     rate[3] = np.where(wet2, gx * h2 - u1 * m + t1 - bf, -u1 * m)
     return rate
+
+
+def _at_uncovered_steps_np(left, right, ul, ur, sL, sR, a0, a1, dH, g, dry, fluct):
+    """The upper layer's fluctuations (D-_h1, D+_h1, D-_h1u1, D+_h1u1) with those of
+    :func:`.flux.upper_layer_at_uncovered_step` where the lower layer is at rest on both
+    sides of a face and steps above the upper layer's surface on one side; ``fluct``
+    (the flux's own) elsewhere."""
+    h1l, h1r, h2l, h2r = left[0], right[0], left[2], right[2]
+    top = np.maximum(h2l, h2r)
+    s_l = h1l + h2l - top
+    s_r = h1r + h2r - top
+    at = ((left[3] == 0.0) & (right[3] == 0.0) & (h2r - h2l != 0.0)
+          & ((s_l <= 0.0) | (s_r <= 0.0)))
+    s_l = np.maximum(s_l, 0.0)
+    s_r = np.maximum(s_r, 0.0)
+    f_l, f_r = s_l * ul, s_r * ur
+    pressure = g * 0.5 * (h1l + h1r) * dH
+    mass = f_l + hll_split(sL, sR, s_r - s_l, f_r - f_l)[0]
+    mom = f_l * ul + hll_split(sL, sR, f_r - f_l, f_r * ur - f_l * ul)[0]
+    share_l = hll_split(sL, sR, 0.0 * pressure, pressure)[0]  # the flux's share of it
+    share_r = pressure - share_l
+    # both wet: the thinner side gets at most the share its own depth carries, the
+    # thicker side the rest (as pvm.upper_layer_at_uncovered_step)
+    both = (h1l > dry) & (h1r > dry)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        h1bar = 0.5 * (h1l + h1r)
+        thin_l = np.where(both & (h1l < h1r), share_l * h1l / h1bar, share_l)
+        thin_r = np.where(both & (h1l >= h1r), share_r * h1r / h1bar, share_r)
+    share_l, share_r = (np.where(both & (h1l >= h1r), pressure - thin_r, thin_l),
+                        np.where(both & (h1l < h1r), pressure - thin_l, thin_r))
+    # a side without upper layer gets no share of the hydrostatic jump
+    share_l = np.where(h1l > dry, share_l, 0.0)
+    share_r = np.where(h1r > dry, share_r, 0.0)
+    dm0 = mass - ul * h1l
+    dm1 = mom - ul * ul * h1l + share_l
+    dp1 = ur * ur * h1r - ul * ul * h1l - (mom - ul * ul * h1l) + share_r
+    dm0_, dp0_, dm1_, dp1_ = fluct
+    return (np.where(at, dm0, dm0_), np.where(at, a0 - dm0, dp0_),
+            np.where(at, dm1, dm1_), np.where(at, dp1, dp1_))
+
+
+def _speeds_np(hs: list, us: list, dry: float) -> tuple[np.ndarray, np.ndarray]:
+    """Slowest and fastest wet layer's velocity [m/s] on one side of every face."""
+    u1 = np.where(hs[0] > dry, us[0], us[1])
+    u2 = np.where(hs[1] > dry, us[1], us[0])
+    return np.minimum(u1, u2), np.maximum(u1, u2)
+
+
+def fluctuations_np(left: np.ndarray, right: np.ndarray, g: float, dry: float,
+                    r: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """HLL fluctuations of the two-layer system (24) over all faces between the states
+    ``left`` and ``right`` (the numpy twin of :func:`.flux.fluctuations` for HLL):
+    (D^-, D^+, S_L, S_R)."""
+    hs_l = [np.maximum(left[2 * k], 0.0) for k in range(2)]
+    hs_r = [np.maximum(right[2 * k], 0.0) for k in range(2)]
+    us_l = [velocity_np(left[2 * k], left[2 * k + 1], dry) for k in range(2)]
+    us_r = [velocity_np(right[2 * k], right[2 * k + 1], dry) for k in range(2)]
+    HL = sum(hs_l)
+    HR = sum(hs_r)
+    cL = np.sqrt(g * HL)
+    cR = np.sqrt(g * HR)
+    loL, hiL = _speeds_np(hs_l, us_l, dry)
+    loR, hiR = _speeds_np(hs_r, us_r, dry)
+    sL = np.minimum(loL - cL, loR - cR)
+    sR = np.maximum(hiL + cL, hiR + cR)
+    dH = HR - HL
+    fluct_m = []
+    fluct_p = []
+    for k in range(2):
+        hl, hr = left[2 * k], right[2 * k]
+        ml, mr = left[2 * k + 1], right[2 * k + 1]
+        ul, ur = us_l[k], us_r[k]
+        # the path-conservative coupling: g h1bar Delta(h1 + h2), g h2bar Delta(h2 + r h1)
+        dpress = dH if k == 0 else (right[2] - left[2]) + r * (right[0] - left[0])
+        a1 = ur * ur * hr - ul * ul * hl + g * 0.5 * (hl + hr) * dpress
+        fluct = layer_fluctuations(hl, hr, ml, mr, ul, ur, a1, sL, sR)
+        if k == 0:
+            fluct = _at_uncovered_steps_np(left, right, ul, ur, sL, sR, ur * hr - ul * hl,
+                                           a1, dH, g, dry, fluct)
+        dm0, dp0, dm1, dp1 = at_rest(fluct, hl, hr, ml, mr, g, dpress)
+        fluct_m += [dm0, dm1]
+        fluct_p += [dp0, dp1]
+    return np.array(fluct_m), np.array(fluct_p), sL, sR
