@@ -47,8 +47,9 @@ _REPORT_LINE = re.compile(r"^\s*([\d.]+)%\s+\[\.\]\s+(\S+)")
 
 
 def readable(mangled: str) -> str:
-    """A numba function's symbol without the mangling: ``_ZN7pdeflow8numerics7sources
-    18friction_two_layerB3v53...`` -> ``pdeflow.numerics.sources.friction_two_layer``
+    """A numba function's symbol without the mangling: ``_ZN7pdeflow6models9two_layer
+    8exchange18friction_two_layerB3v53...`` ->
+    ``pdeflow.models.two_layer.exchange.friction_two_layer``
     (a ``cpython.`` or ``cfunc.`` prefix of a wrapper is kept; other names unchanged)."""
     prefix, _, rest = mangled.rpartition("_ZN")
     if not rest or not rest[0].isdigit():

@@ -216,7 +216,7 @@ import pdeflow
 from pdeflow.cases import load_case
 from pdeflow.simulate import run_model
 from pdeflow.numerics import compiled, layout as L
-from pdeflow.numerics.bundles import TWO_LAYER
+from pdeflow.models.two_layer.kernels import KERNELS as TWO_LAYER
 from pdeflow.numerics.splitting import scheme_stepper
 t_import = time.perf_counter() - t0
 loop = scheme_stepper(TWO_LAYER, L.FLUX_HLL, 1, L.LIMITER_MINMOD, False,

@@ -178,7 +178,8 @@ class Run:
                      self.pde.system.densities(self.pde.parameters))
         snaps = FextraStorageTracker(sorted(case.snapshot_times))
         trackers: list[Any] = [snaps] if case.snapshot_times else []
-        series = SeriesTracker(case.series_every) if case.erosion_series else None
+        series = (SeriesTracker(case.series_every, self.pde.system.diagnostics)
+                  if case.erosion_series else None)
         if series is not None:
             trackers.append(series)
         observers = [] if tracker is None else (
@@ -218,7 +219,7 @@ class Run:
                 f"a negative depth); nothing is kept. Use a smaller numerics.dt, or the "
                 f"fv-split solver (CFL-limited).",
                 report={"variant": self.variant.name}, state=final.data.copy())
-        diag = (SplitDiagnostics.from_array(data)
+        diag = (SplitDiagnostics.from_array(data, self.pde.system.diagnostics)
                 if isinstance(data, np.ndarray) and not self.variant.is_mol else None)
         t_final = float(sinfo.get("rest_time", info["controller"].get("t_final",
                                                                       case.t_end)))

@@ -16,8 +16,8 @@ their models (:mod:`pdeflow.models`), which ``import pdeflow`` imports.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -97,6 +97,12 @@ class EquationSystem:
     law_kernels: Any = None
     """the :attr:`kernels` with a rate-dependent basal friction law, for parameters
     whose ``rate_dependent_law`` is true (None: the model has no such choice)"""
+    diagnostics: Mapping[str, int] = field(default_factory=dict)
+    """the model's own slots of the fv-split diagnostics array, name -> index (named in
+    its layout, from :data:`pdeflow.numerics.layout.MODEL_SLOTS`): what its source stage
+    books and :attr:`summarize` reads as ``diagnostics.<name>``; ``eroded`` and
+    ``deposited`` (exchanged depth summed over cells [m]), if booked, also feed the
+    erosion series"""
 
     def kernels_for(self, parameters: Any) -> Any:
         """The kernel bundle for ``parameters``: :attr:`law_kernels` if they choose a

@@ -27,7 +27,7 @@ from .models.base import MAX_CFL as BASE_MAX_CFL
 from .numerics import layout as L
 
 FLUXES: tuple[str, ...] = tuple(L.FLUXES)
-RECONSTRUCTIONS: tuple[str, ...] = ("first-order", "muscl")
+RECONSTRUCTIONS: tuple[str, ...] = tuple(L.RECONSTRUCTIONS)
 MAX_CFL = BASE_MAX_CFL
 """The largest Courant number of each reconstruction (see pdeflow.models.base)."""
 LIMITERS: tuple[str, ...] = tuple(L.LIMITERS)

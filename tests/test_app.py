@@ -34,7 +34,7 @@ from pdeflow.app.kernels import WARMUP, KernelWarmup  # noqa: E402
 from pdeflow.app.runout import RunoutPage, format_r  # noqa: E402
 from pdeflow.cases import load_case  # noqa: E402
 from pdeflow.cli import main  # noqa: E402
-from pdeflow.numerics.hyperbolicity import (  # noqa: E402
+from pdeflow.models.two_layer.hyperbolicity import (  # noqa: E402
     discriminant,
     eigenvalues,
     lower_bound_fl,

@@ -188,7 +188,7 @@ def test_the_other_pages_open_from_their_tabs(opened):
 
 def test_hyperbolicity_page_shows_the_eigenvalues(opened):
     from pdeflow.app.hyperbolicity import G, format_eigenvalue
-    from pdeflow.numerics.hyperbolicity import eigenvalues
+    from pdeflow.models.two_layer.hyperbolicity import eigenvalues
 
     page = opened("hyperbolicity")
     lam = eigenvalues(0.5, 1.0, 3.01, 0.0, G, 0.67)

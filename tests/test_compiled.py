@@ -11,10 +11,11 @@ from pathlib import Path
 import pytest
 from numba.core import config
 
+from pdeflow.models.single_layer.kernels import KERNELS as SINGLE_LAYER
+from pdeflow.models.two_layer.kernels import KERNELS as TWO_LAYER
 from pdeflow.numerics import compile_parallel as parallel
 from pdeflow.numerics import compiled, warmup
 from pdeflow.numerics import layout as L
-from pdeflow.numerics.bundles import SINGLE_LAYER, TWO_LAYER
 from pdeflow.numerics.splitting import scheme_stepper
 
 #: the schemes of hll/first-order, Lie splitting, planar, for each model
@@ -59,7 +60,7 @@ def test_the_paper_cases_compile_every_kernel_once():
     # a closure's name ends in a digest of its constants (compiled.specialise)
     assert any(k.startswith("pdeflow.numerics.splitting.stepping_function.<locals>"
                             ".advance_") for k in used), sorted(used)
-    assert "pdeflow.numerics.source_stage.sources_two_layer" in used
+    assert "pdeflow.models.two_layer.sources.sources_two_layer" in used
     for name in ("reconstruct_muscl", "predictor", "rusanov", "ifcp", "roe",
                  "internal_speed", "source_rate", "source_stage_"):
         assert not any(name in k for k in used), (name, sorted(used))
@@ -74,7 +75,7 @@ def test_kernels_are_compiled_for_their_declared_signature_only():
     import numpy as np
 
     import pdeflow
-    from pdeflow.numerics.source_stage import sources_single
+    from pdeflow.models.single_layer.sources import sources_single
 
     stepper = scheme_stepper(*PLANAR_HLL_SINGLE).ready()
     eq = pdeflow.SingleLayerGranular()
@@ -95,7 +96,7 @@ def test_a_closure_is_cached_under_its_constants(tmp_path):
 import json
 from pdeflow.numerics import layout as L
 from pdeflow.numerics.advection import advection_kernel
-from pdeflow.numerics.bundles import SINGLE_LAYER
+from pdeflow.models.single_layer.kernels import KERNELS as SINGLE_LAYER
 from pdeflow.numerics.compiled import ready
 out = []
 for flux in (L.FLUX_HLL, L.FLUX_RUSANOV):
@@ -123,7 +124,7 @@ import json, sys
 import numpy as np
 from pdeflow.numerics import layout as L
 from pdeflow.numerics.advection import advection_kernel
-from pdeflow.numerics.bundles import SINGLE_LAYER
+from pdeflow.models.single_layer.kernels import KERNELS as SINGLE_LAYER
 from pdeflow.numerics.compiled import ready
 q = np.zeros((2, 8))
 q[0, :4] = 1.0
@@ -169,7 +170,7 @@ refresh = numba.core.base.BaseContext.refresh
 numba.core.base.BaseContext.refresh = lambda self: calls.append(1) or refresh(self)
 from pdeflow.numerics import layout as L
 from pdeflow.numerics.advection import advection_kernel
-from pdeflow.numerics.bundles import SINGLE_LAYER
+from pdeflow.models.single_layer.kernels import KERNELS as SINGLE_LAYER
 from pdeflow.numerics.compiled import ready
 k = ready(advection_kernel(SINGLE_LAYER, L.FLUX_HLL, 1, L.LIMITER_MINMOD,
                            L.GEOMETRY_PLANAR))
@@ -200,8 +201,9 @@ def test_cache_key_follows_the_code_of_every_called_kernel(monkeypatch):
     """A kernel's disk-cache key changes when a kernel it calls, in another file and
     two calls down, changes (numba's own key, the file's time stamp, does not: a stale
     cache once gave a wrong test 5.1 result)."""
-    from pdeflow.numerics import sources
-    from pdeflow.numerics.source_stage import sources_two_layer
+    from pdeflow.models.two_layer import exchange
+    from pdeflow.models.two_layer.sources import sources_two_layer
+    from pdeflow.numerics.implicit import coulomb_single
 
     def key() -> tuple:
         return sources_two_layer._cache._index_key(
@@ -209,9 +211,9 @@ def test_cache_key_follows_the_code_of_every_called_kernel(monkeypatch):
 
     before = key()
     assert key() == before  # the same in every call (and process: test above)
-    # sources_two_layer -> friction.implicit_friction -> sources.friction_two_layer
-    monkeypatch.setattr(sources.friction_two_layer.py_func, "__code__",
-                        sources.coulomb_single.py_func.__code__)
+    # sources_two_layer -> friction.implicit_friction -> exchange.friction_two_layer
+    monkeypatch.setattr(exchange.friction_two_layer.py_func, "__code__",
+                        coulomb_single.py_func.__code__)
     assert key() != before
 
 
@@ -239,8 +241,8 @@ def test_the_cache_key_changes_with_the_constants_a_kernel_reads(monkeypatch):
     must be recompiled, not loaded with the old offset (a stale source stage once wrote
     F_extra over the retry counter). The key also changes with a constant of the
     kernel's own module, and not with anything else."""
-    from pdeflow.numerics import source_stage
-    from pdeflow.numerics.source_stage import sources_two_layer
+    from pdeflow.models.two_layer import sources as source_stage
+    from pdeflow.models.two_layer.sources import sources_two_layer
 
     def key() -> tuple:
         return sources_two_layer._cache._index_key(
@@ -482,14 +484,18 @@ def test_prepare_refuses_what_is_no_kernel_or_stepper():
 def test_the_rest_of_the_package_warms_kernels_up_through_prepare_only():
     """Outside pdeflow/numerics nothing calls the compile machinery behind
     warmup.prepare: of compile_parallel only the fork helpers the figures use, of
-    compiled only ready (the py-pde solvers' rates and hooks compile on demand)."""
+    compiled only ready (the py-pde solvers' rates and hooks compile on demand) and,
+    in a model's package, the decorators and types that declare its kernels."""
     import ast
 
-    allowed = {"pdeflow.numerics.compile_parallel": {"can_fork", "fork_context"},
-               "pdeflow.numerics.compiled": {"ready"}}
+    declare = {"cached", "kernel", "specialise", "types", "f8", "i8", "STATE", "PARAMS",
+               "VECTOR", "FIELDS"}
     for path in sorted((ROOT / "pdeflow").rglob("*.py")):
         if path.parent.name == "numerics":
             continue
+        in_model = path.parent.parent.name == "models"
+        allowed = {"pdeflow.numerics.compile_parallel": {"can_fork", "fork_context"},
+                   "pdeflow.numerics.compiled": {"ready"} | (declare if in_model else set())}
         pkg = path.relative_to(ROOT).with_suffix("").parts[:-1]
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.ImportFrom) and node.module:

@@ -204,7 +204,7 @@ def test_bed_stresses_follow_the_closure_and_the_bed_holds_below_phi_b():
     without pressure gradients (phi_int < phi_B)."""
     from pdeflow.analysis.bed_stresses import bed_stresses
     from pdeflow.models import TwoLayerParameters
-    from pdeflow.numerics.sources import closure_rate
+    from pdeflow.models.two_layer.exchange import closure_rate
 
     p = TwoLayerParameters(theta_deg=25.0, k=0.8, c=1.0, du_reg=0.05)
     rng = np.random.default_rng(1)

@@ -22,8 +22,6 @@ from pdeflow import FVSplitSolver, SimulationBlowUp
 from pdeflow.cases import CaseError, load_case
 from pdeflow.io import atomic_path, write_json, write_npz
 from pdeflow.numerics import layout as L
-from pdeflow.numerics import layout_two_layer as T
-from pdeflow.numerics.vectorized import advection_rate
 from pdeflow.solvers.fv_split import diagnose_blowup
 
 from .helpers import grid, two_layer_column
@@ -297,7 +295,7 @@ def test_steps_beyond_the_cfl_limit_are_retried_not_blown_up():
             break
     assert solver.diagnostics[L.D_RETRIES] > 0, "no step of CFL 1.5 was rejected"
     P = eq.parameter_array()
-    rate, smax = advection_rate(before, 0.1, eq.bc_codes, P[T.G_Z], P[T.DRY], P[T.R])
+    rate, smax = eq.kernels.numpy_advection(before, 0.1, eq.bc_codes, P)
     full = 1.5 * 0.1 / smax
     new = before + full * rate
     assert np.any(new[::2] < -1e-12 * (1 + np.abs(before[::2])))  # a full step fails

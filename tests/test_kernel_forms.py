@@ -12,14 +12,14 @@ import math
 import numpy as np
 import pytest
 
-from pdeflow.numerics import layout as L
-from pdeflow.numerics.hyperbolicity import (
+from pdeflow.models.two_layer.exchange import friction_two_layer
+from pdeflow.models.two_layer.hyperbolicity import (
     band_lower_edge,
     is_hyperbolic,
     lower_bound_fl,
     restoration_target,
 )
-from pdeflow.numerics.sources import friction_two_layer
+from pdeflow.numerics import layout as L
 
 
 def _sign(x):

@@ -131,8 +131,8 @@ def test_a_compiled_kernel_has_the_private_state_pdeflow_reads():
     """On a kernel of pdeflow's: the dispatcher attributes, the cache it replaced, the
     index entry that in_disk_cache looks for (read here without its fallback to
     False, so that the failure says what moved) and the function pointer."""
+    from pdeflow.models.single_layer.sources import sources_single
     from pdeflow.numerics import compiled
-    from pdeflow.numerics.source_stage import sources_single
 
     k = compiled.ready(sources_single)
     for name in INSTANCE_ATTRIBUTES:

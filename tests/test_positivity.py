@@ -68,8 +68,8 @@ def test_a_film_on_an_uncovered_step_gets_only_the_share_its_depth_carries():
     fluctuation is of the order of its own depth (g h1 Delta H), no longer g h1bar Delta
     H with h1bar ~ 2 mm, and the two fluctuations still sum to the path-conservative
     jump of (24)."""
+    from pdeflow.models.two_layer.flux import fluctuations as fluctuations_two_layer
     from pdeflow.numerics.compiled import ready
-    from pdeflow.numerics.pvm import fluctuations_two_layer
 
     left = (4.05e-3, -0.0038, 0.2877)
     right = (1.985e-6, -0.0966, 0.3123)

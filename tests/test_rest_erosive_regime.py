@@ -9,7 +9,7 @@ carried the eroded mass at the lower layer's velocity (docs/model.md, "Coming to
 when the upper layer erodes"), every c = 3 set kept moving until t_end; the
 phi_B = 46 deg set kept moving until the upper layer's numerical viscosity stopped
 lifting material onto steps of the deposit that rise above its surface
-(``pdeflow.numerics.pvm.upper_layer_at_uncovered_step``).
+(``pdeflow.models.two_layer.flux.upper_layer_at_uncovered_step``).
 """
 
 from pathlib import Path

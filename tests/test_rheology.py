@@ -11,15 +11,11 @@ from pde.backends import get_backend
 
 import pdeflow
 from pdeflow.models.friction_laws import h_stop
+from pdeflow.models.single_layer import layout as S
+from pdeflow.models.two_layer import layout as T
+from pdeflow.models.two_layer.laws import friction_two_layer_law
 from pdeflow.numerics import layout as L
-from pdeflow.numerics import layout_single_layer as S
-from pdeflow.numerics import layout_two_layer as T
-from pdeflow.numerics.rheology import (
-    basal_accel,
-    friction_two_layer_law,
-    law_block,
-    law_speed,
-)
+from pdeflow.numerics.rheology import basal_accel, law_block, law_speed
 from tests.helpers import grid, step
 
 LAWS = ["pouliquen", "mu_i", "voellmy"]

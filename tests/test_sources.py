@@ -6,16 +6,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import pdeflow
-from pdeflow.numerics import layout as L
-from pdeflow.numerics import layout_two_layer as T
-from pdeflow.numerics.hyperbolicity import (
+from pdeflow.models.two_layer import layout as T
+from pdeflow.models.two_layer.exchange import exchange_step, friction_two_layer
+from pdeflow.models.two_layer.hyperbolicity import (
     band_lower_edge,
     discriminant,
     eigenvalues,
     is_hyperbolic,
     lower_bound_fl,
 )
-from pdeflow.numerics.sources import exchange_step, friction_two_layer
 
 pos = st.floats(0.01, 2.0)
 
@@ -142,7 +141,7 @@ def test_fextra_restores_hyperbolicity_and_conserves_momentum(mode):
     eq.source_kernel()(q, 1e-3, 1e-3, eq.parameter_array(), diag)
     u1, u2 = q[1] / q[0], q[3] / q[2]
     assert all(is_hyperbolic(q[0, i], q[2, i], u1[i], u2[i], 9.81, r, 1) for i in range(n))
-    assert diag[L.D_FEXTRA_MAX] > 0
+    assert diag[T.D_FEXTRA_MAX] > 0
     assert np.sum(r * q[1] + q[3]) == pytest.approx(p0, rel=1e-12)
     # the smallest correction: |du| ends within w of the boundary F_c1 (exact mode)
     if mode == "exact":
@@ -187,7 +186,7 @@ def test_direct_restoration_is_the_bisection_limit(mode):
     """The closed-form inversion of the friction step lands |du| on the band edge:
     hyperbolic, never more F_extra than bisection to w = 1e-3, and |du| within 1e-8
     (relative) of bisection to w = 1e-12."""
-    from pdeflow.numerics.friction import (
+    from pdeflow.models.two_layer.friction import (
         bisect_fextra,
         friction_params,
         implicit_friction,
@@ -238,11 +237,11 @@ def test_erosion_from_a_stuck_lower_layer_creates_no_momentum(h1, u1):
     p0 = r * q[1, 0] + q[3, 0]
     diag = eq.new_diagnostics(1)
     eq.source_kernel()(q, 5e-3, 5e-3, eq.parameter_array(), diag)
-    assert diag[L.D_ERODED] > 0  # the closure erodes here
+    assert diag[T.D_ERODED] > 0  # the closure erodes here
     assert q[3, 0] == 0.0  # the lower layer stays stuck
     assert r * q[1, 0] + q[3, 0] <= p0 * (1 + 1e-12)
     # the velocity of a speck is diluted by what it erodes: it cannot keep sliding
-    assert q[1, 0] / q[0, 0] < u1 * h1 / (h1 + diag[L.D_ERODED]) + 1e-12
+    assert q[1, 0] / q[0, 0] < u1 * h1 / (h1 + diag[T.D_ERODED]) + 1e-12
 
 
 def test_erosion_keeps_momentum_when_the_lower_layer_slides():
@@ -254,5 +253,5 @@ def test_erosion_keeps_momentum_when_the_lower_layer_slides():
     p0 = np.sum(r * q[1] + q[3])
     diag = eq.new_diagnostics(2)
     eq.source_kernel()(q, 5e-3, 5e-3, eq.parameter_array(), diag)
-    assert diag[L.D_ERODED] > 0
+    assert diag[T.D_ERODED] > 0
     assert np.sum(r * q[1] + q[3]) == pytest.approx(p0, rel=1e-12)

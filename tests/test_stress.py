@@ -38,8 +38,8 @@ from pde import CartesianGrid, PolarSymGrid
 import pdeflow
 from pdeflow import FVSplitSolver
 from pdeflow.metrics import mass
+from pdeflow.models.two_layer.hyperbolicity import is_hyperbolic
 from pdeflow.numerics import layout as L
-from pdeflow.numerics.hyperbolicity import is_hyperbolic
 
 settings.register_profile(
     "pdeflow-default", max_examples=150, deadline=None, derandomize=True,

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import pdeflow
-from pdeflow.numerics import layout as L
+from pdeflow.models.two_layer import layout as T
 from pdeflow.numerics.splitting import STATUS_REST
 
 from .helpers import grid, step, two_layer_column
@@ -16,7 +16,7 @@ def test_mass_conserved_to_round_off_with_walls():
     m0 = np.sum(r * st.data[0] + st.data[2])
     q, t, steps, status, diag = step(eq, st, 1.0)
     assert steps > 100
-    assert diag[L.D_DEPOSITED] > 0.1  # exchange really happened
+    assert diag[T.D_DEPOSITED] > 0.1  # exchange really happened
     m1 = np.sum(r * q[0] + q[2])
     assert abs(m1 - m0) <= 1e-13 * m0
 
@@ -32,7 +32,7 @@ def test_momentum_conserved_by_exchange_and_fextra():
     p0 = np.sum(0.67 * q[1] + q[3])
     diag = eq.new_diagnostics(50)
     eq.source_kernel()(q, 1e-3, 1e-3, eq.parameter_array(), diag)
-    assert diag[L.D_HYP_EVENTS] > 0 or diag[L.D_ERODED] + diag[L.D_DEPOSITED] > 0
+    assert diag[T.D_HYP_EVENTS] > 0 or diag[T.D_ERODED] + diag[T.D_DEPOSITED] > 0
     assert np.sum(0.67 * q[1] + q[3]) == pytest.approx(p0, rel=1e-12, abs=1e-12)
 
 

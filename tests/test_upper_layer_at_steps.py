@@ -1,15 +1,15 @@
-"""The upper layer at a step of a lower layer at rest (pdeflow.numerics.pvm,
+"""The upper layer at a step of a lower layer at rest (pdeflow.models.two_layer.flux,
 ``upper_layer_at_uncovered_step``): where the step rises above the upper layer's surface,
 the scheme's viscosity does not lift upper-layer material onto it."""
 
 import numpy as np
 import pytest
 
+from pdeflow.models.two_layer.flux import fluctuations as fluctuations_two_layer
+from pdeflow.models.two_layer.kernels import KERNELS as TWO_LAYER
 from pdeflow.numerics import layout as L
 from pdeflow.numerics.advection import rate_kernel
-from pdeflow.numerics.bundles import TWO_LAYER
 from pdeflow.numerics.compiled import ready
-from pdeflow.numerics.pvm import fluctuations_two_layer
 
 G = 9.81
 R = 0.67

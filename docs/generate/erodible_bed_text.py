@@ -127,7 +127,7 @@ def _why(n: dict[str, Any]) -> str:
     return (
         "## Why the model does not reproduce the trend\n\n"
         "Three things in the model's stress balance decide it (formulas in "
-        "`pdeflow.analysis.bed_stresses`, taken from `pdeflow/numerics/sources.py`):\n\n"
+        "`pdeflow.analysis.bed_stresses`, taken from `pdeflow/models/two_layer/exchange.py`):\n\n"
         "* **The bed never fails as a whole below phi_B.** A lower layer at rest is driven "
         "by gravity along the slope and the interface stress it receives, "
         "g_x h2 + r g_z h1 tan(phi_int), and resists with g_z (r h1 + h2) tan(phi_B). With "
@@ -145,7 +145,7 @@ def _why(n: dict[str, Any]) -> str:
         f"lose {_span(n, 'two layers, defaults')} of their run-out at e_i = H0/10, the "
         f"law set {_span(n, 'two layers, planar law set')}. Material the closure deposits "
         "carries its velocity u1 into the lower layer "
-        "(`pdeflow/numerics/source_stage.py`: the lower layer takes the rest of the "
+        "(`pdeflow/models/two_layer/sources.py`: the lower layer takes the rest of the "
         "momentum). On the rigid bed that new lower layer "
         "moves at u1 and slides on; on a bed at rest its momentum is shared with the "
         "bed's grains in the cell, and basal friction holds the mixture. The more bed "

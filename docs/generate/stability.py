@@ -48,7 +48,7 @@ from pdeflow.analysis.stability_problems import (  # noqa: E402
 from pdeflow.io import atomic_path  # noqa: E402
 from pdeflow.metrics import mass, total_depth  # noqa: E402
 from pdeflow.models import SingleLayerGranular, TwoLayerGranular  # noqa: E402
-from pdeflow.numerics.hyperbolicity import lower_bound_fl, upper_bound_fr  # noqa: E402
+from pdeflow.models.two_layer.hyperbolicity import lower_bound_fl, upper_bound_fr  # noqa: E402
 from pdeflow.variant import Variant  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]

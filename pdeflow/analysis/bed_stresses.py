@@ -1,7 +1,7 @@
 r"""The stresses at an erodible bed under a two-layer flow, from the model's formulas.
 
 Kinematic stresses (divided by rho2) [m^2/s^2] of a two-layer state (h1, u1, h2, u2 in
-m and m/s per cell), as in :mod:`pdeflow.numerics.sources` (r = rho1/rho2, g_z = g
+m and m/s per cell), as in :mod:`pdeflow.models.two_layer.exchange` (r = rho1/rho2, g_z = g
 cos(theta), g_x = g sin(theta), du = u1 - u2):
 
 * interface, upper side (22): :math:`t_1 = k\,r g_z h_1 \tan\varphi_{int} + c\,du^2`;

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from ..numerics import hyperbolicity as hyp
+from ..models.two_layer import hyperbolicity as hyp
 from ..variant import Variant
 
 G = 9.81  #: gravity of all problems [m/s^2]
@@ -100,7 +100,7 @@ def shear(r: float, du_scaled: float, cells: int = 400, t_end: float = 4.0,
 
 def shear_band(r: float) -> tuple[float, float]:
     """Edges (F_c1, F_c2) [m/s] of the non-hyperbolic band of the shear problem's layers
-    (:func:`pdeflow.numerics.hyperbolicity.band_edges`); NaN if there is none."""
+    (:func:`pdeflow.models.two_layer.hyperbolicity.band_edges`); NaN if there is none."""
     return hyp.band_edges(H1, H2, G, r) or (math.nan, math.nan)
 
 

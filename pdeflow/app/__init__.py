@@ -2,7 +2,7 @@
 
 Three pages over pdeflow's public API (they run cases with
 :func:`pdeflow.simulate.run_model` and :func:`pdeflow.analysis.sweep.run_sweep`, and analyse states
-with :mod:`pdeflow.numerics.hyperbolicity`):
+with :mod:`pdeflow.models.two_layer.hyperbolicity`):
 
 1. dam break (:mod:`.dam_break`): sliders for a case's parameters, both models animated,
    the summary table of ``pdeflow run``;

@@ -2,9 +2,9 @@
 relative velocities where two of them are complex, and where F_extra acts in the run.
 
 For a state (h1, h2 [m], r = rho1/rho2, du = u1 - u2 [m/s]) the page shows the roots
-of the characteristic polynomial (:func:`pdeflow.numerics.hyperbolicity.eigenvalues`)
+of the characteristic polynomial (:func:`pdeflow.models.two_layer.hyperbolicity.eigenvalues`)
 and the band F_c1 < |du| < F_c2 where the inner pair is complex (the discriminant of
-:mod:`pdeflow.numerics.hyperbolicity` is negative), with the closed-form bounds F_L and
+:mod:`pdeflow.models.two_layer.hyperbolicity` is negative), with the closed-form bounds F_L and
 F_R. Next to it: the cells and times where the dam-break page's current run needed
 F_extra, and the state of any of its cells (to analyse it with one click).
 """
@@ -28,8 +28,8 @@ from bokeh.palettes import Reds256
 from bokeh.plotting import figure
 
 from ..cases import PAPER_MODEL
-from ..numerics import hyperbolicity as hyp
-from ..numerics.hyperbolicity import (
+from ..models.two_layer import hyperbolicity as hyp
+from ..models.two_layer.hyperbolicity import (
     discriminant,
     eigenvalues,
     lower_bound_fl,
@@ -69,7 +69,7 @@ class LocalSpectrum:
 
 
 def band_edges(h1: float, h2: float, r: float, g: float = G) -> tuple[float, float] | None:
-    """(F_c1, F_c2) [m/s] of :func:`pdeflow.numerics.hyperbolicity.band_edges`, or None."""
+    """(F_c1, F_c2) [m/s] of :func:`pdeflow.models.two_layer.hyperbolicity.band_edges`, or None."""
     return hyp.band_edges(h1, h2, g, r)
 
 

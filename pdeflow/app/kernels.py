@@ -31,7 +31,7 @@ def warm_kernels() -> None:
     """Run every kernel the app uses once: compiles them, or loads them from the cache."""
     from ..cases import Case
     from ..checks import RunWarning
-    from ..numerics import hyperbolicity as hyp
+    from ..models.two_layer import hyperbolicity as hyp
     from ..numerics.warmup import prepare
     from ..simulate import case_steppers, run_model
 

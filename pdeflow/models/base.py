@@ -28,7 +28,7 @@ from ..numerics.geometry import Metric, geometry_of, metric_of
 from ..numerics.state import DRY_TOLERANCE
 
 BC_NAMES = L.BOUNDARIES
-RECONSTRUCTIONS = {"first-order": 1, "muscl": 2}
+RECONSTRUCTIONS = L.RECONSTRUCTIONS
 MAX_CFL = {"first-order": 1.0, "muscl": 0.5}
 """The largest Courant number of each reconstruction: the first-order update is positive
 up to 1; MUSCL's SSP-RK2 update with limited slopes keeps depths non-negative only up to

@@ -123,42 +123,6 @@ def reconstruct_muscl(q: np.ndarray, work: np.ndarray, lo: int, hi: int, bc_left
             work[1, k + 1, i] = hp * (u + 0.5 * su) if hp > dry else 0.0
 
 
-@cached
-def cell_jump_single(qm: np.ndarray, qp: np.ndarray, rate: np.ndarray, lo: int, hi: int,
-                     inv_dx: float, g: float, r: float, dry: float) -> None:
-    """Subtract the flux difference across the reconstruction inside cells lo..hi
-    (single layer; ``r`` unused)."""
-    for i in range(lo, hi + 1):
-        hl, hr = qm[0, i], qp[0, i]
-        ul = velocity(hl, qm[1, i], dry)
-        ur = velocity(hr, qp[1, i], dry)
-        rate[0, i] -= (ur * hr - ul * hl) * inv_dx
-        rate[1, i] -= (ur * ur * hr + 0.5 * g * hr * hr
-                       - ul * ul * hl - 0.5 * g * hl * hl) * inv_dx
-
-
-@cached
-def cell_jump_two_layer(qm: np.ndarray, qp: np.ndarray, rate: np.ndarray, lo: int,
-                        hi: int, inv_dx: float, g: float, r: float, dry: float) -> None:
-    """Subtract the path-conservative jump across the linear reconstruction inside cells
-    lo..hi (two layers)."""
-    for i in range(lo, hi + 1):
-        h1l, h1r = qm[0, i], qp[0, i]
-        h2l, h2r = qm[2, i], qp[2, i]
-        u1l = velocity(h1l, qm[1, i], dry)
-        u1r = velocity(h1r, qp[1, i], dry)
-        u2l = velocity(h2l, qm[3, i], dry)
-        u2r = velocity(h2r, qp[3, i], dry)
-        dh1 = h1r - h1l
-        dh2 = h2r - h2l
-        rate[0, i] -= (u1r * h1r - u1l * h1l) * inv_dx
-        rate[1, i] -= ((u1r * u1r * h1r - u1l * u1l * h1l)
-                       + g * 0.5 * (h1l + h1r) * (dh1 + dh2)) * inv_dx
-        rate[2, i] -= (u2r * h2r - u2l * h2l) * inv_dx
-        rate[3, i] -= ((u2r * u2r * h2r - u2l * u2l * h2l)
-                       + g * 0.5 * (h2l + h2r) * (dh2 + r * dh1)) * inv_dx
-
-
 ADVECT_SIGNATURE = (STATE, FIELDS, WORK, f8, METRIC, i8, i8, f8, f8, f8, i8, i8)
 
 

@@ -236,11 +236,13 @@ def _callees(compiled: Any) -> Iterator[Any]:
 
 
 def kernels() -> list[Any]:
-    """Every numba kernel of :mod:`pdeflow.numerics` in this process: the module-level
-    ones of the imported modules and the specialised ones built so far."""
+    """Every numba kernel of pdeflow in this process (:mod:`pdeflow.numerics` and the
+    models' packages): the module-level ones of the imported modules and the
+    specialised ones built so far."""
     found: dict[int, Any] = {}
+    top = __package__.split(".")[0] + "."
     for name, module in list(sys.modules.items()):
-        if name.startswith(__package__ + ".") and module is not None:
+        if name.startswith(top) and module is not None:
             for value in vars(module).values():
                 if isinstance(value, Dispatcher) and value.py_func.__module__ == name:
                     found[id(value)] = value

@@ -9,8 +9,9 @@ third node at the intermediate (internal) speed S_int and uses the parabola
           S \in \{S_L, S_{int}, S_R\},
 
 evaluated on the total jump as Q(A) dq = alpha0 dq + alpha1 A dq + alpha2 A (A dq), with A
-the pseudo-Jacobian of (28) at the Roe-averaged state. The internal eigenvalues are
-approximated by U_c -+ c_int with U_c = (h1 u2 + h2 u1)/H and
+the pseudo-Jacobian of (28) at the Roe-averaged state. The model supplies S_int; the
+two-layer model's (:func:`pdeflow.models.two_layer.flux.internal_speed`) approximates
+the internal eigenvalues by U_c -+ c_int with U_c = (h1 u2 + h2 u1)/H and
 c_int^2 = (1 - r) g h1 h2 / H (1 - du^2 / ((1 - r) g H)) (clipped at 0); S_int is the one
 of larger magnitude. Where the three nodes are too close (S_int at an end of [S_L, S_R]),
 the parabola degenerates and the HLL line is used; so it is near a layer's front (any
@@ -22,8 +23,6 @@ scheme Q = |A| (with Harten's entropy fix, and HLL at dry fronts).
 """
 
 from __future__ import annotations
-
-import math
 
 from .compiled import cached
 from .hll import hll_coefficients
@@ -38,20 +37,6 @@ def ifcp_coefficients(sL: float, sR: float, sint: float) -> tuple[float, float, 
     d1 = (abs(sR) - abs(sL)) / width
     d2 = (abs(sint) - abs(sL) - d1 * (sint - sL)) / ((sint - sL) * (sint - sR))
     return abs(sL) - d1 * sL + d2 * sL * sR, d1 - d2 * (sL + sR), d2
-
-
-@cached
-def internal_speed(h1: float, u1: float, h2: float, u2: float, g: float,
-                   r: float) -> float:
-    """Approximate internal eigenvalue of larger magnitude [m/s] (see module doc)."""
-    H = h1 + h2
-    if H <= 0.0:
-        return 0.0
-    du = u1 - u2
-    uc = (h1 * u2 + h2 * u1) / H
-    c2 = (1.0 - r) * g * h1 * h2 / H * (1.0 - du * du / ((1.0 - r) * g * H))
-    c = math.sqrt(c2) if c2 > 0.0 else 0.0
-    return uc + c if abs(uc + c) >= abs(uc - c) else uc - c
 
 
 @cached

@@ -2,9 +2,10 @@
 
 Numba kernels receive the physical and numerical parameters as one float64 array, so
 that a single compiled kernel (cached on disk) serves every parameter set and grid of
-a sweep. Each model has its own parameter layout (:mod:`.layout_two_layer`,
-:mod:`.layout_single_layer`); every layout starts with the header below, which the
-model-independent kernels (the stepping loop) read. The model classes in
+a sweep. Each model has its own parameter layout in its package
+(:mod:`pdeflow.models.two_layer.layout`, :mod:`pdeflow.models.single_layer.layout`);
+every layout starts with the header below, which the model-independent kernels (the
+stepping loop) read. The model classes in
 :mod:`pdeflow.models` fill these arrays; nothing else indexes them by number.
 
 All stresses and mass fluxes inside the kernels are *kinematic*, i.e. divided by the
@@ -18,22 +19,14 @@ G_X = 1  #: gravity along the bed (down-slope positive), g sin(theta) [m/s^2]
 N_HEADER = 2
 
 # --- diagnostics vector (post-step data of the splitting hook) -------------------------
+# The scheme's slots; the others below N_DIAG (MODEL_SLOTS) are the model's own, named
+# in its layout (e.g. pdeflow.models.two_layer.layout.D_MOVE_UPPER) and read by name
+# through its system (pdeflow.systems.EquationSystem.diagnostics).
 D_DT = 0  #: time step of the step just taken; 0 => the hook only cleans up [s]
 D_T = 1  #: simulation time at the end of the last step [s]
-D_MOVE_UPPER = 2  #: last time any upper-layer (or the single layer) cell moved [s]
-D_MOVE_LOWER = 3  #: last time any lower-layer cell moved [s]
-D_FAST_UPPER = 4  #: last time |u1| >= SLOW_U somewhere with h1 > SLOW_H [s]
-D_FAST_LOWER = 5  #: same for the lower layer [s]
-D_FEXTRA_MAX = 6  #: largest F_extra/rho1 applied so far [m^2/s^2]
-D_FEXTRA_CELL = 7  #: cell index where it occurred
-D_FEXTRA_TIME = 8  #: time at which it occurred [s]
-D_DEPOSITED = 9  #: cumulative upper -> lower exchange, as upper-layer depth x dx [m]
-D_ERODED = 10  #: cumulative lower -> upper exchange, as upper-layer depth x dx [m]
-D_HYP_EVENTS = 11  #: number of cell-steps in which hyperbolicity was restored
 D_CHANGED = 12  #: 1 if the last source stage changed any depth or momentum
 D_STEPS = 13  #: number of source stages applied
 D_FLUX_FALLBACKS = 14  #: steps redone with HLL because the IFCP step was not positive
-D_HYP_BISECTIONS = 15  #: restorations that needed the bisection fallback (see splitting)
 D_BAD_STEPS = 16  #: steps of a generic py-pde solver that left a non-finite value or a depth
 #: below -1e-12 m, before the post-step hook clipped it (models.base.make_post_step_hook)
 D_RETRIES = 17  #: steps rejected (a depth would turn negative) and retried with dt / 2
@@ -41,7 +34,10 @@ D_RESUME = 18  #: 1 if D_LIVE_LO..D_LIVE_HI are the live cells of the state the 
 #: loop left (the next call goes on from them; pdeflow.numerics.resting), else 0
 D_LIVE_LO = 19  #: first live cell after the loop's last step
 D_LIVE_HI = 20  #: last live cell after the loop's last step
-N_DIAG = 21  #: the per-cell F_extra/rho1 of the last step follows at N_DIAG
+MODEL_SLOTS = (2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 15)
+"""the slots a model's source stage books in (its layout names them; saved along with
+the scheme's when a step is retried)"""
+N_DIAG = 21  #: the model's per-cell diagnostic (F_extra/rho1 of the last step) follows
 
 # --- boundary conditions ---------------------------------------------------------------
 BC_WALL = 0
@@ -53,6 +49,7 @@ FLUX_HLL = 0
 FLUX_RUSANOV = 1
 FLUX_IFCP = 2
 FLUXES = {"hll": FLUX_HLL, "rusanov": FLUX_RUSANOV, "ifcp": FLUX_IFCP}
+RECONSTRUCTIONS = {"first-order": 1, "muscl": 2}  #: name -> order of accuracy
 LIMITER_MINMOD = 0
 LIMITER_MC = 1
 LIMITERS = {"minmod": LIMITER_MINMOD, "mc": LIMITER_MC}

@@ -42,7 +42,7 @@ import math
 
 from . import layout as L
 from .compiled import cached
-from .sources import _drag_root, friction_two_layer
+from .implicit import drag_root
 
 
 @cached(inline="always")
@@ -133,7 +133,7 @@ def law_speed(a, h, gw, hm, dt, law):
     if y <= 0.0:
         return 0.0  # held at rest: the static bound of the other laws is mu1
     if code == L.FRICTION_VOELLMY:
-        return _drag_root(y, 1.0, dt * law[6] / hm)
+        return drag_root(y, 1.0, dt * law[6] / hm)
     if code == L.FRICTION_COULOMB:
         return y
     return _rational_root(y, ydt * law[2], law[3] * h * math.sqrt(h))
@@ -144,65 +144,3 @@ def law_velocity(b, h, gw, hm, dt, law):
     """:func:`law_speed` with the sign of ``b``: the velocity after friction [m/s]."""
     s = law_speed(abs(b), h, gw, hm, dt, law)
     return s if b > 0.0 else -s
-
-
-@cached
-def _upper_over(v, b1, m1, kdt, cdt):
-    """Upper-layer velocity [m/s] of stage (32) over a lower layer moving at ``v``, and
-    its derivative in v [-] (the interface law (22) solved in closed form)."""
-    e = b1 - v
-    d = _drag_root(m1 * abs(e) - kdt, m1, cdt)
-    if d <= 0.0:
-        return v, 1.0  # locked to the lower layer
-    return v + (d if e > 0.0 else -d), 1.0 - m1 / (m1 + 2.0 * cdt * d)
-
-
-@cached
-def friction_two_layer_law(b1, b2, m1, m2, kdt, cdt, dt, gz, H, law):
-    r"""Stage (32) of :func:`pdeflow.numerics.sources.friction_two_layer` with the basal
-    law ``law`` (:func:`law_block`): returns (u1, u2) [m/s].
-
-    ``gz`` [m/s^2] times the weight depth m1 + m2 is the normal stress/rho2; ``H`` [m]
-    the depth the law sees (h1 + h2). With the static bound B_s = g_z (m1 + m2) mu_static(H)
-    the Coulomb solution decides stick or slip exactly as for Coulomb friction (every
-    law's friction at s -> 0+ is its static bound). A sliding lower layer's speed v is the
-    root of the total momentum balance
-    g(v) = m1 (u1(v) - b1) + m2 (v - b2) + dt B(v) = 0 (in the sliding direction),
-    B(v) = g_z (m1 + m2) mu(H, v) + D v^2, u1(v) from the interface law: g is strictly
-    increasing, g(0+) < 0 (the layer slides) and g >= 0 at the Coulomb solution with B_s
-    (B >= B_s), so a safeguarded Newton iteration in that bracket converges to the
-    unique root.
-    """
-    w = m1 + m2
-    u1c, u2c = friction_two_layer(b1, b2, m1, m2, kdt, cdt,
-                                  dt * gz * w * static_mu(law, H))
-    if u2c == 0.0:
-        return u1c, 0.0
-    sgn = 1.0 if u2c > 0.0 else -1.0
-    c1 = sgn * b1  # in the frame where the lower layer slides forwards
-    c2 = sgn * b2
-    lo = 0.0
-    hi = abs(u2c)
-    v = hi
-    drag = law[6]
-    for _ in range(100):
-        u1, du1 = _upper_over(v, c1, m1, kdt, cdt)
-        gv = (m1 * (u1 - c1) + m2 * (v - c2)
-              + dt * (gz * w * flowing_mu(law, H, v) + drag * v * v))
-        if gv > 0.0:
-            hi = v
-        elif gv < 0.0:
-            lo = v
-        else:
-            break
-        slope = (m1 * du1 + m2
-                 + dt * (gz * w * flowing_mu_slope(law, H, v) + 2.0 * drag * v))
-        v_new = v - gv / slope
-        if not (lo < v_new < hi):
-            v_new = 0.5 * (lo + hi)  # Newton left the bracket: bisect
-        if abs(v_new - v) <= 1e-15 * hi or hi - lo <= 1e-15 * hi:
-            v = v_new
-            break
-        v = v_new
-    u1, _ = _upper_over(v, c1, m1, kdt, cdt)
-    return sgn * u1, sgn * v

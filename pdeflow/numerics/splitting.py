@@ -5,7 +5,7 @@ One step of length dt (Lie splitting, as in the paper):
 1. advection (29): q <- q + dt L_HLL(q), dt = CFL dx / max|S| over the faces
    (:mod:`pdeflow.numerics.advection`);
 2. exchange (31), 3. implicit momentum sources (32), 4. hyperbolicity (33)-(34): the
-   source stage of :mod:`pdeflow.numerics.source_stage`.
+   source stage of the model (e.g. :mod:`pdeflow.models.two_layer.sources`).
 
 With MUSCL the advection is integrated with SSP-RK2 (Heun); with Strang splitting half
 a source step is applied before and after it.
@@ -321,9 +321,9 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int) ->
 ADVECT = types.FunctionType(types.Tuple((f8, i8, i8))(*ADVECT_SIGNATURE))
 """type of an advection stage passed to the loop (a function pointer)"""
 SOURCES = types.FunctionType(types.none(STATE, f8, f8, PARAMS, VECTOR, i8, i8))
-"""type of a source stage on a range of cells (:mod:`pdeflow.numerics.source_stage`)"""
+"""type of a source stage on a range of cells (e.g. :mod:`pdeflow.models.two_layer.sources`)"""
 PREDICTOR = types.FunctionType(types.none(STATE, f8, PARAMS, i8, i8))
-"""type of a MUSCL predictor (:mod:`pdeflow.numerics.friction`)"""
+"""type of a MUSCL predictor (e.g. :mod:`pdeflow.models.two_layer.friction`)"""
 
 
 @functools.cache
@@ -348,7 +348,7 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
     layer) and ``dry`` [m] are the model's. The model's kernels: ``advect`` (its
     advection stage), ``sources`` (its source stage), ``predictor`` (MUSCL, ``order``
     2: the friction predictor of the SSP-RK2/Heun integrator, see
-    :func:`~pdeflow.numerics.friction.predictor_two_layer`; else None) and
+    :func:`~pdeflow.models.two_layer.friction.predictor_two_layer`; else None) and
     ``fallback`` (``ifcp``: the HLL advection stage that redoes a step IFCP left
     negative; else None). ``strang`` applies half a source step before and after the
     advection (else Lie, as in the paper). With Strang, dt is chosen before the first

@@ -1,21 +1,24 @@
 """Vectorised numpy implementation of the method-of-lines rate (py-pde's numpy backend).
 
 An independent second implementation of the same formulas as the numba kernels in
-:mod:`pdeflow.numerics.hll`, :mod:`pdeflow.numerics.advection` and
-:mod:`pdeflow.numerics.mol`, written over whole arrays of faces. It serves py-pde's
+:mod:`pdeflow.numerics.hll` and :mod:`pdeflow.numerics.advection`, written over whole
+arrays of faces: the driver and the HLL pieces every layer shares; each model's face
+fluctuations and source rate have their numpy twins beside its kernels (e.g.
+:func:`pdeflow.models.two_layer.rates.fluctuations_np`). It serves py-pde's
 ``numpy`` backend and, in the tests, as a cross-check of the compiled kernels.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from . import layout as L
-from . import layout_single_layer as S
-from . import layout_two_layer as T
 
 
-def _vel(h: np.ndarray, m: np.ndarray, dry: float) -> np.ndarray:
+def velocity_np(h: np.ndarray, m: np.ndarray, dry: float) -> np.ndarray:
+    """Depth-averaged velocity m/h [m/s] where h > dry [m], else 0 (over arrays)."""
     return np.where(h > dry, m / np.where(h > dry, h, 1.0), 0.0)
 
 
@@ -30,7 +33,7 @@ def _with_ghosts(q: np.ndarray, bc_left: int, bc_right: int) -> np.ndarray:
     return ext
 
 
-def _hll_split(sL, sR, dq, a):
+def hll_split(sL, sR, dq, a):
     """HLL fluctuations D-, D+ for one (mass, momentum) pair over all faces."""
     width = np.where(sR - sL > 0, sR - sL, 1.0)
     dm = np.where(sL >= 0, 0.0, np.where(sR <= 0, a, sL / width * (sR * dq - a)))
@@ -39,104 +42,34 @@ def _hll_split(sL, sR, dq, a):
     return dm, dp
 
 
-def _at_uncovered_steps(left, right, ul, ur, sL, sR, a0, a1, dH, g, dry, fluct):
-    """The upper layer's fluctuations (D-_h1, D+_h1, D-_h1u1, D+_h1u1) with those of
-    :func:`pdeflow.numerics.pvm.upper_layer_at_uncovered_step` where the lower layer is
-    at rest on both sides of a face and steps above the upper layer's surface on one
-    side; ``fluct`` (the flux's own) elsewhere."""
-    h1l, h1r, h2l, h2r = left[0], right[0], left[2], right[2]
-    top = np.maximum(h2l, h2r)
-    s_l = h1l + h2l - top
-    s_r = h1r + h2r - top
-    at = ((left[3] == 0.0) & (right[3] == 0.0) & (h2r - h2l != 0.0)
-          & ((s_l <= 0.0) | (s_r <= 0.0)))
-    s_l = np.maximum(s_l, 0.0)
-    s_r = np.maximum(s_r, 0.0)
-    f_l, f_r = s_l * ul, s_r * ur
-    pressure = g * 0.5 * (h1l + h1r) * dH
-    mass = f_l + _hll_split(sL, sR, s_r - s_l, f_r - f_l)[0]
-    mom = f_l * ul + _hll_split(sL, sR, f_r - f_l, f_r * ur - f_l * ul)[0]
-    share_l = _hll_split(sL, sR, 0.0 * pressure, pressure)[0]  # the flux's share of it
-    share_r = pressure - share_l
-    # both wet: the thinner side gets at most the share its own depth carries, the
-    # thicker side the rest (as pvm.upper_layer_at_uncovered_step)
-    both = (h1l > dry) & (h1r > dry)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        h1bar = 0.5 * (h1l + h1r)
-        thin_l = np.where(both & (h1l < h1r), share_l * h1l / h1bar, share_l)
-        thin_r = np.where(both & (h1l >= h1r), share_r * h1r / h1bar, share_r)
-    share_l, share_r = (np.where(both & (h1l >= h1r), pressure - thin_r, thin_l),
-                        np.where(both & (h1l < h1r), pressure - thin_l, thin_r))
-    # a side without upper layer gets no share of the hydrostatic jump
-    share_l = np.where(h1l > dry, share_l, 0.0)
-    share_r = np.where(h1r > dry, share_r, 0.0)
-    dm0 = mass - ul * h1l
-    dm1 = mom - ul * ul * h1l + share_l
-    dp1 = ur * ur * h1r - ul * ul * h1l - (mom - ul * ul * h1l) + share_r
-    dm0_, dp0_, dm1_, dp1_ = fluct
-    return (np.where(at, dm0, dm0_), np.where(at, a0 - dm0, dp0_),
-            np.where(at, dm1, dm1_), np.where(at, dp1, dp1_))
+def layer_fluctuations(hl, hr, ml, mr, ul, ur, a1, sL, sR):
+    """HLL fluctuations (D-_h, D+_h, D-_hu, D+_hu) of one layer over all faces: its mass
+    flux jump and its momentum jump ``a1`` (the model's, with its pressure and
+    coupling), between wave speeds ``sL``, ``sR`` [m/s]."""
+    a0 = ur * hr - ul * hl
+    dm0, dp0 = hll_split(sL, sR, hr - hl, a0)
+    dm1, dp1 = hll_split(sL, sR, mr - ml, a1)
+    return dm0, dp0, dm1, dp1
 
 
-def advection_rate(q: np.ndarray, dx: float, bc: tuple[int, int], g: float,
-                   dry: float, r: float | None) -> tuple[np.ndarray, float]:
-    """HLL advection rate of a single-layer (r is None) or two-layer state, and the
-    largest wave speed over the faces [m/s] (for the CFL condition)."""
+def at_rest(fluct, hl, hr, ml, mr, g, dpress):
+    """The at-rest rule of :mod:`pdeflow.numerics.pvm` over all faces: where the layer has
+    no momentum on both sides, no mass moves and the hydrostatic jump g h ``dpress`` is
+    split by each side's own depth."""
+    dm0, dp0, dm1, dp1 = fluct
+    rest = (ml == 0.0) & (mr == 0.0)
+    return (np.where(rest, 0.0, dm0), np.where(rest, 0.0, dp0),
+            np.where(rest, 0.5 * g * hl * dpress, dm1),
+            np.where(rest, 0.5 * g * hr * dpress, dp1))
+
+
+def advection_rate(q: np.ndarray, dx: float, bc: tuple[int, int], fluctuations: Callable,
+                   *args: float) -> tuple[np.ndarray, float]:
+    """HLL advection rate of a state and the largest wave speed over the faces [m/s] (for
+    the CFL condition): ``fluctuations(left, right, *args) -> (D^-, D^+, sL, sR)``, the
+    model's over all faces (rows as the state's), between the ghosted states."""
     ext = _with_ghosts(q, *bc)
-    left = ext[:, :-1]
-    right = ext[:, 1:]
-    n_layers = q.shape[0] // 2
-    hs_l = [np.maximum(left[2 * k], 0.0) for k in range(n_layers)]
-    hs_r = [np.maximum(right[2 * k], 0.0) for k in range(n_layers)]
-    us_l = [_vel(left[2 * k], left[2 * k + 1], dry) for k in range(n_layers)]
-    us_r = [_vel(right[2 * k], right[2 * k + 1], dry) for k in range(n_layers)]
-    HL = sum(hs_l)
-    HR = sum(hs_r)
-    cL = np.sqrt(g * HL)
-    cR = np.sqrt(g * HR)
-
-    def extremes(hs, us):
-        if n_layers == 1:
-            return us[0], us[0]
-        u1 = np.where(hs[0] > dry, us[0], us[1])
-        u2 = np.where(hs[1] > dry, us[1], us[0])
-        return np.minimum(u1, u2), np.maximum(u1, u2)
-
-    loL, hiL = extremes(hs_l, us_l)
-    loR, hiR = extremes(hs_r, us_r)
-    sL = np.minimum(loL - cL, loR - cR)
-    sR = np.maximum(hiL + cL, hiR + cR)
-    dH = HR - HL
-    fluct_m = []
-    fluct_p = []
-    for k in range(n_layers):
-        hl, hr = left[2 * k], right[2 * k]
-        ml, mr = left[2 * k + 1], right[2 * k + 1]
-        ul, ur = us_l[k], us_r[k]
-        if n_layers == 1:
-            dpress = dH  # g h dH split by own depth at rest
-            a1 = ur * ur * hr + 0.5 * g * hr * hr - ul * ul * hl - 0.5 * g * hl * hl
-        elif k == 0:
-            dpress = dH
-            a1 = ur * ur * hr - ul * ul * hl + g * 0.5 * (hl + hr) * dH
-        else:
-            dpress = (right[2] - left[2]) + r * (right[0] - left[0])
-            a1 = ur * ur * hr - ul * ul * hl + g * 0.5 * (hl + hr) * dpress
-        a0 = ur * hr - ul * hl
-        dm0, dp0 = _hll_split(sL, sR, hr - hl, a0)
-        dm1, dp1 = _hll_split(sL, sR, mr - ml, a1)
-        if n_layers == 2 and k == 0:
-            dm0, dp0, dm1, dp1 = _at_uncovered_steps(left, right, ul, ur, sL, sR, a0, a1,
-                                                     dH, g, dry, (dm0, dp0, dm1, dp1))
-        rest = (ml == 0.0) & (mr == 0.0)
-        dm0 = np.where(rest, 0.0, dm0)
-        dp0 = np.where(rest, 0.0, dp0)
-        dm1 = np.where(rest, 0.5 * g * hl * dpress, dm1)
-        dp1 = np.where(rest, 0.5 * g * hr * dpress, dp1)
-        fluct_m += [dm0, dm1]
-        fluct_p += [dp0, dp1]
-    dmin = np.array(fluct_m)  # shape (fields, faces)
-    dplus = np.array(fluct_p)
+    dmin, dplus, sL, sR = fluctuations(ext[:, :-1], ext[:, 1:], *args)
     smax = float(np.max(np.maximum(np.abs(sL), np.abs(sR))))
     return -(dplus[:, :-1] + dmin[:, 1:]) / dx, smax
 
@@ -159,60 +92,3 @@ def basal_accel_np(P: np.ndarray, base: int, h: np.ndarray, gw: np.ndarray,
             mu = np.where(s < P[base + L.LAW_BETA_G] * np.sqrt(hp), mu_static, mu)
     mu = np.where(s > 0.0, mu, mu_static)
     return gw * mu + P[base + L.LAW_DRAG] * s * s / np.maximum(hm, 1e-300)
-
-
-def source_rate_single_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
-    """Gravity along the bed and regularised Coulomb friction of the single layer (the
-    numpy twin of :func:`pdeflow.numerics.mol.source_rate_single`)."""
-    rate = np.zeros_like(q)
-    h = np.maximum(q[0], 0.0)
-    u = _vel(h, q[1], P[S.DRY])
-    eps = P[S.MOL_EPS]
-    wet = h > P[S.DRY]
-    if int(P[S.LAW + L.LAW_CODE]) == L.FRICTION_COULOMB:
-        fric = P[S.G_Z] * h * P[S.TAN_B] * u / np.maximum(np.abs(u), eps)
-    else:
-        fric = h * basal_accel_np(P, S.LAW, h, P[S.G_Z], h, np.abs(u)) * u / np.maximum(
-            np.abs(u), eps)
-    rate[1] = np.where(wet, P[S.G_X] * h - fric, 0.0)
-    return rate
-
-
-def source_rate_two_layer_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
-    """Regularised source rate of (26)-(27) of the two layers (the numpy twin of
-    :func:`pdeflow.numerics.mol.source_rate_two_layer`)."""
-    rate = np.zeros_like(q)
-    r, g, gx, dry, eps = P[T.R], P[T.G_Z], P[T.G_X], P[T.DRY], P[T.MOL_EPS]
-    h1 = np.maximum(q[0], 0.0)
-    h2 = np.maximum(q[2], 0.0)
-    u1 = _vel(h1, q[1], dry)
-    u2 = _vel(h2, q[3], dry)
-    wet1 = h1 > dry
-    wet2 = h2 > dry
-    du = u1 - u2
-    num = P[T.C] * du * du - (1.0 - P[T.K]) * r * g * h1 * P[T.TAN_INT]
-    m = num / np.maximum(np.abs(du), max(P[T.DU_REG], eps))
-    closure = int(P[T.CLOSURE])
-    if closure == L.CLOSURE_RELAXED:
-        # relaxed closure: bounded by the relaxation towards h1_eq on tau
-        tau = P[T.TAU_STAR] * np.sqrt(np.maximum(h1 + h2, 1e-300) / g)
-        denom = (1.0 - P[T.K]) * r * g * P[T.TAN_INT]
-        h1_eq = P[T.C] * du * du / denom if denom > 0 else np.full_like(h1, np.inf)
-        dep = r * (np.minimum(h1_eq, h1) - h1) / tau
-        ero = np.maximum(r * (np.minimum(h1_eq, h1 + h2 / r) - h1) / tau, 0.0)
-        m = np.where(m < 0, np.maximum(m, dep), np.where(m > 0, np.minimum(m, ero), m))
-    m = np.where(wet1 & ((m <= 0) | wet2) & (closure != L.CLOSURE_NONE), m, 0.0)
-    sgn_du = du / np.maximum(np.abs(du), eps)
-    t1 = np.where(wet1, (P[T.K] * r * g * h1 * P[T.TAN_INT] + P[T.C] * du * du) * sgn_du,
-                  0.0)
-    rate[0] = m / r
-    rate[1] = np.where(wet1, gx * h1 + u1 * m / r - t1 / r, 0.0)
-    rate[2] = -m
-    if int(P[T.LAW + L.LAW_CODE]) == L.FRICTION_COULOMB:
-        bf = g * (r * h1 + h2) * P[T.TAN_B] * u2 / np.maximum(np.abs(u2), eps)
-    else:
-        gw = g * (r * h1 + h2) / np.maximum(h2, 1e-300)
-        bf = h2 * basal_accel_np(P, T.LAW, h1 + h2, gw, h2, np.abs(u2)) * u2 / np.maximum(
-            np.abs(u2), eps)
-    rate[3] = np.where(wet2, gx * h2 - u1 * m + t1 - bf, -u1 * m)
-    return rate

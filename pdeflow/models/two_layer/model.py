@@ -23,15 +23,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import systems
-from ..initial_shapes import is_column
-from ..numerics import layout as L
-from ..numerics import layout_two_layer as T
-from ..numerics.bundles import TWO_LAYER as KERNELS
-from ..numerics.bundles import TWO_LAYER_LAWS as LAW_KERNELS
-from ..numerics.geometry import Metric
-from .base import GranularPDE, SharedParameters, check_range, stop_time
-from .friction_laws import FrictionLawParameters
+from ... import systems
+from ...initial_shapes import is_column
+from ...numerics import layout as L
+from ...numerics.geometry import Metric
+from ..base import GranularPDE, SharedParameters, check_range, stop_time
+from ..friction_laws import FrictionLawParameters
+from . import layout as T
+from .kernels import KERNELS, LAW_KERNELS
 
 HYPERBOLICITY_MODES = L.HYPERBOLICITY_MODES
 
@@ -66,7 +65,7 @@ class TwoLayerParameters(FrictionLawParameters, SharedParameters):
     exchange_closure: str = "paper"
     """'paper': closure (25) as published (singular at du = 0); 'relaxed': its rate
     bounded by a relaxation towards the equilibrium depth on the time scale
-    tau_star sqrt(H/g) (see pdeflow.numerics.sources); 'none': no mass exchange (two
+    tau_star sqrt(H/g) (see pdeflow.models.two_layer.exchange); 'none': no mass exchange (two
     immiscible layers, for verification and teaching)"""
     tau_star: float = 1.0
     """relaxation time of the 'relaxed' closure in units of sqrt(H/g) [-]"""
@@ -95,7 +94,7 @@ class TwoLayerParameters(FrictionLawParameters, SharedParameters):
         self.validate_law()
 
     def to_array(self) -> np.ndarray:
-        """Kernel parameter vector (layout in :mod:`pdeflow.numerics.layout_two_layer`)."""
+        """Kernel parameter vector (layout in :mod:`.layout`)."""
         th = math.radians(self.theta_deg)
         P = np.zeros(T.SIZE)
         P[T.G_Z] = self.g * math.cos(th)
@@ -162,10 +161,10 @@ def summarize(diag, tf: float, at_rest: bool, x: np.ndarray, d: np.ndarray,
         "lower_slow_time": stop_time(diag.last_fast_lower, tf, False),
         "upper_slow_time": stop_time(diag.last_fast_upper, tf, False),
         "max_fextra_over_rho1": diag.fextra_max,
-        "max_fextra_x": float(x[diag.fextra_cell]),
+        "max_fextra_x": float(x[int(diag.fextra_cell)]),
         "max_fextra_time": diag.fextra_time,
-        "hyperbolicity_events": diag.hyperbolicity_events,
-        "hyperbolicity_bisections": diag.hyperbolicity_bisections,
+        "hyperbolicity_events": int(diag.hyperbolicity_events),
+        "hyperbolicity_bisections": int(diag.hyperbolicity_bisections),
         "deposited_volume": float(diag.deposited * dx) if planar else None,
         "eroded_volume": float(diag.eroded * dx) if planar else None,
         "upper_volume_final": metric.integral(d[0]),
@@ -179,7 +178,7 @@ SYSTEM = systems.register(systems.EquationSystem(
     layers=(systems.Layer("h1", "h1u1", "u1", "upper layer", "upper"),
             systems.Layer("h2", "h2u2", "u2", "lower layer", "lower")),
     parameters_class=TwoLayerParameters, pde_class=TwoLayerGranular, kernels=KERNELS,
-    law_kernels=LAW_KERNELS,
+    law_kernels=LAW_KERNELS, diagnostics=T.DIAGNOSTICS,
     densities=lambda p: (p.density_ratio, 1.0), layer_depths=layer_depths,
     summarize=summarize, has_fextra=True, bytes_per_cell=320,
     paper_runout_law=(1.61, 0.84), bed_layer=1,

@@ -77,7 +77,8 @@ from __future__ import annotations
 
 import math
 
-from .compiled import cached
+from ...numerics.compiled import cached
+from ...numerics.implicit import drag_root
 
 
 @cached
@@ -89,29 +90,6 @@ def _sign(x: float) -> float:
     return 0.0
 
 
-@cached
-def coulomb_single(b: float, mu_dt: float) -> float:
-    """Backward-Euler Coulomb step u = b - mu_dt Sgn(u) (set-valued): shrink towards 0.
-
-    ``b`` is the velocity before friction [m/s], ``mu_dt`` = dt g_z tan(phi) [m/s].
-    """
-    if b > mu_dt:
-        return b - mu_dt
-    if b < -mu_dt:
-        return b + mu_dt
-    return 0.0
-
-
-@cached
-def _drag_root(y: float, mass: float, cdt: float) -> float:
-    """Positive x with mass x + cdt x^2 = y (y >= 0), in a cancellation-free form."""
-    if y <= 0.0:
-        return 0.0
-    if cdt <= 0.0:
-        return y / mass
-    return 2.0 * y / (mass + math.sqrt(mass * mass + 4.0 * cdt * y))
-
-
 @cached(inline="always")
 def _sliding(p, b1, m1, mt, mu, Kdt, Cdt):
     """(d, u2) [m/s] of :func:`friction_two_layer` with the lower layer sliding, given
@@ -119,7 +97,7 @@ def _sliding(p, b1, m1, mt, mu, Kdt, Cdt):
     the relative velocity d = u1 - u2 solves mu d + Cdt d|d| + Kdt Sgn(d) = rel with
     rel = m1 (b1 - p/mt), and u2 = (p - m1 d)/mt."""
     rel = m1 * (b1 - p / mt)  # = mu (b1 - u_mean) : drive of the relative velocity
-    d = _sign(rel) * _drag_root(abs(rel) - Kdt, mu, Cdt)
+    d = _sign(rel) * drag_root(abs(rel) - Kdt, mu, Cdt)
     return d, (p - m1 * d) / mt
 
 
@@ -142,7 +120,7 @@ def friction_two_layer(b1, b2, m1, m2, Kdt, Cdt, Bdt):
     df, u2f = _sliding(p0 - Bdt, b1, m1, mt, mu, Kdt, Cdt)  # s2 = +1
     db, u2b = _sliding(p0 + Bdt, b1, m1, mt, mu, Kdt, Cdt)  # s2 = -1
     # 1) try the lower layer stuck: the upper layer slides over a fixed surface
-    u1 = _sign(b1) * _drag_root(m1 * abs(b1) - Kdt, m1, Cdt)
+    u1 = _sign(b1) * drag_root(m1 * abs(b1) - Kdt, m1, Cdt)
     push = m2 * b2 + m1 * (b1 - u1)  # force the stuck lower layer must resist, x dt
     if abs(push) <= Bdt:
         return u1, 0.0

@@ -43,8 +43,8 @@ import math
 
 import numpy as np
 
-from . import layout as L
-from .compiled import cached
+from ...numerics import layout as L
+from ...numerics.compiled import cached
 
 
 @cached

@@ -3,11 +3,11 @@ r"""The source stages (31)-(34) of the split scheme, cell by cell.
 One step of length dt (Lie splitting, as in the paper) advects (29) and then applies,
 in every wet cell:
 
-2. exchange (31): limited closure (25), see :func:`pdeflow.numerics.sources.exchange_step`;
+2. exchange (31): limited closure (25), see :func:`.exchange.exchange_step`;
    the exchanged mass carries the velocity of the layer it leaves;
 3. implicit momentum sources (32): gravity along the bed, Voellmy interface stress
-   (t1 - M du where the step eroded, see :mod:`pdeflow.numerics.sources`), Coulomb basal
-   friction, solved for both layers together (:mod:`pdeflow.numerics.friction`);
+   (t1 - M du where the step eroded, see :mod:`.exchange`), Coulomb basal
+   friction, solved for both layers together (:mod:`.friction`);
 4. hyperbolicity (33)-(34): where the inner eigenvalues are complex, stage 3 is
    repeated with the smallest extra exchange F_extra that restores hyperbolicity.
 
@@ -15,7 +15,7 @@ Stages 2-4 form :func:`source_stage_two_layer`, which is also what the PDE's pos
 hook runs; with dt = 0 it only cleans up (non-negative depths, zero velocity in dry
 cells), which is what a method-of-lines solver needs. The stepping loop of the
 ``fv-split`` solver (:mod:`pdeflow.numerics.splitting`) calls the same stage on the wet
-cells only (:func:`sources_two_layer`, :func:`sources_single`).
+cells only (:func:`sources_two_layer`).
 """
 
 from __future__ import annotations
@@ -24,14 +24,13 @@ import math
 
 import numpy as np
 
-from . import layout as L
-from . import layout_single_layer as S
-from . import layout_two_layer as T
-from .compiled import PARAMS, STATE, VECTOR, cached, f8, i8, kernel
+from ...numerics import layout as L
+from ...numerics.compiled import PARAMS, STATE, VECTOR, cached, f8, i8, kernel
+from ...numerics.state import velocity
+from . import layout as T
+from .exchange import exchange_step
 from .friction import friction_params, implicit_friction, restore_to_edge
 from .hyperbolicity import restoration_target
-from .sources import coulomb_single, exchange_step
-from .state import velocity
 
 
 @kernel(STATE, f8, f8, PARAMS, VECTOR)
@@ -116,9 +115,9 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
                             u1 = mom / (r * h1)
                     changed = True
                     if dh1 < 0.0:
-                        diag[L.D_DEPOSITED] -= dh1
+                        diag[T.D_DEPOSITED] -= dh1
                     else:
-                        diag[L.D_ERODED] += dh1
+                        diag[T.D_ERODED] += dh1
             # --- (32) implicit momentum sources ------------------------------------------
             b1 = u1 + dt * gx if h1 > dry else 0.0
             b2 = u2 + dt * gx if h2 > dry else 0.0
@@ -130,13 +129,13 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
                     f, v1, v2, bisected = restore_to_edge(b1, b2, h1, h2, v1, v2, dt, fp,
                                                           k_eff, c_eff, edge)
                     if bisected:
-                        diag[L.D_HYP_BISECTIONS] += 1.0
+                        diag[T.D_HYP_BISECTIONS] += 1.0
                     fex[i] = abs(f) / r
-                    diag[L.D_HYP_EVENTS] += 1.0
-                    if fex[i] > diag[L.D_FEXTRA_MAX]:
-                        diag[L.D_FEXTRA_MAX] = fex[i]
-                        diag[L.D_FEXTRA_CELL] = i
-                        diag[L.D_FEXTRA_TIME] = t
+                    diag[T.D_HYP_EVENTS] += 1.0
+                    if fex[i] > diag[T.D_FEXTRA_MAX]:
+                        diag[T.D_FEXTRA_MAX] = fex[i]
+                        diag[T.D_FEXTRA_CELL] = i
+                        diag[T.D_FEXTRA_TIME] = t
             u1 = v1
             u2 = v2
         m1 = h1 * u1 if h1 > dry else 0.0
@@ -156,69 +155,19 @@ def sources_two_layer(q: np.ndarray, dt: float, t: float, P: np.ndarray,
     _close_stage(diag, t, moving1, fast1, moving2, fast2, changed)
 
 
-@kernel(STATE, f8, f8, PARAMS, VECTOR)
-def source_stage_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
-                        diag: np.ndarray) -> None:
-    """Implicit Coulomb friction (and gravity along the bed) for the single layer."""
-    sources_single(q, dt, t, P, diag, 0, q.shape[1] - 1)
-
-
-@kernel(STATE, f8, f8, PARAMS, VECTOR, i8, i8)
-def sources_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
-                   diag: np.ndarray, lo: int, hi: int) -> None:
-    """:func:`source_stage_single` on the cells ``lo..hi`` only."""
-    g = P[S.G_Z]
-    gx = P[S.G_X]
-    dry = P[S.DRY]
-    friction = basal_friction(dt, g, P)
-    moving = False
-    fast = False
-    for i in range(lo, hi + 1):
-        h = q[0, i]
-        m = q[1, i]
-        if h == 0.0 and m == 0.0:
-            continue
-        h = max(h, 0.0)
-        u = velocity(h, m, dry)
-        if dt > 0.0 and h > dry:
-            u = basal_velocity(u + dt * gx, h, dt, g, friction)
-        m = h * u if h > dry else 0.0
-        if m != 0.0:
-            moving = True
-            if h > P[S.SLOW_H] and abs(u) >= P[S.SLOW_U]:
-                fast = True
-        q[0, i] = h
-        q[1, i] = m
-    _close_stage(diag, t, moving, fast, False, False, False)
-
-
-@cached(inline="always")
-def basal_friction(dt, g, P):
-    """What the single layer's implicit Coulomb friction needs of a step: mu g_z dt
-    [m/s] (computed once per stage)."""
-    return dt * g * P[S.TAN_B]
-
-
-@cached(inline="always")
-def basal_velocity(b, h, dt, g, friction):
-    """The velocity [m/s] after the implicit basal friction of a step from ``b`` [m/s]
-    (set-valued: 0 where |b| <= mu g_z dt)."""
-    return coulomb_single(b, friction)
-
-
 @cached(inline="always")
 def _close_stage(diag, t, moving1, fast1, moving2, fast2, changed):
     """Book a source stage ending at ``t`` [s] in ``diag``: the times of the last motion
     (``moving``: a layer has momentum; ``fast``: faster than SLOW_U where deeper than
-    SLOW_H) of layer 1 (or the single layer) and 2, whether it changed anything."""
+    SLOW_H) of layer 1 and 2, whether it changed anything."""
     if moving1:
-        diag[L.D_MOVE_UPPER] = t
+        diag[T.D_MOVE_UPPER] = t
     if moving2:
-        diag[L.D_MOVE_LOWER] = t
+        diag[T.D_MOVE_LOWER] = t
     if fast1:
-        diag[L.D_FAST_UPPER] = t
+        diag[T.D_FAST_UPPER] = t
     if fast2:
-        diag[L.D_FAST_LOWER] = t
+        diag[T.D_FAST_LOWER] = t
     diag[L.D_CHANGED] = 1.0 if (changed or moving1 or moving2) else 0.0
     diag[L.D_T] = t
     diag[L.D_STEPS] += 1.0

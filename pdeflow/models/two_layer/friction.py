@@ -1,13 +1,13 @@
 r"""Implicit friction (32) of one cell, with the extra exchange F_extra of (33)-(34).
 
 :func:`implicit_friction` solves stage (32) of a cell for both layers together, in closed
-form (:func:`pdeflow.numerics.sources.friction_two_layer`), with an extra momentum
+form (:func:`.exchange.friction_two_layer`), with an extra momentum
 exchange F_extra between the layers; :func:`restore_hyperbolicity` finds the smallest
 F_extra after which the cell's state is hyperbolic (33)-(34), by inverting that closed
 form, with :func:`bisect_fextra` as the fallback. The predictors zero the momentum that
 friction would hold at rest in the intermediate stage of SSP-RK2 (MUSCL).
 
-Kinematic units (divided by rho2) as in :mod:`pdeflow.numerics.sources`:
+Kinematic units (divided by rho2) as in :mod:`.exchange`:
 f = F_extra/rho2 [m^2/s^2], velocities [m/s], depths [m].
 
 The helpers take the parameters they read as the tuple ``fp`` of :func:`friction_params`
@@ -19,13 +19,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import layout as L
-from . import layout_single_layer as S
-from . import layout_two_layer as T
-from .compiled import PARAMS, STATE, cached, f8, i8, kernel
+from ...numerics import layout as L
+from ...numerics.compiled import PARAMS, STATE, cached, f8, i8, kernel
+from ...numerics.implicit import coulomb_single, drag_root
+from ...numerics.state import velocity
+from . import layout as T
+from .exchange import friction_two_layer
 from .hyperbolicity import band_lower_edge, is_hyperbolic, lower_bound_fl
-from .sources import _drag_root, coulomb_single, friction_two_layer
-from .state import velocity
 
 FP_R, FP_G, FP_DRY, FP_TAN_INT, FP_TAN_B, FP_W, FP_MODE = range(7)
 """positions in :func:`friction_params`' tuple"""
@@ -78,7 +78,7 @@ def implicit_friction(b1, b2, h1, h2, dt, fp, f, k, c):
         # no lower layer: the upper layer rubs on the bed with the interface law (22)
         m1 = r * h1
         kdt = dt * k * r * g * h1 * fp[FP_TAN_INT]
-        u1 = _drag_root(m1 * abs(b1) - kdt, m1, dt * c)
+        u1 = drag_root(m1 * abs(b1) - kdt, m1, dt * c)
         return (u1 if b1 > 0.0 else -u1), 0.0
     if wet2:
         return 0.0, bed_under_lower(b2, h1, h2, dt, g, r, fp)
@@ -129,9 +129,9 @@ def restore_hyperbolicity(b1, b2, h1, h2, u1, u2, dt, fp, k, c):
     """Smallest F_extra/rho2 [m^2/s^2] making the post-friction state (u1, u2) [m/s]
     of a non-hyperbolic cell hyperbolic, the velocities it leads to, and whether the
     bisection fallback was used: :func:`restore_to_edge` with the edge of
-    :func:`pdeflow.numerics.hyperbolicity.band_lower_edge` (F_L in ``bound`` mode).
+    :func:`pdeflow.models.two_layer.hyperbolicity.band_lower_edge` (F_L in ``bound`` mode).
     The source stage finds the edge with its hyperbolicity test
-    (:func:`pdeflow.numerics.hyperbolicity.restoration_target`)."""
+    (:func:`pdeflow.models.two_layer.hyperbolicity.restoration_target`)."""
     g = fp[FP_G]
     r = fp[FP_R]
     if int(fp[FP_MODE]) == L.HYPERBOLICITY_BOUND:
@@ -150,7 +150,7 @@ def restore_to_edge(b1, b2, h1, h2, u1, u2, dt, fp, k, c, edge):
     lower band edge F_c1 (F_L in ``bound`` mode; <= 0: none found, bisect). Stage (32)
     with the extra exchange f = F_extra/rho2
     shifts b1 by -dt f/m1 and b2 by +dt f/m2 and keeps m1 b1 + m2 b2, so on each branch
-    of its closed-form solution (:func:`pdeflow.numerics.sources.friction_two_layer`)
+    of its closed-form solution (:func:`.exchange.friction_two_layer`)
     du is an explicit function of f, inverted here for du = sgn(du0) d with
 
     * lower layer sliding in direction s2 (mu = m1 m2/(m1 + m2), p = m1 b1 + m2 b2
@@ -224,16 +224,3 @@ def predictor_two_layer(q: np.ndarray, dt: float, P: np.ndarray, lo: int,
             q[1, i] = 0.0
         if u2 == 0.0:
             q[3, i] = 0.0
-
-
-@kernel(STATE, f8, PARAMS, i8, i8)
-def predictor_single(q: np.ndarray, dt: float, P: np.ndarray, lo: int, hi: int) -> None:
-    """:func:`predictor_two_layer` for the single layer (Coulomb friction)."""
-    dry = P[S.DRY]
-    for i in range(lo, hi + 1):
-        h = max(q[0, i], 0.0)
-        if h > dry:
-            u = coulomb_single(q[1, i] / h + dt * P[S.G_X],
-                               dt * P[S.G_Z] * P[S.TAN_B])
-            if u == 0.0:
-                q[1, i] = 0.0

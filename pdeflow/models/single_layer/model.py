@@ -20,12 +20,11 @@ from typing import Any
 
 import numpy as np
 
-from .. import systems
-from ..numerics import layout_single_layer as S
-from ..numerics.bundles import SINGLE_LAYER as KERNELS
-from ..numerics.bundles import SINGLE_LAYER_LAWS as LAW_KERNELS
-from .base import GranularPDE, SharedParameters, check_range, stop_time
-from .friction_laws import FrictionLawParameters
+from ... import systems
+from ..base import GranularPDE, SharedParameters, check_range, stop_time
+from ..friction_laws import FrictionLawParameters
+from . import layout as S
+from .kernels import KERNELS, LAW_KERNELS
 
 
 @dataclass
@@ -44,7 +43,7 @@ class SingleLayerParameters(FrictionLawParameters, SharedParameters):
         self.validate_law()
 
     def to_array(self) -> np.ndarray:
-        """Kernel parameter vector (layout in :mod:`pdeflow.numerics.layout_single_layer`)."""
+        """Kernel parameter vector (layout in :mod:`.layout`)."""
         th = math.radians(self.theta_deg)
         P = np.zeros(S.SIZE)
         P[S.G_Z] = self.g * math.cos(th)
@@ -70,8 +69,8 @@ class SingleLayerGranular(GranularPDE):
 def summarize(diag, tf: float, at_rest: bool, x: np.ndarray, d: np.ndarray,
               metric: Any) -> dict:
     """The single-layer numbers of a run's summary."""
-    return {"stop_time": stop_time(diag.last_move_upper, tf, at_rest),
-            "slow_time": stop_time(diag.last_fast_upper, tf, False),
+    return {"stop_time": stop_time(diag.last_move, tf, at_rest),
+            "slow_time": stop_time(diag.last_fast, tf, False),
             "max_fextra_over_rho1": 0.0}
 
 
@@ -79,7 +78,8 @@ SYSTEM = systems.register(systems.EquationSystem(
     name="single_layer", label="single layer", adjective="single-layer",
     layers=(systems.Layer("h", "hu", "u", "single layer", "single"),),
     parameters_class=SingleLayerParameters, pde_class=SingleLayerGranular,
-    kernels=KERNELS, law_kernels=LAW_KERNELS, densities=lambda p: (1.0,),
+    kernels=KERNELS, law_kernels=LAW_KERNELS, diagnostics=S.DIAGNOSTICS,
+    densities=lambda p: (1.0,),
     layer_depths=lambda h, x, ini, p: (h,),
     summarize=summarize, bytes_per_cell=180, paper_runout_law=(2.25, 1.06),
     quantities=(systems.Quantity("slow_time", "slow", "s"),)))
