@@ -13,12 +13,13 @@ class does not need (scheme, friction law, the command line) hidden.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import math
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import panel as pn
-from bokeh.models import GlyphRenderer, Span
+from bokeh.models import FixedTicker, GlyphRenderer, NumeralTickFormatter, Span
 
 SIDEBAR_PX = 300
 """Width of a page's side bar of parameters [px]."""
@@ -85,6 +86,36 @@ def style_figure(fig: Any, present: bool) -> None:
 def style_figures(figures: Iterable[Any], present: bool) -> None:
     for f in figures:
         style_figure(f, present)
+
+
+LOG_MANTISSAS = (1, 2, 3, 5)
+"""The labelled ticks of a log axis in each decade: 1, 2, 3, 5, 10, 20, ..."""
+
+
+def log_ticks(low: float, high: float, mantissas: Sequence[int] = LOG_MANTISSAS
+              ) -> list[float]:
+    """The ticks ``m * 10**k`` (m in ``mantissas``) in [low, high] (> 0), ascending.
+
+    Bokeh's log ticker labels only the decades, and over less than about two decades
+    falls back to linear steps: on the run-out law's a axis (1 to 35) it labelled 5, 10,
+    15, ... and nothing below 5."""
+    ticks = []
+    for k in range(math.floor(math.log10(low)), math.ceil(math.log10(high)) + 1):
+        for m in mantissas:
+            tick = float(m * 10.0**k) if k >= 0 else m / 10.0**-k  # 0.5, not 0.5000001
+            if low * (1 - 1e-9) <= tick <= high * (1 + 1e-9):
+                ticks.append(tick)
+    return ticks
+
+
+def label_log_axis(axis: Any, low: float, high: float) -> None:
+    """Ticks of :func:`log_ticks` on the Bokeh log ``axis`` shown over [low, high] (and a
+    decade beyond, for panning), labelled as plain numbers (0.5, 1, 20; not 10^0), with
+    a minor tick at every 1..9 x 10^k."""
+    low, high = low / 10, high * 10
+    axis.ticker = FixedTicker(ticks=log_ticks(low, high),
+                              minor_ticks=log_ticks(low, high, range(1, 10)))
+    axis.formatter = NumeralTickFormatter(format="0[.][0000]")
 
 
 def legend_outside(fig: Any, place: str = "right") -> None:
