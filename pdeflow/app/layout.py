@@ -34,6 +34,23 @@ def _url_argument(name: str) -> str | None:
     return value[0].decode() if value else None
 
 
+def _styles_from_this_server() -> None:
+    """Point the session's stylesheets at this server, before any is made.
+
+    Panel's widgets name their stylesheets by CDN address and rewrite them to the
+    server's own (``dist_url``) once the page is rendered; a stylesheet made before
+    that and shown later (the presentation toggle, a new case) kept the CDN address,
+    and a browser offline could not load it. The address is the one Panel's page
+    template gives the same document."""
+    from panel.io.resources import LOCAL_DIST, use_cdn
+
+    if not served() or use_cdn():
+        return
+    rel = pn.state.rel_path
+    pn.state.curdoc._template_variables.setdefault(
+        "dist_url", f"{rel}/{LOCAL_DIST}" if rel else LOCAL_DIST)
+
+
 def _requested_present() -> bool | None:
     """``?present=1`` (or 0) in the URL of a served session; None if not given."""
     value = _url_argument("present")
@@ -121,6 +138,7 @@ def create_app(case_dir: str | Path | None = None, page: str | None = None,
     elapsed time, and builds its pages when they are ready; elsewhere (Jupyter, a
     script) this call prints the same and waits.
     """
+    _styles_from_this_server()
     case_dir = find_case_dir(case_dir)
     page = page or _url_argument("page")
     url_present = _requested_present()

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 import panel as pn
-from bokeh.models import ColumnDataSource, LinearColorMapper
+from bokeh.models import ColumnDataSource, LinearColorMapper, Range1d
 from bokeh.plotting import figure
 
 from ..plotting import DRY
@@ -20,6 +20,8 @@ from .look import style_figures
 
 PLAN_PIXELS = 121
 """Pixels across the plan view (the revolved total depth)."""
+FRAME_PX = 230
+"""Width and height of the plan view's plot area [px] (square: a circle is round)."""
 
 
 def plan_view(r: np.ndarray, depth: np.ndarray, radius: float,
@@ -63,6 +65,8 @@ class PlanView:
         ``radius`` [m], revolved (while :attr:`visible`)."""
         self.source.data = {"image": [plan_view(r, depth, radius)], "x": [-radius],
                             "y": [-radius], "dw": [2 * radius], "dh": [2 * radius]}
+        for axis in (self.figure.x_range, self.figure.y_range):
+            axis.start, axis.end = -radius, radius  # sent only when they change
 
     def set_present(self, present: bool) -> None:
         """Presentation mode on or off (for the figure now or when it is built)."""
@@ -73,9 +77,13 @@ class PlanView:
     def _build(self) -> None:
         self.source = ColumnDataSource({"image": [np.full((2, 2), np.nan)], "x": [-1.0],
                                         "y": [-1.0], "dw": [2.0], "dh": [2.0]})
-        fp = figure(title="seen from above (total depth)", height=300, width=320,
-                    match_aspect=True, x_axis_label="x [m]", y_axis_label="y [m]",
-                    toolbar_location=None)
+        # fixed ranges on a square plot area, not match_aspect's data ranges: those
+        # have no extent while the figure is hidden (a planar run after an
+        # axisymmetric one), and Bokeh warned "could not set initial ranges" at each
+        # of its layouts
+        fp = figure(title="seen from above (total depth)", frame_width=FRAME_PX,
+                    frame_height=FRAME_PX, x_range=Range1d(-1, 1), y_range=Range1d(-1, 1),
+                    x_axis_label="x [m]", y_axis_label="y [m]", toolbar_location=None)
         self.colours = LinearColorMapper(palette="Cividis256", low=0.0, high=1.0,
                                          nan_color="white")
         fp.image("image", x="x", y="y", dw="dw", dh="dh", source=self.source,
