@@ -300,6 +300,43 @@ def test_results_go_under_the_figures_on_a_projector(browser, server):
     assert wide["summary"]["y"] < wide["fextra"]["y"]
 
 
+def _box(page, name: str) -> dict:
+    return page.locator(f".pdeflow-{name}").first.bounding_box()
+
+
+def test_a_projector_shows_figures_and_numbers_without_scrolling(browser, server):
+    """At 1024x768 (issue 38: the side bar took 30 % of the width, the F_extra panel
+    and the table needed scrolling, small values read 0): the side bar takes at most a
+    quarter of the width and scrolls on its own, the three figures fit the window's
+    height beside it, and with it hidden the table stands beside them, in view too."""
+    width, height = SIZES[0]
+    page, log = open_page(browser, server, "dam-break", viewport=SIZES[0])
+    try:
+        assert _box(page, "sidebar")["width"] <= width / 4
+        assert _box(page, "sidebar")["y"] + _box(page, "sidebar")["height"] <= height
+        inner, outer = page.locator(".pdeflow-sidebar").first.evaluate(
+            "el => [el.scrollHeight, el.clientHeight]")
+        assert inner > outer  # its last sliders are reached by scrolling it alone
+        # the case's Pouliquen L, 0.00065 m, read 0 with Bokeh's two decimals
+        assert page.locator(".pdeflow-pouliquen_L .bk-slider-title").first.inner_text() \
+            == "Pouliquen L [m]: 0.00065"
+        for name in FIGURES["dam-break"]:
+            box = _box(page, name)
+            assert box["y"] >= 0 and box["y"] + box["height"] <= height, (name, box)
+        page.locator(".pdeflow-sidebar-toggle button").click()
+        _wait_for(lambda: not page.locator(".pdeflow-sidebar").first.is_visible(), 10)
+        figures = [_box(page, name) for name in FIGURES["dam-break"]]
+        table = page.locator(".pdeflow-summary pre").first.bounding_box()
+        assert table["x"] >= max(b["x"] + b["width"] for b in figures) - 1, table
+        assert table["x"] + table["width"] <= width and table["y"] + table["height"] <= height
+        for box in figures:
+            assert box["y"] + box["height"] <= height, box
+        assert layout_problems(page, FIGURES["dam-break"], ("summary",)) == []
+        assert not log.errors and not log.warnings, (log.errors, log.warnings)
+    finally:
+        page.close()
+
+
 def _title(page, name: str) -> dict:
     return figure_titles(page)[f"pdeflow-{name}"]
 

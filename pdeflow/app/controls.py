@@ -276,8 +276,10 @@ class ParameterControls:
         self.knobs = list(knobs)
         self._quiet = False
         self._present = False
+        # the selects as wide as the side bar (Panel's default, 300 px, is wider)
         self.case_select = pn.widgets.Select(label="case file", options=list(cases),
-                                             value=default, css_classes=["pdeflow-case"])
+                                             value=default, css_classes=["pdeflow-case"],
+                                             sizing_mode="stretch_width")
         self.sliders = {k.name: Slider(
             label=k.label, start=k.start, end=k.end, step=k.step, value=k.start,
             css_classes=[f"pdeflow-{k.name}"], sizing_mode="stretch_width")
@@ -289,10 +291,12 @@ class ParameterControls:
             label="geometry", options=list(GEOMETRIES), value="planar",
             css_classes=["pdeflow-geometry"])
         self.law = pn.widgets.Select(label="basal friction law", options=list(LAWS),
-                                     value=LAWS[0], css_classes=["pdeflow-law"])
+                                     value=LAWS[0], css_classes=["pdeflow-law"],
+                                     sizing_mode="stretch_width")
         self.scheme = pn.widgets.Select(label="scheme (flux/reconstruction[/limiter]"
                                         "[+splitting])", options=list(SCHEMES),
-                                        value=SCHEMES[0], css_classes=["pdeflow-scheme"])
+                                        value=SCHEMES[0], css_classes=["pdeflow-scheme"],
+                                        sizing_mode="stretch_width")
         self.case: Case = load_case(cases[default])
         self.set_case(self.case)
         self.case_select.param.watch(self._case_changed, "value")

@@ -20,10 +20,10 @@ PAGES = {"dam-break": "Dam break", "run-out": "Run-out law",
 POLL_MS = 500
 """How often the waiting page updates its elapsed time [ms]."""
 
-HEADER = """<h2 style="margin:0.2em 0">pdeflow: dry granular avalanches, one layer and
-two layers</h2><p style="margin:0">Move a slider: the case runs again in the server (a few
-milliseconds for the paper's dam break) and every number shown is what <code>pdeflow
-run</code> prints for the same case and overrides.</p>"""
+HEADER = """<h2 style="margin:0; font-size:1.3em">pdeflow: dry granular avalanches, one
+layer and two layers</h2><p style="margin:0">Move a slider: the case runs again in the
+server, and every number shown is what <code>pdeflow run</code> prints for it.</p>"""
+"""Two lines on a projector's 1024 px: the figures start high enough to fit below."""
 
 
 def _url_argument(name: str) -> str | None:
@@ -84,6 +84,7 @@ class SessionPages:
                 page = HyperbolicityPage(self.shared, present=self.present)
             self.pages[key] = page
             self.holders[key].objects = [page.panel()]
+            page.layout.set_present(self.present)
         return self.pages[key]
 
     def show(self, key: str) -> None:
@@ -98,6 +99,7 @@ class SessionPages:
         with pn.io.hold():
             for key, p in self.pages.items():
                 p.set_present(present)
+                p.layout.set_present(present)
                 if key != "hyperbolicity":  # the side bar follows the mode
                     p.layout.show_sidebar(not present)
 
@@ -148,7 +150,7 @@ def create_app(case_dir: str | Path | None = None, page: str | None = None,
                           sizing_mode="stretch_width")
     body = pn.Column(status, sizing_mode="stretch_width")
     toggle = pn.widgets.Toggle(name="presentation mode", value=present, width=180,
-                               css_classes=["pdeflow-present"], align="center")
+                               height=30, css_classes=["pdeflow-present"], align="center")
     header = pn.Row(pn.pane.HTML(HEADER, sizing_mode="stretch_width"), toggle,
                     sizing_mode="stretch_width")
     app = pn.Column(header, body, sizing_mode="stretch_width")

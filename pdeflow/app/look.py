@@ -21,12 +21,20 @@ from typing import Any
 import panel as pn
 from bokeh.models import FixedTicker, GlyphRenderer, NumeralTickFormatter, Span
 
-SIDEBAR_PX = 300
-"""Width of a page's side bar of parameters [px]."""
+SIDEBAR_PX = 240
+"""Width of a page's side bar of parameters [px] (23 % of a projector's 1024 px)."""
+SIDEBAR_TOP_PX = 110
+"""Height above the side bar [px] (the header and the tabs): the side bar is at most the
+rest of the window high and scrolls on its own, so that the figures stay in view while
+one scrolls to the last sliders."""
 RESULTS_PX = 380
 """Width of a page's results column [px] (beside the figures, or under them)."""
-FIGURES_MIN_PX = 700
-"""The narrowest the figures get before the results wrap under them [px]."""
+FIGURES_MIN_PX = 580
+"""The narrowest the figures get before the results wrap under them [px]: on a
+projector's 1024 px the results stand beside the figures once the side bar is hidden."""
+FIGURES_MIN_PRESENT_PX = 700
+"""The same in presentation mode [px]: larger fonts need wider figures, and the results
+go under them."""
 
 
 @dataclass(frozen=True)
@@ -134,25 +142,38 @@ class PageLayout:
         sidebar: the page's parameters.
         figures: the figures and what belongs to them (player, warnings).
         results: the numbers; beside the figures if both fit, else under them.
+        top: beside the side bar's button, above the figures and results (the
+            animation's player: one row for both, the figures start higher).
     """
 
     def __init__(self, sidebar: pn.viewable.Viewable, figures: pn.viewable.Viewable,
-                 results: pn.viewable.Viewable | None = None):
-        self.sidebar = pn.Column(sidebar, width=SIDEBAR_PX, css_classes=["pdeflow-sidebar"])
+                 results: pn.viewable.Viewable | None = None,
+                 top: pn.viewable.Viewable | None = None):
+        self.sidebar = pn.Column(sidebar, width=SIDEBAR_PX, css_classes=["pdeflow-sidebar"],
+                                 styles={"max-height": f"calc(100vh - {SIDEBAR_TOP_PX}px)",
+                                         "overflow-y": "auto", "overflow-x": "hidden"})
         self.toggle = pn.widgets.Toggle(name="◀ hide the parameters", value=True,
                                         css_classes=["pdeflow-sidebar-toggle"],
-                                        width=220)
+                                        width=200, height=30)
         self.toggle.param.watch(lambda e: self.show_sidebar(e.new), "value")
-        figures.styles = {"flex": f"1 1 {FIGURES_MIN_PX}px", "min-width": "0"}
+        self.figures = figures
+        self.set_present(False)
         parts = [figures]
         if results is not None:
             results.styles = {"flex": f"0 1 {RESULTS_PX}px"}
             parts.append(results)
         self.main = pn.FlexBox(*parts, flex_wrap="wrap", align_items="flex-start",
                                sizing_mode="stretch_width")
-        self.row = pn.Row(self.sidebar, pn.Column(self.toggle, self.main,
+        head = (self.toggle if top is None
+                else pn.Row(self.toggle, top, sizing_mode="stretch_width"))
+        self.row = pn.Row(self.sidebar, pn.Column(head, self.main,
                                                   sizing_mode="stretch_width"),
                           sizing_mode="stretch_width")
+
+    def set_present(self, present: bool) -> None:
+        """The figures' narrowest width for the mode (:data:`FIGURES_MIN_PX`)."""
+        least = FIGURES_MIN_PRESENT_PX if present else FIGURES_MIN_PX
+        self.figures.styles = {"flex": f"1 1 {least}px", "min-width": "0"}
 
     def show_sidebar(self, shown: bool) -> None:
         self.sidebar.visible = shown
