@@ -201,12 +201,8 @@ def test_slider_readouts_show_every_position():
     positions differ by a step), and never 0 for a non-zero value (Bokeh's default
     format, two decimals, showed the Pouliquen L of 0.001 m as 0). The read-out is
     numeral.js's in the browser; _readout is its Python twin for these formats."""
-    from pdeflow.app.controls import (
-        MAX_DECIMALS,
-        ParameterControls,
-        list_cases,
-        readout_format,
-    )
+    from pdeflow.app.controls import ParameterControls, list_cases
+    from pdeflow.app.slider import MAX_DECIMALS, readout_format
 
     assert [readout_format(0.0, s) for s in (1.0, 0.25, 5e-5, 100.0)] == \
         ["0", "0.00", "0.00000", "0"]
