@@ -317,7 +317,7 @@ class DamBreakPage:
         initial = [case.initial_profiles(m) for m in run.results]
         depth = max(float(sum(p[k] for k in p if k.startswith("h")).max()) for p in initial)
         self.fig_h.y_range.start, self.fig_h.y_range.end = -0.02 * depth, 1.1 * depth
-        self.plan.show_run(axisymmetric, depth)
+        self.plan.show_run(axisymmetric, depth, case.length)
         # the final state; the player and the velocity limits wait for the frames (each
         # change of the player would redraw it in the browser twice per move)
         self.show_frame(len(run.times) - 1)

@@ -38,10 +38,11 @@ def _styles_from_this_server() -> None:
     """Point the session's stylesheets at this server, before any is made.
 
     Panel's widgets name their stylesheets by CDN address and rewrite them to the
-    server's own (``dist_url``) once the page is rendered; a stylesheet made before
-    that and shown later (the presentation toggle, a new case) kept the CDN address,
-    and a browser offline could not load it. The address is the one Panel's page
-    template gives the same document."""
+    server's own (``dist_url``) as they are made, or once the page is rendered; made
+    before that, Panel's loading.css got the CDN address, and a browser later asked
+    cdn.holoviz.org for it (seen after case changes; issue 38 saw it at the
+    presentation toggle), which a machine offline cannot load. The address set here
+    is the one Panel's page template gives the same document."""
     from panel.io.resources import LOCAL_DIST, use_cdn
 
     if not served() or use_cdn():

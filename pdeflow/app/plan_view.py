@@ -51,22 +51,24 @@ class PlanView:
         """Whether the page shows the plan view (the last run was axisymmetric)."""
         return self.figure is not None and bool(self.figure.visible)
 
-    def show_run(self, axisymmetric: bool, depth: float) -> None:
+    def show_run(self, axisymmetric: bool, depth: float, radius: float) -> None:
         """A new run: shown if ``axisymmetric`` (the figure built the first time), its
-        colour scale up to ``depth`` [m] (the initial total depth)."""
+        colour scale up to ``depth`` [m] (the initial total depth), its axes over the
+        domain's ``radius`` [m]."""
         if axisymmetric and self.figure is None:
-            self._build()
+            self._build(radius)
         if self.figure is not None:
             self.figure.visible = axisymmetric
             self.colours.high = depth
+            if axisymmetric:
+                for axis in (self.figure.x_range, self.figure.y_range):
+                    axis.start, axis.end = -radius, radius  # sent if they change
 
     def show_frame(self, r: np.ndarray, depth: np.ndarray, radius: float) -> None:
         """The total depth ``depth`` [m] at the radii ``r`` [m] of a domain of
         ``radius`` [m], revolved (while :attr:`visible`)."""
         self.source.data = {"image": [plan_view(r, depth, radius)], "x": [-radius],
                             "y": [-radius], "dw": [2 * radius], "dh": [2 * radius]}
-        for axis in (self.figure.x_range, self.figure.y_range):
-            axis.start, axis.end = -radius, radius  # sent only when they change
 
     def set_present(self, present: bool) -> None:
         """Presentation mode on or off (for the figure now or when it is built)."""
@@ -74,7 +76,7 @@ class PlanView:
         if self.figure is not None:
             style_figures((self.figure,), present)
 
-    def _build(self) -> None:
+    def _build(self, radius: float) -> None:
         self.source = ColumnDataSource({"image": [np.full((2, 2), np.nan)], "x": [-1.0],
                                         "y": [-1.0], "dw": [2.0], "dh": [2.0]})
         # fixed ranges on a square plot area, not match_aspect's data ranges: those
@@ -82,7 +84,8 @@ class PlanView:
         # axisymmetric one), and Bokeh warned "could not set initial ranges" at each
         # of its layouts
         fp = figure(title="seen from above (total depth)", frame_width=FRAME_PX,
-                    frame_height=FRAME_PX, x_range=Range1d(-1, 1), y_range=Range1d(-1, 1),
+                    frame_height=FRAME_PX, x_range=Range1d(-radius, radius),
+                    y_range=Range1d(-radius, radius),
                     x_axis_label="x [m]", y_axis_label="y [m]", toolbar_location=None)
         self.colours = LinearColorMapper(palette="Cividis256", low=0.0, high=1.0,
                                          nan_color="white")
