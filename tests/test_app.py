@@ -189,6 +189,43 @@ def test_every_knob_names_case_keys():
     assert case.initial["H0"] == 2.0
 
 
+def _readout(value: float, fmt: str) -> str:
+    """What a slider's read-out shows for ``value`` with the numeral.js format ``fmt``
+    ('0' or '0.' and zeros: fixed decimals, as Python's f-format)."""
+    return f"{value:.{max(fmt.count('0') - 1, 0)}f}"
+
+
+def test_slider_readouts_show_every_position():
+    """Every slider of every page, on every case: the read-out of its start, first
+    steps, case value and end is that number (to a thousandth of a step: the
+    positions differ by a step), and never 0 for a non-zero value (Bokeh's default
+    format, two decimals, showed the Pouliquen L of 0.001 m as 0). The read-out is
+    numeral.js's in the browser; _readout is its Python twin for these formats."""
+    from pdeflow.app.controls import ParameterControls, list_cases
+    from pdeflow.app.slider import MAX_DECIMALS, readout_format
+
+    assert [readout_format(0.0, s) for s in (1.0, 0.25, 5e-5, 100.0)] == \
+        ["0", "0.00", "0.00000", "0"]
+    cases = list_cases(CASES)
+    controls = ParameterControls(cases, "paper_5_1_dam_break.toml", lambda: None)
+    sliders = [*HyperbolicityPage(SharedRun()).sliders.values(),
+               RunoutPage(CASES, start=False).a]
+    checked = 0
+    for name in cases:
+        controls.set_case(load_case(cases[name]))
+        for s in [*controls.sliders.values(), *sliders]:
+            for v in (s.start, s.start + s.step, s.start + 2 * s.step, s.value, s.end):
+                shown = _readout(v, s.format)
+                assert abs(float(shown) - v) < s.step / 1000, (s.name, v, shown)
+                # below half the 6th decimal is 0 to a slider (the frictionless
+                # cases' phi_B of 1e-9 deg)
+                assert abs(v) < 0.5 * 10**-MAX_DECIMALS or float(shown) != 0, \
+                    (s.name, v, shown)
+                checked += 1
+    assert checked > 1000
+    assert controls.sliders["pouliquen_L"].format == "0.00000"
+
+
 # --- page 2: run-out law ----------------------------------------------------------------
 def test_runout_page_points_and_fit_are_the_sweeps():
     page = RunoutPage(CASES)  # not served: the whole set at once
@@ -206,6 +243,26 @@ def test_runout_page_points_and_fit_are_the_sweeps():
     assert 7.5 in page.points["two_layer"]
     page.clear.clicks += 1  # clear the set
     assert page.fit("two_layer") is None and "needs two points" in page.fits.object
+
+
+def test_the_runout_axes_are_labelled_in_every_decade():
+    """Bokeh's log ticker labelled the a axis (1 to 35) at 5, 10, 15, ... only: now
+    1, 2, 3, 5 times each power of ten, as plain numbers."""
+    from bokeh.models import NumeralTickFormatter
+
+    from pdeflow.app.look import log_ticks
+    from pdeflow.app.runout import A_RANGE, R_RANGE
+
+    assert log_ticks(1.0, 35.0) == [1, 2, 3, 5, 10, 20, 30]
+    assert log_ticks(0.5, 150.0) == [0.5, 1, 2, 3, 5, 10, 20, 30, 50, 100]
+    assert log_ticks(0.02, 0.2, range(1, 10)) == pytest.approx(
+        [0.02, 0.03, 0.04, 0.05, 0.06, 0.07, 0.08, 0.09, 0.1, 0.2], rel=1e-12)
+    fig = RunoutPage(CASES, start=False).fig
+    for axis, (low, high) in ((fig.xaxis[0], A_RANGE), (fig.yaxis[0], R_RANGE)):
+        shown = [t for t in axis.ticker.ticks if low <= t <= high]
+        assert shown == log_ticks(low, high), shown
+        assert isinstance(axis.formatter, NumeralTickFormatter)
+    assert [t for t in fig.xaxis[0].ticker.ticks if t < 5] == [0.1, 0.2, 0.3, 0.5, 1, 2, 3]
 
 
 def test_published_laws_leave_their_transition_open():

@@ -15,6 +15,7 @@ import json
 import os
 import time
 from pathlib import Path
+from urllib.parse import urlparse
 
 import pytest
 
@@ -25,6 +26,7 @@ from pdeflow.app.browser import (
     app_server,
     chromium,
     figure_titles,
+    foreign_urls,
     key_to_picture,
     layout_problems,
     open_page,
@@ -91,6 +93,7 @@ def opened(browser, server, shots, request):
         page.screenshot(path=shots / f"{request.node.name}_{name}.png", full_page=True)
         page.close()
         assert not log.errors, log.errors
+        assert not log.warnings, log.warnings
         assert not log.foreign_requests, f"the app must work offline: {log.foreign_requests}"
 
 
@@ -158,6 +161,31 @@ def test_the_plan_view_comes_with_the_first_axisymmetric_run(opened):
     page.locator(".pdeflow-geometry").get_by_text("axisymmetric", exact=True).click()
     page.locator(".pdeflow-plan").first.wait_for(timeout=ANSWER_TIMEOUT_S * 1000)
     _wait_for(lambda: "front radius" in text(page, "summary"), ANSWER_TIMEOUT_S)
+
+
+def test_a_lesson_logs_no_warnings_and_loads_nothing_from_elsewhere(opened, server):
+    """Geometry there and back, presentation mode on and off, another tab, another
+    case: no console warnings (the plan view, hidden by a planar run after an
+    axisymmetric one, made Bokeh warn "could not set initial ranges" at each layout,
+    about 40 times) and no model naming a URL on another host (Panel's stylesheets are
+    named by CDN address until rewritten; one made before the page was rendered kept
+    it). The fixture also asserts no errors, warnings or requests to other hosts."""
+    page = opened("dam-break")
+    geometry = page.locator(".pdeflow-geometry")
+    geometry.get_by_text("axisymmetric", exact=True).click()
+    _wait_for(lambda: "front radius" in text(page, "summary"), ANSWER_TIMEOUT_S)
+    geometry.get_by_text("planar", exact=True).click()
+    _wait_for(lambda: "front radius" not in text(page, "summary"), ANSWER_TIMEOUT_S)
+    for _ in range(2):  # on and off: every figure laid out again, twice
+        page.locator(".pdeflow-present button").click()
+        time.sleep(1.0)
+    page.get_by_text("Hyperbolicity", exact=True).first.click()
+    page.locator(READY["hyperbolicity"]).first.wait_for(timeout=ANSWER_TIMEOUT_S * 1000)
+    page.get_by_text("Dam break", exact=True).first.click()
+    page.locator(".pdeflow-case select").select_option("column_on_slope.toml")
+    _wait_for(lambda: "case column_on_slope" in text(page, "summary"), ANSWER_TIMEOUT_S)
+    time.sleep(1.0)  # the animation's frames, and the layouts they bring
+    assert foreign_urls(page, urlparse(server).hostname) == []
 
 
 def test_runout_page_shows_the_sweep(opened):
@@ -240,7 +268,8 @@ OTHERS = {"dam-break": ("summary", "player", "sidebar"),
 @pytest.mark.parametrize("name", list(FIGURES))
 def test_pages_fit_the_screen(browser, server, shots, name, size):
     """No figure narrower than half the page, nothing outside the viewport, no title
-    cut off; with the side bar hidden, the figures get wider."""
+    cut off; with the side bar hidden, the figures get wider, or the results move up
+    beside them (a projector's dam-break and run-out pages)."""
     page, log = open_page(browser, server, name, viewport=size)
     try:
         if name == "run-out":
@@ -251,12 +280,24 @@ def test_pages_fit_the_screen(browser, server, shots, name, size):
         wide = page.locator(f".pdeflow-{first}").first.bounding_box()["width"]
         page.locator(".pdeflow-sidebar-toggle button").click()
         _wait_for(lambda: not page.locator(".pdeflow-sidebar").first.is_visible(), 10)
-        _wait_for(lambda: page.locator(f".pdeflow-{first}").first.bounding_box()["width"]
-                  > wide + 100, 10)
+        _wait_for(lambda: _box(page, first)["width"] > wide + 100
+                  or _results_beside(page, name, first), 10)
         assert layout_problems(page, FIGURES[name]) == []
         assert not log.errors, log.errors
     finally:
         page.close()
+
+
+RESULTS = {"dam-break": "summary", "run-out": "current"}
+"""Per page with a results column, an element of it."""
+
+
+def _results_beside(page, name: str, figure: str) -> bool:
+    """Whether the page's results stand right of its ``figure``."""
+    if name not in RESULTS:
+        return False
+    fig = _box(page, figure)
+    return _box(page, RESULTS[name])["x"] >= fig["x"] + fig["width"] - 1
 
 
 def test_results_go_under_the_figures_on_a_projector(browser, server):
@@ -270,6 +311,43 @@ def test_results_go_under_the_figures_on_a_projector(browser, server):
     assert narrow["summary"]["y"] > narrow["fextra"]["y"] + narrow["fextra"]["height"] - 1
     assert wide["summary"]["x"] >= wide["depths"]["x"] + wide["depths"]["width"] - 1
     assert wide["summary"]["y"] < wide["fextra"]["y"]
+
+
+def _box(page, name: str) -> dict:
+    return page.locator(f".pdeflow-{name}").first.bounding_box()
+
+
+def test_a_projector_shows_figures_and_numbers_without_scrolling(browser, server):
+    """At 1024x768 (issue 38: the side bar took 30 % of the width, the F_extra panel
+    and the table needed scrolling, small values read 0): the side bar takes at most a
+    quarter of the width and scrolls on its own, the three figures fit the window's
+    height beside it, and with it hidden the table stands beside them, in view too."""
+    width, height = SIZES[0]
+    page, log = open_page(browser, server, "dam-break", viewport=SIZES[0])
+    try:
+        assert _box(page, "sidebar")["width"] <= width / 4
+        assert _box(page, "sidebar")["y"] + _box(page, "sidebar")["height"] <= height
+        inner, outer = page.locator(".pdeflow-sidebar").first.evaluate(
+            "el => [el.scrollHeight, el.clientHeight]")
+        assert inner > outer  # its last sliders are reached by scrolling it alone
+        # the case's Pouliquen L, 0.00065 m, read 0 with Bokeh's two decimals
+        assert page.locator(".pdeflow-pouliquen_L .bk-slider-title").first.inner_text() \
+            == "Pouliquen L [m]: 0.00065"
+        for name in FIGURES["dam-break"]:
+            box = _box(page, name)
+            assert box["y"] >= 0 and box["y"] + box["height"] <= height, (name, box)
+        page.locator(".pdeflow-sidebar-toggle button").click()
+        _wait_for(lambda: not page.locator(".pdeflow-sidebar").first.is_visible(), 10)
+        figures = [_box(page, name) for name in FIGURES["dam-break"]]
+        table = page.locator(".pdeflow-summary pre").first.bounding_box()
+        assert table["x"] >= max(b["x"] + b["width"] for b in figures) - 1, table
+        assert table["x"] + table["width"] <= width and table["y"] + table["height"] <= height
+        for box in figures:
+            assert box["y"] + box["height"] <= height, box
+        assert layout_problems(page, FIGURES["dam-break"], ("summary",)) == []
+        assert not log.errors and not log.warnings, (log.errors, log.warnings)
+    finally:
+        page.close()
 
 
 def _title(page, name: str) -> dict:

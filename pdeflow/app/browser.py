@@ -104,16 +104,21 @@ def chromium(executable: str = CHROMIUM) -> Iterator[Any]:
 
 @dataclass
 class PageLog:
-    """What a page reported: console errors, uncaught exceptions, foreign requests."""
+    """What a page reported: console errors and warnings, uncaught exceptions, foreign
+    requests."""
 
     host: str
     errors: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    """console warnings (Bokeh's "could not set initial ranges", ...)"""
     foreign_requests: list[str] = field(default_factory=list)
     """requests to any host but the app's (the app must work offline)"""
 
     def attach(self, page: Any) -> None:
         page.on("console", lambda m: self.errors.append(f"console: {m.text}")
                 if m.type == "error" else None)
+        page.on("console", lambda m: self.warnings.append(m.text)
+                if m.type == "warning" else None)
         page.on("pageerror", lambda e: self.errors.append(f"page error: {e}"))
         page.on("request", lambda r: self.foreign_requests.append(r.url)
                 if urlparse(r.url).hostname not in (self.host, None) else None)
@@ -131,6 +136,24 @@ def open_page(browser: Any, url: str, page: str, *, timeout: float = 300.0,
     p.goto(f"{url}?page={page}" + (f"&{query}" if query else ""))
     p.locator(READY[page]).first.wait_for(timeout=timeout * 1000)
     return p, log
+
+
+FOREIGN_URLS = """(host) => {
+  const out = [];
+  for (const doc of Bokeh.documents)
+    for (const m of doc.all_models)
+      if (typeof m.url === "string" && /^[a-z]+:\\/\\//.test(m.url)
+          && new URL(m.url).hostname !== host)
+        out.push(`${m.type}: ${m.url}`);
+  return out;
+}"""
+"""The models of the page (stylesheets, ...) that name a URL on another host than
+``host``: a browser offline could not load them."""
+
+
+def foreign_urls(page: Any, host: str) -> list[str]:
+    """:data:`FOREIGN_URLS` of the page."""
+    return page.evaluate(FOREIGN_URLS, host)
 
 
 def text(page: Any, css_class: str) -> str:

@@ -14,7 +14,7 @@ import shlex
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 import panel as pn
 
@@ -22,6 +22,7 @@ from .. import systems
 from ..analysis.workprecision import DEFAULT_VARIANTS
 from ..cases import Case, CaseError, load_case
 from ..variant import Variant
+from .slider import Slider  # the pages import it from here
 
 GEOMETRIES = ("planar", "axisymmetric")
 """grid.geometry choices: a slope of unit width, or a column collapsing radially"""
@@ -36,16 +37,6 @@ PRESENTED = ("H0", "L0", "slope", "phi_b_two", "phi_b_single", "length", "t_end"
 scheme choices, are hidden: a lecture needs the physics, not every knob)."""
 MAX_CELLS = 20_000
 """Larger grids would keep the server busy for seconds per slider move: refused."""
-
-
-class Slider(pn.widgets.FloatSlider):
-    """A float slider whose moves reach the server's callbacks at once.
-
-    Panel waits 50 ms after a widget's first event for more before it runs the callbacks;
-    a slider's release (``value_throttled``) is the last event of a move, so that wait
-    would only add to the time until the new picture."""
-
-    _priority_changes: ClassVar[list[str]] = ["value", "value_throttled"]
 
 
 @dataclass(frozen=True)
@@ -239,8 +230,10 @@ class ParameterControls:
         self.knobs = list(knobs)
         self._quiet = False
         self._present = False
+        # the selects as wide as the side bar (Panel's default, 300 px, is wider)
         self.case_select = pn.widgets.Select(label="case file", options=list(cases),
-                                             value=default, css_classes=["pdeflow-case"])
+                                             value=default, css_classes=["pdeflow-case"],
+                                             sizing_mode="stretch_width")
         self.sliders = {k.name: Slider(
             label=k.label, start=k.start, end=k.end, step=k.step, value=k.start,
             css_classes=[f"pdeflow-{k.name}"], sizing_mode="stretch_width")
@@ -252,10 +245,12 @@ class ParameterControls:
             label="geometry", options=list(GEOMETRIES), value="planar",
             css_classes=["pdeflow-geometry"])
         self.law = pn.widgets.Select(label="basal friction law", options=list(LAWS),
-                                     value=LAWS[0], css_classes=["pdeflow-law"])
+                                     value=LAWS[0], css_classes=["pdeflow-law"],
+                                     sizing_mode="stretch_width")
         self.scheme = pn.widgets.Select(label="scheme (flux/reconstruction[/limiter]"
                                         "[+splitting])", options=list(SCHEMES),
-                                        value=SCHEMES[0], css_classes=["pdeflow-scheme"])
+                                        value=SCHEMES[0], css_classes=["pdeflow-scheme"],
+                                        sizing_mode="stretch_width")
         self.case: Case = load_case(cases[default])
         self.set_case(self.case)
         self.case_select.param.watch(self._case_changed, "value")

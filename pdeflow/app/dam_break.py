@@ -49,8 +49,9 @@ SEND_MS = 40
 (the frames' run would otherwise hold the message back until it is done)."""
 LABELS = {m: systems.get(m).label for m in (PAPER_MODEL, BASELINE_MODEL)}
 """The models as the pages name them."""
-FIGURE_HEIGHT = 240
-"""Height of each of the three profile figures [px] (presentation mode: more)."""
+FIGURE_HEIGHT = 195
+"""Height of each of the three profile figures [px] (presentation mode: more): on a
+projector's 768 px the three fit under the header and the player, no scrolling."""
 @dataclass
 class DamBreakRun:
     """One run of every model of a case: summary runs and animation frames."""
@@ -193,7 +194,8 @@ class DamBreakPage:
         self.summary = Div(text="", css_classes=["pdeflow-summary"],
                            sizing_mode="stretch_width")
         self.player = pn.widgets.Player(
-            label="time", start=0, end=1, value=0, interval=60, loop_policy="once",
+            # no label: the time is in the title of the first figure
+            start=0, end=1, value=0, interval=60, loop_policy="once",
             show_loop_controls=False, css_classes=["pdeflow-player"],
             visible_buttons=["first", "previous", "pause", "play", "next", "last"],
             sizing_mode="stretch_width")
@@ -212,7 +214,8 @@ class DamBreakPage:
         self.src_two = ColumnDataSource({k: zero for k in
                                          ("x", "zero", "h2", "top", "u1", "u2", "f")})
         self.src_one = ColumnDataSource({k: zero for k in ("x", "h", "u")})
-        fh = figure(title="", y_axis_label="depth normal to bed [m]",
+        # short: upright, the label must fit the figure's height on a projector
+        fh = figure(title="", y_axis_label="depth ⊥ bed [m]",
                     y_range=Range1d(0, 1), **opts)
         fh.varea("x", "zero", "h2", source=self.src_two, color=COLOURS["lower"],
                  alpha=0.6, legend_label="lower layer h2")
@@ -314,7 +317,7 @@ class DamBreakPage:
         initial = [case.initial_profiles(m) for m in run.results]
         depth = max(float(sum(p[k] for k in p if k.startswith("h")).max()) for p in initial)
         self.fig_h.y_range.start, self.fig_h.y_range.end = -0.02 * depth, 1.1 * depth
-        self.plan.show_run(axisymmetric, depth)
+        self.plan.show_run(axisymmetric, depth, case.length)
         # the final state; the player and the velocity limits wait for the frames (each
         # change of the player would redraw it in the browser twice per move)
         self.show_frame(len(run.times) - 1)
@@ -397,12 +400,13 @@ class DamBreakPage:
                 f"come from a second run that stops at every frame time.</p>")
 
     def panel(self) -> pn.Row:
-        plots = pn.Column(self.status, self.warnings, self.player,
+        plots = pn.Column(self.status, self.warnings,
                           pn.pane.Bokeh(self.fig_h), pn.pane.Bokeh(self.fig_u),
                           pn.pane.Bokeh(self.fig_f), sizing_mode="stretch_width")
         results = pn.Column("### results", self.plan.pane,
                             pn.pane.Bokeh(self.summary), sizing_mode="stretch_width")
-        self.layout = PageLayout(self.controls.panel("dam break"), plots, results)
+        self.layout = PageLayout(self.controls.panel("dam break"), plots, results,
+                                 top=self.player)
         if self.present:
             self.layout.show_sidebar(False)
         return self.layout.row

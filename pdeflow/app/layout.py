@@ -20,10 +20,10 @@ PAGES = {"dam-break": "Dam break", "run-out": "Run-out law",
 POLL_MS = 500
 """How often the waiting page updates its elapsed time [ms]."""
 
-HEADER = """<h2 style="margin:0.2em 0">pdeflow: dry granular avalanches, one layer and
-two layers</h2><p style="margin:0">Move a slider: the case runs again in the server (a few
-milliseconds for the paper's dam break) and every number shown is what <code>pdeflow
-run</code> prints for the same case and overrides.</p>"""
+HEADER = """<h2 style="margin:0; font-size:1.3em">pdeflow: dry granular avalanches, one
+layer and two layers</h2><p style="margin:0">Move a slider: the case runs again in the
+server, and every number shown is what <code>pdeflow run</code> prints for it.</p>"""
+"""Two lines on a projector's 1024 px: the figures start high enough to fit below."""
 
 
 def _url_argument(name: str) -> str | None:
@@ -32,6 +32,24 @@ def _url_argument(name: str) -> str | None:
         return None
     value = (pn.state.session_args or {}).get(name)
     return value[0].decode() if value else None
+
+
+def _styles_from_this_server() -> None:
+    """Point the session's stylesheets at this server, before any is made.
+
+    Panel's widgets name their stylesheets by CDN address and rewrite them to the
+    server's own (``dist_url``) as they are made, or once the page is rendered; made
+    before that, Panel's loading.css got the CDN address, and a browser later asked
+    cdn.holoviz.org for it (seen after case changes; issue 38 saw it at the
+    presentation toggle), which a machine offline cannot load. The address set here
+    is the one Panel's page template gives the same document."""
+    from panel.io.resources import LOCAL_DIST, use_cdn
+
+    if not served() or use_cdn():
+        return
+    rel = pn.state.rel_path
+    pn.state.curdoc._template_variables.setdefault(
+        "dist_url", f"{rel}/{LOCAL_DIST}" if rel else LOCAL_DIST)
 
 
 def _requested_present() -> bool | None:
@@ -67,6 +85,7 @@ class SessionPages:
                 page = HyperbolicityPage(self.shared, present=self.present)
             self.pages[key] = page
             self.holders[key].objects = [page.panel()]
+            page.layout.set_present(self.present)
         return self.pages[key]
 
     def show(self, key: str) -> None:
@@ -81,6 +100,7 @@ class SessionPages:
         with pn.io.hold():
             for key, p in self.pages.items():
                 p.set_present(present)
+                p.layout.set_present(present)
                 if key != "hyperbolicity":  # the side bar follows the mode
                     p.layout.show_sidebar(not present)
 
@@ -121,6 +141,7 @@ def create_app(case_dir: str | Path | None = None, page: str | None = None,
     elapsed time, and builds its pages when they are ready; elsewhere (Jupyter, a
     script) this call prints the same and waits.
     """
+    _styles_from_this_server()
     case_dir = find_case_dir(case_dir)
     page = page or _url_argument("page")
     url_present = _requested_present()
@@ -130,7 +151,7 @@ def create_app(case_dir: str | Path | None = None, page: str | None = None,
                           sizing_mode="stretch_width")
     body = pn.Column(status, sizing_mode="stretch_width")
     toggle = pn.widgets.Toggle(name="presentation mode", value=present, width=180,
-                               css_classes=["pdeflow-present"], align="center")
+                               height=30, css_classes=["pdeflow-present"], align="center")
     header = pn.Row(pn.pane.HTML(HEADER, sizing_mode="stretch_width"), toggle,
                     sizing_mode="stretch_width")
     app = pn.Column(header, body, sizing_mode="stretch_width")

@@ -13,19 +13,28 @@ class does not need (scheme, friction law, the command line) hidden.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import math
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import panel as pn
-from bokeh.models import GlyphRenderer, Span
+from bokeh.models import FixedTicker, GlyphRenderer, NumeralTickFormatter, Span
 
-SIDEBAR_PX = 300
-"""Width of a page's side bar of parameters [px]."""
+SIDEBAR_PX = 240
+"""Width of a page's side bar of parameters [px] (23 % of a projector's 1024 px)."""
+SIDEBAR_TOP_PX = 110
+"""Height above the side bar [px] (the header and the tabs): the side bar is at most the
+rest of the window high and scrolls on its own, so that the figures stay in view while
+one scrolls to the last sliders."""
 RESULTS_PX = 380
 """Width of a page's results column [px] (beside the figures, or under them)."""
-FIGURES_MIN_PX = 700
-"""The narrowest the figures get before the results wrap under them [px]."""
+FIGURES_MIN_PX = 580
+"""The narrowest the figures get before the results wrap under them [px]: on a
+projector's 1024 px the results stand beside the figures once the side bar is hidden."""
+FIGURES_MIN_PRESENT_PX = 700
+"""The same in presentation mode [px]: larger fonts need wider figures, and the results
+go under them."""
 
 
 @dataclass(frozen=True)
@@ -87,6 +96,36 @@ def style_figures(figures: Iterable[Any], present: bool) -> None:
         style_figure(f, present)
 
 
+LOG_MANTISSAS = (1, 2, 3, 5)
+"""The labelled ticks of a log axis in each decade: 1, 2, 3, 5, 10, 20, ..."""
+
+
+def log_ticks(low: float, high: float, mantissas: Sequence[int] = LOG_MANTISSAS
+              ) -> list[float]:
+    """The ticks ``m * 10**k`` (m in ``mantissas``) in [low, high] (> 0), ascending.
+
+    Bokeh's log ticker labels only the decades, and over less than about two decades
+    falls back to linear steps: on the run-out law's a axis (1 to 35) it labelled 5, 10,
+    15, ... and nothing below 5."""
+    ticks = []
+    for k in range(math.floor(math.log10(low)), math.ceil(math.log10(high)) + 1):
+        for m in mantissas:
+            tick = float(m * 10.0**k) if k >= 0 else m / 10.0**-k  # 0.5, not 0.5000001
+            if low * (1 - 1e-9) <= tick <= high * (1 + 1e-9):
+                ticks.append(tick)
+    return ticks
+
+
+def label_log_axis(axis: Any, low: float, high: float) -> None:
+    """Ticks of :func:`log_ticks` on the Bokeh log ``axis`` shown over [low, high] (and a
+    decade beyond, for panning), labelled as plain numbers (0.5, 1, 20; not 10^0), with
+    a minor tick at every 1..9 x 10^k."""
+    low, high = low / 10, high * 10
+    axis.ticker = FixedTicker(ticks=log_ticks(low, high),
+                              minor_ticks=log_ticks(low, high, range(1, 10)))
+    axis.formatter = NumeralTickFormatter(format="0[.][0000]")
+
+
 def legend_outside(fig: Any, place: str = "right") -> None:
     """Move the figure's legend out of the plot area (``place``: 'right', 'below'), where
     it cannot cover the data."""
@@ -103,25 +142,38 @@ class PageLayout:
         sidebar: the page's parameters.
         figures: the figures and what belongs to them (player, warnings).
         results: the numbers; beside the figures if both fit, else under them.
+        top: beside the side bar's button, above the figures and results (the
+            animation's player: one row for both, the figures start higher).
     """
 
     def __init__(self, sidebar: pn.viewable.Viewable, figures: pn.viewable.Viewable,
-                 results: pn.viewable.Viewable | None = None):
-        self.sidebar = pn.Column(sidebar, width=SIDEBAR_PX, css_classes=["pdeflow-sidebar"])
+                 results: pn.viewable.Viewable | None = None,
+                 top: pn.viewable.Viewable | None = None):
+        self.sidebar = pn.Column(sidebar, width=SIDEBAR_PX, css_classes=["pdeflow-sidebar"],
+                                 styles={"max-height": f"calc(100vh - {SIDEBAR_TOP_PX}px)",
+                                         "overflow-y": "auto", "overflow-x": "hidden"})
         self.toggle = pn.widgets.Toggle(name="◀ hide the parameters", value=True,
                                         css_classes=["pdeflow-sidebar-toggle"],
-                                        width=220)
+                                        width=200, height=30)
         self.toggle.param.watch(lambda e: self.show_sidebar(e.new), "value")
-        figures.styles = {"flex": f"1 1 {FIGURES_MIN_PX}px", "min-width": "0"}
+        self.figures = figures
+        self.set_present(False)
         parts = [figures]
         if results is not None:
             results.styles = {"flex": f"0 1 {RESULTS_PX}px"}
             parts.append(results)
         self.main = pn.FlexBox(*parts, flex_wrap="wrap", align_items="flex-start",
                                sizing_mode="stretch_width")
-        self.row = pn.Row(self.sidebar, pn.Column(self.toggle, self.main,
+        head = (self.toggle if top is None
+                else pn.Row(self.toggle, top, sizing_mode="stretch_width"))
+        self.row = pn.Row(self.sidebar, pn.Column(head, self.main,
                                                   sizing_mode="stretch_width"),
                           sizing_mode="stretch_width")
+
+    def set_present(self, present: bool) -> None:
+        """The figures' narrowest width for the mode (:data:`FIGURES_MIN_PX`)."""
+        least = FIGURES_MIN_PRESENT_PX if present else FIGURES_MIN_PX
+        self.figures.styles = {"flex": f"1 1 {least}px", "min-width": "0"}
 
     def show_sidebar(self, shown: bool) -> None:
         self.sidebar.visible = shown

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 import panel as pn
-from bokeh.models import ColumnDataSource, LinearColorMapper
+from bokeh.models import ColumnDataSource, LinearColorMapper, Range1d
 from bokeh.plotting import figure
 
 from ..plotting import DRY
@@ -20,6 +20,8 @@ from .look import style_figures
 
 PLAN_PIXELS = 121
 """Pixels across the plan view (the revolved total depth)."""
+FRAME_PX = 230
+"""Width and height of the plan view's plot area [px] (square: a circle is round)."""
 
 
 def plan_view(r: np.ndarray, depth: np.ndarray, radius: float,
@@ -49,14 +51,18 @@ class PlanView:
         """Whether the page shows the plan view (the last run was axisymmetric)."""
         return self.figure is not None and bool(self.figure.visible)
 
-    def show_run(self, axisymmetric: bool, depth: float) -> None:
+    def show_run(self, axisymmetric: bool, depth: float, radius: float) -> None:
         """A new run: shown if ``axisymmetric`` (the figure built the first time), its
-        colour scale up to ``depth`` [m] (the initial total depth)."""
+        colour scale up to ``depth`` [m] (the initial total depth), its axes over the
+        domain's ``radius`` [m]."""
         if axisymmetric and self.figure is None:
-            self._build()
+            self._build(radius)
         if self.figure is not None:
             self.figure.visible = axisymmetric
             self.colours.high = depth
+            if axisymmetric:
+                for axis in (self.figure.x_range, self.figure.y_range):
+                    axis.start, axis.end = -radius, radius  # sent if they change
 
     def show_frame(self, r: np.ndarray, depth: np.ndarray, radius: float) -> None:
         """The total depth ``depth`` [m] at the radii ``r`` [m] of a domain of
@@ -70,12 +76,17 @@ class PlanView:
         if self.figure is not None:
             style_figures((self.figure,), present)
 
-    def _build(self) -> None:
+    def _build(self, radius: float) -> None:
         self.source = ColumnDataSource({"image": [np.full((2, 2), np.nan)], "x": [-1.0],
                                         "y": [-1.0], "dw": [2.0], "dh": [2.0]})
-        fp = figure(title="seen from above (total depth)", height=300, width=320,
-                    match_aspect=True, x_axis_label="x [m]", y_axis_label="y [m]",
-                    toolbar_location=None)
+        # fixed ranges on a square plot area, not match_aspect's data ranges: those
+        # have no extent while the figure is hidden (a planar run after an
+        # axisymmetric one), and Bokeh warned "could not set initial ranges" at each
+        # of its layouts
+        fp = figure(title="seen from above (total depth)", frame_width=FRAME_PX,
+                    frame_height=FRAME_PX, x_range=Range1d(-radius, radius),
+                    y_range=Range1d(-radius, radius),
+                    x_axis_label="x [m]", y_axis_label="y [m]", toolbar_location=None)
         self.colours = LinearColorMapper(palette="Cividis256", low=0.0, high=1.0,
                                          nan_color="white")
         fp.image("image", x="x", y="y", dw="dw", dh="dh", source=self.source,

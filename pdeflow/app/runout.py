@@ -34,7 +34,7 @@ from ..checks import run_warnings
 from ..solvers.fv_split import SimulationBlowUp
 from .controls import KNOBS, ParameterControls, Slider, is_column, list_cases, served
 from .dam_break import COLOURS, LABELS, WARNING_STYLE
-from .look import PageLayout, style_figure
+from .look import PageLayout, label_log_axis, style_figure
 
 MODEL_STYLE = {PAPER_MODEL: (COLOURS["upper"], "square", LABELS[PAPER_MODEL]),
                BASELINE_MODEL: (COLOURS["single"], "circle", LABELS[BASELINE_MODEL])}
@@ -42,6 +42,8 @@ PAPER_FITS = {m: systems.get(m).paper_runout_law for m in MODEL_STYLE}
 """the paper's fits of test 5.2, (prefactor, exponent) per model"""
 A_RANGE = (1.0, 35.0)
 """a axis of the figure"""
+R_RANGE = (0.5, 150.0)
+"""r axis of the figure"""
 
 
 def format_r(r: float | None) -> str:
@@ -160,9 +162,11 @@ class RunoutPage:
     def _figure(self) -> None:
         f = figure(x_axis_type="log", y_axis_type="log", height=620,
                    sizing_mode="stretch_width", x_range=Range1d(*A_RANGE),
-                   y_range=Range1d(0.5, 150), x_axis_label="aspect ratio a = H0/L0",
+                   y_range=Range1d(*R_RANGE), x_axis_label="aspect ratio a = H0/L0",
                    y_axis_label="normalised run-out r = (R - L0)/L0",
                    tools="pan,wheel_zoom,box_zoom,reset,save")
+        label_log_axis(f.xaxis[0], *A_RANGE)  # 1, 2, 3, 5, 10, 20, 30
+        label_log_axis(f.yaxis[0], *R_RANGE)
         aa = np.geomspace(*A_RANGE, 200)
         items = []
         self.src_points, self.src_fits = {}, {}
