@@ -27,7 +27,15 @@ import re
 from pathlib import Path
 from typing import Any
 
-from .io import OutputError, PendingDir, PendingFile, discard_pending, write_json, write_npz
+from .io import (
+    OutputError,
+    PendingDir,
+    PendingFile,
+    discard_pending,
+    signals_blocked,
+    write_json,
+    write_npz,
+)
 from .outpaths import FIGURE_SUFFIXES, check_dir, check_file
 
 RESULTS = Path("results")
@@ -226,15 +234,17 @@ class RunOutputs:
 
     def discard(self) -> None:
         """Remove every temporary of the run (movies, frames, stored runs, the staged
-        folder and files); targets stay as they were."""
-        for t in self.trackers:
-            t.discard()
-        discard_pending()
-        for folder in sorted(self.created, key=lambda d: len(d.parts), reverse=True):
-            try:
-                folder.rmdir()
-            except OSError:
-                pass  # not empty (written meanwhile by someone else), or never made
+        folder and files); targets stay as they were. A second Ctrl-C meanwhile waits
+        until the clean-up is done."""
+        with signals_blocked():
+            for t in self.trackers:
+                t.discard()
+            discard_pending()
+            for folder in sorted(self.created, key=lambda d: len(d.parts), reverse=True):
+                try:
+                    folder.rmdir()
+                except OSError:
+                    pass  # not empty (written meanwhile by someone else), or never made
 
 
 class _Done:
