@@ -274,3 +274,20 @@ def test_a_pending_directory_is_complete_or_absent(tmp_path):
     assert [p.name for p in target.iterdir()] == ["new.png"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["frames"]
 
+
+def test_the_signal_check_does_not_move_the_snapshots():
+    """The signal check's wall-clock interrupts (here as often as possible) fall at any
+    simulation time; the snapshots are still taken at the case's times, exactly (fv-split
+    lands on them by interpolation; py-pde would fire a tracker due within half a step
+    early if the solver reported its step as ``dt``), with the same states."""
+    from pdeflow.cases import load_case
+    from pdeflow.interrupts import SignalCheck
+    from pdeflow.simulate import run_model
+
+    case = load_case(RITTER, ["grid.cells=40", "output.snapshot_times=[0.05, 0.1]"])
+    quiet = run_model(case, "single_layer")
+    checked = run_model(case, "single_layer", tracker=[SignalCheck(1e-9)])
+    assert sorted(checked.snapshots) == [0.05, 0.1]
+    for t, (state, _) in quiet.snapshots.items():
+        # the same steps and the same interpolation: identical bits
+        assert (checked.snapshots[t][0] == state).all(), t
