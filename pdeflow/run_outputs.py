@@ -209,22 +209,26 @@ class RunOutputs:
         from .interrupts import deferred_signals, note_written, received
 
         written: list[Any] = []
+
+        def wrote(*paths: Any) -> None:  # told at once: the last line must be true
+            written.extend(paths)
+            note_written(paths)
+
         with deferred_signals():
             if received():  # its KeyboardInterrupt was swallowed on the way
                 raise KeyboardInterrupt("a signal came before the results were written")
             self._stage(case, summary, results, figures)
             for pending, shown in self.staged:
                 pending.commit()
-                written.append(shown)
+                wrote(shown)
             for t in self.trackers_of("commit", "metadata"):  # the stored runs
                 model = t.metadata["model"]
                 extra = {"summary": summary["models"][model]}
                 if results[model].series is not None:  # the erosion series (with a bed)
                     extra["erosion_series"] = results[model].series.to_dict()
-                written.append(t.commit(extra))
+                wrote(t.commit(extra))
             for t in self.trackers_of("commit", "frames_dir"):
-                written.extend(_shown_live(t, t.commit()))
-            note_written(written)
+                wrote(*_shown_live(t, t.commit()))
         return written
 
     def trackers_of(self, *attributes: str) -> list[Any]:
