@@ -4,13 +4,17 @@ Built on py-pde: the models are ``PDEBase`` subclasses, the paper's scheme is th
 py-pde solver ``"fv-split"`` (registered on import).
 """
 
-from .models import (
+from . import early_signals
+
+early_signals.install()  # the program only: a Ctrl-C during the imports below is kept
+
+from .models import (  # noqa: E402
     SingleLayerGranular,
     SingleLayerParameters,
     TwoLayerGranular,
     TwoLayerParameters,
 )
-from .solvers import FVSplitSolver, SimulationBlowUp
+from .solvers import FVSplitSolver, SimulationBlowUp  # noqa: E402
 
 __version__ = "0.1.0"
 

@@ -244,7 +244,8 @@ def _add_run(sub: Any) -> None:
                      "further models go to OUT.<model>.npz")
     out.add_argument("--plot", metavar="OUT.png", help="write the final-deposit figure")
     out.add_argument("--outdir", metavar="DIR",
-                     help="write summary.json and all figures (snapshots, deposits) here")
+                     help="write summary.json and all figures (snapshots, deposits) here; "
+                     "the folder is replaced as a whole (refused if it holds other files)")
     out.add_argument("--store", metavar="OUT.h5",
                      help="store the run in HDF5 (py-pde FileStorage: state and "
                      "F_extra/rho1 every --store-every s, and the final state; case, "
@@ -265,7 +266,8 @@ def _add_run(sub: Any) -> None:
                        ".m4v, .mov, .mkv, .avi; H.264, needs ffmpeg, e.g. pip install "
                        "imageio-ffmpeg) or .gif; further models go to OUT.<model>.mp4")
     watch.add_argument("--frames", metavar="DIR",
-                       help="write the live plot as PNG frames DIR/<model>/frame_*.png")
+                       help="write the live plot as PNG frames DIR/<model>/frame_*.png (each "
+                     "DIR/<model> replaced as a whole)")
     watch.add_argument("--live-every", type=float, metavar="DT",
                        help="simulation time between live frames [s] (default t_end/100)")
     watch.add_argument("--fps", type=float, default=10.0,

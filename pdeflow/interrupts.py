@@ -92,7 +92,7 @@ def signals_interrupt(session: Session | None = None) -> Iterator[Session]:
         signal.signal(s, _raise_interrupt)
     sys.unraisablehook = _unraisable(old_hook)
     try:
-        # signals recorded before the command started (pdeflow.__main__.EarlySignals)
+        # signals recorded before the command started (pdeflow.early_signals)
         early = [n for h in set(old.values()) for n in getattr(h, "came", ())]
         if early:
             session.signals.extend(early)

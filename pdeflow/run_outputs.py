@@ -27,7 +27,15 @@ import re
 from pathlib import Path
 from typing import Any
 
-from .io import OutputError, PendingDir, PendingFile, discard_pending, write_json, write_npz
+from .io import (
+    OutputError,
+    PendingDir,
+    PendingFile,
+    discard_pending,
+    signals_blocked,
+    write_json,
+    write_npz,
+)
 from .outpaths import FIGURE_SUFFIXES, check_dir, check_file
 
 RESULTS = Path("results")
@@ -201,22 +209,26 @@ class RunOutputs:
         from .interrupts import deferred_signals, note_written, received
 
         written: list[Any] = []
+
+        def wrote(*paths: Any) -> None:  # told at once: the last line must be true
+            written.extend(paths)
+            note_written(paths)
+
         with deferred_signals():
             if received():  # its KeyboardInterrupt was swallowed on the way
                 raise KeyboardInterrupt("a signal came before the results were written")
             self._stage(case, summary, results, figures)
             for pending, shown in self.staged:
                 pending.commit()
-                written.append(shown)
+                wrote(shown)
             for t in self.trackers_of("commit", "metadata"):  # the stored runs
                 model = t.metadata["model"]
                 extra = {"summary": summary["models"][model]}
                 if results[model].series is not None:  # the erosion series (with a bed)
                     extra["erosion_series"] = results[model].series.to_dict()
-                written.append(t.commit(extra))
+                wrote(t.commit(extra))
             for t in self.trackers_of("commit", "frames_dir"):
-                written.extend(_shown_live(t, t.commit()))
-            note_written(written)
+                wrote(*_shown_live(t, t.commit()))
         return written
 
     def trackers_of(self, *attributes: str) -> list[Any]:
@@ -226,15 +238,17 @@ class RunOutputs:
 
     def discard(self) -> None:
         """Remove every temporary of the run (movies, frames, stored runs, the staged
-        folder and files); targets stay as they were."""
-        for t in self.trackers:
-            t.discard()
-        discard_pending()
-        for folder in sorted(self.created, key=lambda d: len(d.parts), reverse=True):
-            try:
-                folder.rmdir()
-            except OSError:
-                pass  # not empty (written meanwhile by someone else), or never made
+        folder and files); targets stay as they were. A second Ctrl-C meanwhile waits
+        until the clean-up is done."""
+        with signals_blocked():
+            for t in self.trackers:
+                t.discard()
+            discard_pending()
+            for folder in sorted(self.created, key=lambda d: len(d.parts), reverse=True):
+                try:
+                    folder.rmdir()
+                except OSError:
+                    pass  # not empty (written meanwhile by someone else), or never made
 
 
 class _Done:

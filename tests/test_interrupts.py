@@ -33,9 +33,10 @@ from tests.helpers import assert_no_temporaries
 ROOT = Path(__file__).parents[1]
 CASE_51 = ROOT / "cases" / "paper_5_1_dam_break.toml"
 RITTER = ROOT / "cases" / "ritter_dam_break.toml"
-# a coarse 5.1 (70 cells) and a frame every 0.25 s: a few frames per model
+# a coarse 5.1 (70 cells) and a frame every 0.4 s: a few frames per model (drawing them
+# is most of the command's time)
 COMMAND = [sys.executable, "-m", "pdeflow", "run", str(CASE_51), "--set", "grid.dx=0.1",
-           "--live-every", "0.25", "--movie", "m.gif", "--frames", "fr", "--summary",
+           "--live-every", "0.4", "--movie", "m.gif", "--frames", "fr", "--summary",
            "s.json", "--outdir", "od", "--no-progress"]
 MODELS = ("two_layer", "single_layer")
 
@@ -114,9 +115,11 @@ def _interrupt_once(folder: Path, delay: float, sig: int, group: bool,
     last = (err.strip().splitlines() or [""])[-1]
     where = f"{label}: exit {proc.returncode}, last line {last!r}, files {present}\n{err}"
     assert "Exception ignored" not in err, where
-    if proc.returncode == -sig and sent:
-        # during Python's own start-up (`import pdeflow`), before pdeflow's handlers
-        assert not any(present.values()) and not (folder / "fr").exists(), where
+    if sent and (proc.returncode == -sig or last == "KeyboardInterrupt"):
+        # during Python's own start-up, before the package pdeflow is imported
+        # (pdeflow.early_signals): Python's traceback, exit 1 or killed by the signal
+        assert proc.returncode in (1, -sig), where
+        assert sorted(p.name for p in folder.iterdir()) == [], where
         return "python start-up"
     assert "Traceback" not in err, where
     if proc.returncode == 0:  # it had finished, or the signal came after its end
@@ -150,11 +153,12 @@ def _interrupt_many(tmp_path: Path, reference: tuple[dict[str, object], float], 
 
 
 def test_a_handful_of_signals_leave_complete_outputs_or_none(tmp_path, reference):
-    """Four signals at seeded random moments (the default suite; the slow test sends
+    """Three signals at seeded random moments (the default suite; the slow test sends
     50): each run ends with every output complete or none, no temporaries, a true last
     line and exit code 130 (0 if it had ended)."""
-    tally = _interrupt_many(tmp_path, reference, 4, seed=38)
-    assert sum(tally.values()) == 4
+    tally = _interrupt_many(tmp_path, reference, 3, seed=38)
+    print(tally)
+    assert sum(tally.values()) == 3
 
 
 @pytest.mark.slow
@@ -163,6 +167,7 @@ def test_fifty_signals_at_random_moments(tmp_path, reference):
     it); most of them must interrupt a run (not all fall after its end)."""
     seed = int(os.environ.get("PDEFLOW_SIGNAL_SEED", random.randrange(10**6)))
     tally = _interrupt_many(tmp_path, reference, 50, seed)
+    print(f"seed {seed}: {tally}")
     assert tally.get("nothing written", 0) >= 25, (seed, tally)
 
 
@@ -268,3 +273,21 @@ def test_a_pending_directory_is_complete_or_absent(tmp_path):
     pending.commit()
     assert [p.name for p in target.iterdir()] == ["new.png"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["frames"]
+
+
+def test_the_signal_check_does_not_move_the_snapshots():
+    """The signal check's wall-clock interrupts (here as often as possible) fall at any
+    simulation time; the snapshots are still taken at the case's times, exactly (fv-split
+    lands on them by interpolation; py-pde would fire a tracker due within half a step
+    early if the solver reported its step as ``dt``), with the same states."""
+    from pdeflow.cases import load_case
+    from pdeflow.interrupts import SignalCheck
+    from pdeflow.simulate import run_model
+
+    case = load_case(RITTER, ["grid.cells=40", "output.snapshot_times=[0.05, 0.1]"])
+    quiet = run_model(case, "single_layer")
+    checked = run_model(case, "single_layer", tracker=[SignalCheck(1e-9)])
+    assert sorted(checked.snapshots) == [0.05, 0.1]
+    for t, (state, _) in quiet.snapshots.items():
+        # the same steps and the same interpolation: identical bits
+        assert (checked.snapshots[t][0] == state).all(), t
