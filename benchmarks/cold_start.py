@@ -335,6 +335,13 @@ above, not re-measured since the code moved behind `prepare`):
 * **Cache keys following every callee's code** (`numba_hooks._CodeKeyedCache`): numba's own
   key, the source file's time stamp, once loaded a kernel with an old callee compiled
   in and gave a wrong test 5.1 result.
+* **The public path**: on a numba newer than `compiled.NEWEST_TESTED_NUMBA`, or with
+  `PDEFLOW_NUMBA_FALLBACK=1`, `numba_hooks` is not imported and none of its mechanisms
+  apply: kernels are plain `numba.njit(cache=True)` with entry points, no helper
+  process compiles, kernels are passed to the stepping loop as dispatchers, and
+  closures over kernels (the advection stages, the stepping loop) are compiled in every
+  process, since numba's own cache key for them changes from one process to the next.
+  The numbers computed are the same (`tests/test_numba_fallback.py`).
 * **The app** loads its kernels in a background thread (`app/kernels.py`) and says so:
   its first picture came 13 s after a start with an empty cache (docs/teaching.md).
 """

@@ -20,14 +20,9 @@ What the factories and the kernels share is kept here:
   converted instead of compiling a second signature.
 * :func:`specialise` names a closure after the constants it closes over and the code
   of the kernels it calls (:mod:`pdeflow.numerics.kernel_identity`).
-* Every kernel is cached on disk. On the numba releases pdeflow was tested on
-  (:data:`NEWEST_TESTED_NUMBA`) four of numba's private classes make a start faster
-  (:mod:`pdeflow.numerics.numba_hooks`, :data:`HOOKS`): cache keys that follow the code
-  (closures over kernels load in later processes), :func:`cached` helpers without the
-  entry points every caller would compile again, function pointers looked up once, a
-  look into the cache (:func:`in_disk_cache`). On a newer numba, or with
-  ``PDEFLOW_NUMBA_FALLBACK=1``, kernels are plain ``numba.njit(cache=True)`` (closures
-  over kernels uncached), and the same code computes the same numbers.
+* Every kernel is cached on disk. On the numba releases pdeflow was tested on, numba's
+  private classes make a start faster (:data:`HOOKS`, :mod:`pdeflow.numerics.numba_hooks`);
+  elsewhere kernels are plain ``numba.njit(cache=True)``, computing the same numbers.
 * :func:`kernels`, :func:`pending` and :func:`in_disk_cache`: what is compiled, what is
   still to compile or load, and what numba's disk cache holds.
 
@@ -198,15 +193,9 @@ def first_class(compiled: Any) -> Any:
     return HOOKS.pointer(compiled, _SIGNATURES[compiled])
 
 
-def referenced_kernels(compiled: Any) -> tuple[list[Any], list[Any]]:
-    """(the kernels ``compiled`` closes over, the module-level kernels its code names)."""
-    closed, named = named_kernels(compiled)
-    return [k for _, k in closed], [k for _, k in named]
-
-
 def named_kernels(compiled: Any) -> tuple[list[tuple[str, Any]], list[tuple[str, Any]]]:
-    """:func:`referenced_kernels` with the name each goes by in the code of
-    ``compiled``: (closed over, named at module level), as (name, kernel) pairs."""
+    """(the kernels ``compiled`` closes over, the module-level kernels its code names),
+    each as (the name it goes by in the code, kernel)."""
     func = compiled.py_func
     cells = zip(func.__code__.co_freevars, func.__closure__ or (), strict=True)
     closed = [(name, cell.cell_contents) for name, cell in cells]
@@ -219,9 +208,9 @@ def _callees(compiled: Any) -> Iterator[Any]:
     """The kernels that ``compiled`` closes over, and the module-level kernels with a
     declared signature that it names. (A factory closes over what its scheme calls
     only, None for the rest, so that nothing here is compiled for nothing.)"""
-    closed, named = referenced_kernels(compiled)
-    yield from closed
-    yield from (k for k in named if k in _SIGNATURES)
+    closed, named = named_kernels(compiled)
+    yield from (k for _, k in closed)
+    yield from (k for _, k in named if k in _SIGNATURES)
 
 
 def kernels() -> list[Any]:

@@ -16,9 +16,7 @@ make it. Behind that one call (nothing else in the package uses these):
   (:func:`~pdeflow.numerics.compile_parallel.fewer_collections`);
 * a stepper's kernels become function pointers once (its ``ready()``).
 
-The helper kernels compiled without Python entry points and the function pointers
-(:mod:`pdeflow.numerics.numba_hooks`) are how the kernels are built; they need no call
-of their own. Without those hooks (``compiled.HOOKS`` None) no helper process is started:
+Without numba's private hooks (``compiled.HOOKS`` None) no helper process is started:
 its closures would not load from the disk cache. :func:`status` says whether anything is left to
 compile (for progress bars).
 """
