@@ -17,8 +17,8 @@ make it. Behind that one call (nothing else in the package uses these):
 * a stepper's kernels become function pointers once (its ``ready()``).
 
 Without numba's private hooks (``compiled.HOOKS`` None) no helper process is started:
-its closures would not load from the disk cache. :func:`status` says whether anything is left to
-compile (for progress bars).
+its closures would not load from the disk cache. :func:`status` says whether anything
+is left to compile (for progress bars).
 """
 
 from __future__ import annotations
