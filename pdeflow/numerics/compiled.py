@@ -41,9 +41,8 @@ from typing import Any
 
 import numba
 from numba import config, njit, types
-from numba.extending import is_jitted
 
-from .kernel_identity import closes_over_kernels, digest
+from .kernel_identity import closes_over_kernels, digest, is_kernel
 
 f8 = types.float64
 i8 = types.int64
@@ -99,7 +98,7 @@ def kernel(*arg_types: Any) -> Callable:
 
     def wrap(func: Callable) -> Any:
         compiled = _jit(func)
-        if is_jitted(compiled):  # not with NUMBA_DISABLE_JIT=1
+        if is_kernel(compiled):  # not with NUMBA_DISABLE_JIT=1
             _SIGNATURES[compiled] = tuple(arg_types)
         return compiled
 
@@ -157,20 +156,20 @@ def entry(*kernels: Any) -> None:
     scheme and the model's kernels it is given): :func:`pending` lists them until they
     are compiled or loaded."""
     for compiled in kernels:
-        if is_jitted(compiled) and compiled not in _ENTRIES:
+        if is_kernel(compiled) and compiled not in _ENTRIES:
             _ENTRIES.append(compiled)
 
 
 def needs_compiling(compiled: Any) -> bool:
     """True for a kernel whose declared signature is neither compiled nor loaded."""
-    return (is_jitted(compiled) and compiled in _SIGNATURES
+    return (is_kernel(compiled) and compiled in _SIGNATURES
             and _SIGNATURES[compiled] not in compiled.signatures)
 
 
 def ready(compiled: Any) -> Any:
     """Compile (or load) the signature of ``compiled`` and of the kernels it calls,
     callees first, then allow no other signature; returns ``compiled``."""
-    if not is_jitted(compiled) or compiled in _READY:
+    if not is_kernel(compiled) or compiled in _READY:
         return compiled
     for dep in _callees(compiled):
         ready(dep)
@@ -188,7 +187,7 @@ def first_class(compiled: Any) -> Any:
     (:class:`pdeflow.numerics.numba_hooks.FunctionPointer`); anything else as is (a
     kernel on the public path: numba converts it at each call; None; a Python function
     with NUMBA_DISABLE_JIT=1)."""
-    if HOOKS is None or not is_jitted(compiled):
+    if HOOKS is None or not is_kernel(compiled):
         return compiled
     return HOOKS.pointer(compiled, _SIGNATURES[compiled])
 
@@ -200,8 +199,8 @@ def named_kernels(compiled: Any) -> tuple[list[tuple[str, Any]], list[tuple[str,
     cells = zip(func.__code__.co_freevars, func.__closure__ or (), strict=True)
     closed = [(name, cell.cell_contents) for name, cell in cells]
     named = [(name, func.__globals__.get(name)) for name in func.__code__.co_names]
-    return ([(n, k) for n, k in closed if is_jitted(k)],
-            [(n, k) for n, k in named if is_jitted(k)])
+    return ([(n, k) for n, k in closed if is_kernel(k)],
+            [(n, k) for n, k in named if is_kernel(k)])
 
 
 def _callees(compiled: Any) -> Iterator[Any]:
@@ -220,7 +219,7 @@ def kernels() -> list[Any]:
     for name, module in list(sys.modules.items()):
         if name.startswith(__package__ + ".") and module is not None:
             for value in vars(module).values():
-                if is_jitted(value) and value.py_func.__module__ == name:
+                if is_kernel(value) and value.py_func.__module__ == name:
                     found[id(value)] = value
     for compiled in _SPECIALISED:
         found[id(compiled)] = compiled

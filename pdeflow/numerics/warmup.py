@@ -27,11 +27,10 @@ import time
 from collections.abc import Callable, Iterator
 from typing import Any, TextIO
 
-from numba.extending import is_jitted
-
 from . import compiled
 from .compile_parallel import fewer_collections, ready_each, start_helper
 from .compiled import in_disk_cache, needs_compiling, pending
+from .kernel_identity import is_kernel
 
 READY = "ready"
 """:func:`status`: every kernel is compiled or loaded in this process"""
@@ -120,7 +119,7 @@ def _flatten(work: Any) -> Iterator[Any]:
     """The kernels and steppers of ``work``, nested iterables opened, None dropped."""
     if work is None:
         return
-    if is_jitted(work) or hasattr(work, "kernels") or callable(work):
+    if is_kernel(work) or hasattr(work, "kernels") or callable(work):
         yield work
         return
     try:
@@ -138,7 +137,7 @@ def _kernels_of(item: Any) -> list[Any]:
     """The numba kernels of a kernel or a stepper (none for a Python function, as with
     ``NUMBA_DISABLE_JIT=1``)."""
     found = item.kernels if hasattr(item, "kernels") else [item]
-    return [k for k in found if is_jitted(k)]
+    return [k for k in found if is_kernel(k)]
 
 
 def _bind(items: list[Any]) -> None:
