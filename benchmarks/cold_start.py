@@ -319,22 +319,29 @@ above, not re-measured since the code moved behind `prepare`):
   inlined function at every site). With the queue: compile 4.7 and 5.2 s against 5.9
   and 6.4 s for the code before (column *compile*, *session9* and *9b* against
   *session9-before* and *-b*, measured in the same quarter hour).
-* **Helpers without entry points** (`compiled.HelperKernel`): the two-layer source stage
+* **Helpers without entry points** (`numba_hooks.HelperKernel`): the two-layer source stage
   is a tree of 20 helper kernels; with the Python and function-pointer entry points
   every caller linked in and compiled again at every level (*session5*, together with
   the fewer collections below: 4.2 s of compilation against 5.5 s in *session4*).
 * **Fewer garbage collections while compiling** (`compile_parallel.fewer_collections`):
   0.7-0.8 s of collecting in 8.5-10.4 s of compiling in one process, 0.2 s with it;
   **none at exit** (`pdeflow.__main__`, `gc.freeze()`): 0.4-0.8 s of a first run.
-* **Function pointers looked up once** (`compiled.FunctionPointer`): passed a
+* **Function pointers looked up once** (`numba_hooks.FunctionPointer`): passed a
   dispatcher, numba looks up its address on every call of the stepping loop, about
   0.3 ms; passed numba's own wrapper it builds the function type again, 10-30 us.
 * **Closures named after their constants** (`compiled.specialise`, numba issue #10486):
   a rate test once failed with a cache that many test processes had filled, one
   closure's code loaded for another's.
-* **Cache keys following every callee's code** (`compiled._CodeKeyedCache`): numba's own
+* **Cache keys following every callee's code** (`numba_hooks._CodeKeyedCache`): numba's own
   key, the source file's time stamp, once loaded a kernel with an old callee compiled
   in and gave a wrong test 5.1 result.
+* **The public path**: on a numba newer than `compiled.NEWEST_TESTED_NUMBA`, or with
+  `PDEFLOW_NUMBA_FALLBACK=1`, `numba_hooks` is not imported and none of its mechanisms
+  apply: kernels are plain `numba.njit(cache=True)` with entry points, no helper
+  process compiles, kernels are passed to the stepping loop as dispatchers, and
+  closures over kernels (the advection stages, the stepping loop) are compiled in every
+  process, since numba's own cache key for them changes from one process to the next.
+  The numbers computed are the same (`tests/test_numba_fallback.py`).
 * **The app** loads its kernels in a background thread (`app/kernels.py`) and says so:
   its first picture came 13 s after a start with an empty cache (docs/teaching.md).
 """

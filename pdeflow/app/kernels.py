@@ -37,7 +37,7 @@ def warm_kernels() -> None:
 
     def spectrum_functions() -> None:
         # called from Python by the hyperbolicity page: compiled as Python-callable
-        # twins of the kernels (numerics.compiled.HelperKernel) while a helper process
+        # twins of the kernels (numerics.numba_hooks.HelperKernel) while a helper process
         # compiles the source stages
         g, r, h1, h2 = 9.81, 0.67, 0.5, 1.0
         hyp.discriminant(h1, h2, 3.0, 0.0, g, r)

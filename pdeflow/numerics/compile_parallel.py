@@ -225,7 +225,7 @@ def _importable(compiled: Any) -> bool:
 def _inlined(compiled: Any) -> bool:
     """True for a kernel numba copies into its callers (``inline="always"``): its IR is
     typed and lowered again at every call site, never compiled on its own."""
-    return compiled.targetoptions.get("inline") == "always"
+    return getattr(compiled, "targetoptions", {}).get("inline") == "always"
 
 
 @functools.cache

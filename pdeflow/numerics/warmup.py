@@ -16,10 +16,9 @@ make it. Behind that one call (nothing else in the package uses these):
   (:func:`~pdeflow.numerics.compile_parallel.fewer_collections`);
 * a stepper's kernels become function pointers once (its ``ready()``).
 
-The helper kernels compiled without Python entry points (``compiled.HelperKernel``) and
-the function-pointer wrapper (``compiled.FunctionPointer``) are how the kernels are
-built; they need no call of their own. :func:`status` says whether anything is left to
-compile (for progress bars).
+Without numba's private hooks (``compiled.HOOKS`` None) no helper process is started:
+its closures would not load from the disk cache. :func:`status` says whether anything
+is left to compile (for progress bars).
 """
 
 from __future__ import annotations
@@ -28,10 +27,10 @@ import time
 from collections.abc import Callable, Iterator
 from typing import Any, TextIO
 
-from numba.core.dispatcher import Dispatcher
-
+from . import compiled
 from .compile_parallel import fewer_collections, ready_each, start_helper
 from .compiled import in_disk_cache, needs_compiling, pending
+from .kernel_identity import is_kernel
 
 READY = "ready"
 """:func:`status`: every kernel is compiled or loaded in this process"""
@@ -100,7 +99,9 @@ def _compile(kernels: list[Any], parallel: bool,
     ``parallel``; ``meanwhile`` after this process's share, before the wait."""
     with fewer_collections():
         todo = [k for k in kernels if needs_compiling(k)]
-        helper, mine = start_helper(todo) if parallel else (None, todo)
+        # without the private hooks a helper's closures would not load from the cache
+        helper, mine = start_helper(todo) if parallel and compiled.HOOKS \
+            else (None, todo)
         try:
             ready_each(mine)
             if meanwhile is not None:
@@ -118,7 +119,7 @@ def _flatten(work: Any) -> Iterator[Any]:
     """The kernels and steppers of ``work``, nested iterables opened, None dropped."""
     if work is None:
         return
-    if isinstance(work, Dispatcher) or hasattr(work, "kernels") or callable(work):
+    if is_kernel(work) or hasattr(work, "kernels") or callable(work):
         yield work
         return
     try:
@@ -136,7 +137,7 @@ def _kernels_of(item: Any) -> list[Any]:
     """The numba kernels of a kernel or a stepper (none for a Python function, as with
     ``NUMBA_DISABLE_JIT=1``)."""
     found = item.kernels if hasattr(item, "kernels") else [item]
-    return [k for k in found if isinstance(k, Dispatcher)]
+    return [k for k in found if is_kernel(k)]
 
 
 def _bind(items: list[Any]) -> None:
