@@ -60,7 +60,7 @@ PAGES: dict[str, Page] = {
                                  ("docs/generate/erodible_bed*.py", "docs/generate/run_cache.py",
                                   "docs/generate/law_set.py", "cases/erodible_bed.toml",
                                   "cases/paper_5_2_two_layer_law.toml",
-                                  "pdeflow/analysis/erosion.py", "docs/erodible_bed/sweep.csv")),
+                                  "pdeflow/erosion.py", "docs/erodible_bed/sweep.csv")),
     "docs/calibration_5_1.md": Page(
         "python docs/generate/calibration.py > docs/calibration_5_1.md",
         ("docs/generate/calibration.py", "cases/study_calibration_5_1.toml",
