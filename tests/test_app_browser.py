@@ -19,7 +19,10 @@ from pathlib import Path
 import pytest
 
 from pdeflow.analysis.sweep import run_sweep
-from pdeflow.app.browser import (
+from pdeflow.cases import load_case
+from pdeflow.simulate import run_model
+
+from .browser import (
     CHROMIUM,
     READY,
     app_server,
@@ -32,9 +35,6 @@ from pdeflow.app.browser import (
     slider_latency,
     text,
 )
-from pdeflow.cases import load_case
-from pdeflow.simulate import run_model
-
 from .helpers import cli_warnings
 
 pytestmark = pytest.mark.skipif(os.environ.get("PDEFLOW_SKIP_BROWSER") == "1",
@@ -53,7 +53,8 @@ docs/generate/teaching_screenshots.py, not asserted here."""
 def browser():
     if not Path(CHROMIUM).is_file():
         pytest.fail(f"{CHROMIUM} is missing: apt-get install chromium (CI: .ci/run does), "
-                    "or set PDEFLOW_SKIP_BROWSER=1 to skip the browser tests")
+                    "set PDEFLOW_CHROMIUM to another Chromium, or set "
+                    "PDEFLOW_SKIP_BROWSER=1 to skip the browser tests")
     try:
         import playwright  # noqa: F401
     except ImportError:

@@ -97,7 +97,8 @@ PAGES: dict[str, Page] = {
                                         "pdeflow/analysis/positivity.py")),
     "docs/teaching.md": Page("python docs/generate/teaching_screenshots.py",
                              ("docs/generate/teaching_screenshots.py", "pdeflow/app/**/*.py",
-                              "cases/paper_5_1_dam_break.toml", "cases/collapse_sweep.toml")),
+                              "tests/browser.py", "cases/paper_5_1_dam_break.toml",
+                              "cases/collapse_sweep.toml")),
     "docs/performance.md": Page("python benchmarks/run_benchmarks.py",
                                 ("benchmarks/*.py", "benchmarks/measurements/*.json")),
 }
