@@ -1,7 +1,7 @@
 """The app's warm start: ``pdeflow app`` started to the dam-break page's first picture.
 
 As ``docs/generate/teaching_screenshots.py`` times its second start (kernels cached):
-the clock starts before the server process (``pdeflow.app.browser.app_server``) and
+the clock starts before the server process (``tests.browser.app_server``) and
 stops when the page, loaded in headless Chromium, shows its first result
 (``READY["dam-break"]``). One start first fills the numba cache this benchmark uses
 (a directory of its own), then ``repeats`` warm starts; the median is reported.
@@ -12,12 +12,15 @@ from __future__ import annotations
 
 import os
 import statistics
+import sys
 import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))  # the browser driver is test support: tests/browser.py
 
 
 def warm_start_to_first_picture(repeats: int = 5,
@@ -26,7 +29,7 @@ def warm_start_to_first_picture(repeats: int = 5,
     cached, for the checkout of each of ``trees`` (several: their starts interleaved,
     each with a numba cache of its own): ``{"walls_s": [[...] per tree], "median_s":
     [...], "load_avg_at_start": ..., "load_avg_at_end": ...}``."""
-    from pdeflow.app.browser import app_server, chromium, open_page
+    from tests.browser import app_server, chromium, open_page
 
     walls: list[list[float]] = [[] for _ in trees]
     load = os.getloadavg()[0]

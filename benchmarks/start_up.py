@@ -144,7 +144,7 @@ def _app(repeats: int) -> dict[str, Any] | None:
     """:func:`app_start.warm_start_to_first_picture`, or None without a browser."""
     import app_start
 
-    from pdeflow.app.browser import CHROMIUM
+    from tests.browser import CHROMIUM
 
     try:
         import playwright  # noqa: F401

@@ -108,7 +108,7 @@ def bed_figure(x: np.ndarray, t: np.ndarray, frames: Sequence[np.ndarray], model
                bed0: np.ndarray | None, series: Any, title: str = "",
                duration: float | None = None, region: np.ndarray | None = None) -> Any:
     """Side views (top) and the space-time map (bottom) of one run's frames (state data
-    at the times ``t``), ``series`` its :class:`~pdeflow.analysis.erosion.ErosionSeries`,
+    at the times ``t``), ``series`` its :class:`~pdeflow.erosion.ErosionSeries`,
     over the x range the material reached; the side views span t = 0 .. ``duration``
     [s] (the flow's; default: the whole run)."""
     reach = np.nanmax(series.front) if np.isfinite(series.front).any() else x[-1]

@@ -7,18 +7,18 @@ import math
 from typing import Any
 
 from . import systems
-from .cases import FRAMES, SCHEMA, SERIES, Case, CaseError
+from .case_schema import FRAMES, SCHEMA, SERIES, CaseError
 from .initial_shapes import SHAPES, check_initial
 from .models.base import check_range
 from .numerics.layout import GEOMETRIES
 from .variant import MAX_CFL, VariantError
 
 
-def _err(case: Case, msg: str) -> CaseError:
+def _err(case: Any, msg: str) -> CaseError:
     return CaseError(f"{case.source}: {msg}")
 
 
-def validate(case: Case) -> None:
+def validate(case: Any) -> None:
     """Check sections, keys, types and ranges; raise CaseError naming the key."""
     from .checks import check_memory
 
@@ -74,7 +74,7 @@ def validate(case: Case) -> None:
     except ValueError as err:
         raise _err(case, str(err)) from None
 
-def _check_sections(case: Case) -> None:
+def _check_sections(case: Any) -> None:
     """Known sections and keys of the right types; the models' parameters; known
     models."""
     for section, content in case.data.items():
@@ -110,7 +110,7 @@ def _check_sections(case: Case) -> None:
         raise _err(case, f"case.models names a model twice: {case.models}")
 
 
-def _check_geometry(case: Case) -> None:
+def _check_geometry(case: Any) -> None:
     """grid.geometry is 'planar' or 'axisymmetric'; an axisymmetric grid starts at the
     axis (x_start = 0), whose boundary is a wall (mirror symmetry: no flux)."""
     if case.geometry not in GEOMETRIES:
@@ -131,7 +131,7 @@ def _check_geometry(case: Case) -> None:
             raise _err(case, f"{model}.theta_deg must be 0 on an axisymmetric grid "
                             f"(radial flow on a horizontal plane), got {theta:g}")
 
-def _check_finite(case: Case, key: str, value: Any) -> None:
+def _check_finite(case: Any, key: str, value: Any) -> None:
     """Numbers (also inside lists) must be finite: TOML allows nan and inf."""
     items = value if isinstance(value, list) else [value]
     for v in items:
@@ -141,7 +141,7 @@ def _check_finite(case: Case, key: str, value: Any) -> None:
         if isinstance(v, float) and not math.isfinite(v):
             raise _err(case, f"{key} must be a finite number, got {v!r}")
 
-def _check_cells(case: Case) -> None:
+def _check_cells(case: Any) -> None:
     """grid.cells >= 1 (it wins over grid.dx); grid.dx must divide grid.length."""
     grid = case.data.get("grid", {})
     if "cells" in grid:
@@ -156,7 +156,7 @@ def _check_cells(case: Case) -> None:
                 f"{case.length:g} m into whole cells ({n:.6g}); use a dx in "
                 f"(0, {case.length:g}] m with length/dx an integer, or grid.cells")
 
-def _check_initial(case: Case) -> None:
+def _check_initial(case: Any) -> None:
     try:
         check_initial(case.initial, case.length, case.base_dir)
     except ValueError as err:

@@ -53,6 +53,8 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from . import systems
+from .case_schema import CaseError
+from .case_validation import validate as _validate
 from .initial_shapes import (
     bed_depth,
     bed_region,
@@ -68,40 +70,10 @@ PAPER_MODEL = "two_layer"
 BASELINE_MODEL = "single_layer"
 """the registered name of the single-layer Coulomb baseline (exact solutions are its)"""
 DEFAULT_MODELS = [PAPER_MODEL]
-FRAMES = ("interpolate", "step")
-"""output.frames choices (see :attr:`Case.frames`)"""
-SERIES = ("auto", "on", "off")
-"""output.erosion_series choices (see :attr:`Case.erosion_series`)"""
+"""case.models when a case names none"""
 SERIES_FRAMES = 200
 """frames of the erosion time series by default (output.series_every = t_end / this): the
 memory stays that of 200 states whatever t_end, and a flow of t_end / 4 still gets 50"""
-"""case.models when a case names none"""
-
-SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
-    "case": {"name": (str,), "description": (str,), "t_end": (float, int),
-             "models": (list,)},
-    "grid": {"length": (float, int), "dx": (float, int), "cells": (int,),
-             "x_start": (float, int), "geometry": (str,)},
-    "boundaries": {"left": (str,), "right": (str,)},
-    "initial": {"shape": (str,), "L0": (float, int), "H0": (float, int),
-                "wedge_angle_deg": (float, int), "x_dam": (float, int),
-                "h_left": (float, int), "h_right": (float, int),
-                "upper_fraction": (float, int), "center": (float, int),
-                "height": (float, int), "slope_deg": (float, int), "path": (str,),
-                "bed_thickness": (float, int), "bed_length": (float, int)},
-    "numerics": {"solver": (str,), "cfl": (float, int), "dt": (float, int),
-                 "flux": (str,), "reconstruction": (str,), "limiter": (str,),
-                 "splitting": (str,)},
-    "output": {"snapshot_times": (list,), "front_threshold": (float, int),
-               "runout_mass_fraction": (float, int), "frames": (str,),
-               "erosion_series": (str,), "series_every": (float, int)},
-    "sweep": {"aspect_ratios": (list,)},
-}
-
-
-
-class CaseError(ValueError):
-    """An invalid case file or override; the message names the key and the file."""
 
 
 @dataclass
@@ -152,9 +124,7 @@ class Case:
     def validate(self) -> None:
         """Check sections, keys, types and ranges; raise CaseError naming the key
         (:func:`pdeflow.case_validation.validate`)."""
-        from .case_validation import validate
-
-        validate(self)
+        _validate(self)
 
     # --- accessors ------------------------------------------------------------------------
     def _get(self, section: str, key: str, default: Any) -> Any:
@@ -255,7 +225,7 @@ class Case:
 
     @property
     def erosion_series(self) -> bool:
-        """Whether the runs record the erosion time series (pdeflow.analysis.erosion):
+        """Whether the runs record the erosion time series (pdeflow.erosion):
         ``output.erosion_series`` 'on', 'off', or 'auto' (the default: on for the cases
         that lay a bed, so that no other case pays for frames nobody asked for)."""
         choice = self._get("output", "erosion_series", "auto")

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from . import __version__
+from .cli_options import positive
 
 RUN_HELP = """Run every model listed in the case file (case.models) to rest or t_end.
 
@@ -30,13 +31,6 @@ examples:
   pdeflow run cases/ritter_dam_break.toml --live            # desktop window
   pdeflow run cases/paper_5_1_dam_break.toml --movie 5_1.mp4 --store 5_1.h5
   pdeflow plot 5_1.h5 5_1.single_layer.h5 --time 0.4 --out t04.png"""
-
-def _positive(name: str, value: float | None) -> None:
-    from .cases import CaseError
-
-    if value is not None and not value > 0:
-        raise CaseError(f"{name} must be > 0, got {value!r}")
-
 
 def _run_trackers(args: argparse.Namespace, case: Any, model: str,
                   first: bool) -> list[Any]:
@@ -162,7 +156,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     case = _load_run_case(args)
     for name in ("live_every", "store_every", "fps"):
-        _positive(f"--{name.replace('_', '-')}", getattr(args, name))
+        positive(f"--{name.replace('_', '-')}", getattr(args, name))
     default_out = not (args.summary or args.final or args.plot or args.outdir
                        or args.store or args.movie or args.frames)
     outdir = Path(args.outdir) if args.outdir else (
@@ -395,12 +389,6 @@ def _main(argv: list[str] | None = None) -> int:
             raise
         print(f"pdeflow: error: {err}", file=sys.stderr)
         return 2
-
-
-def module_main(command: str) -> None:
-    """``python -m pdeflow.<module>`` of a command's module: ``pdeflow COMMAND`` on the
-    command line's arguments (the same errors and exit codes), then exit."""
-    sys.exit(main([command, *sys.argv[1:]]))
 
 
 if __name__ == "__main__":  # pragma: no cover

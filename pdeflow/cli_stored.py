@@ -9,7 +9,7 @@ import math
 import sys
 from typing import Any
 
-from .cli import _positive
+from .cli_options import positive
 
 PLOT_HELP = """Plot stored runs (written by `pdeflow run --store`) at one time, or as a movie.
 
@@ -53,7 +53,7 @@ def cmd_plot(args: argparse.Namespace) -> int:
     from .plotting import RunFigure, Series, display_name
     from .storage import open_run
 
-    _positive("--fps", args.fps)
+    positive("--fps", args.fps)
     if args.time is not None and not math.isfinite(args.time):
         from .cases import CaseError
 

@@ -21,14 +21,6 @@ import numpy as np
 from pde import FieldCollection
 
 from . import systems
-from .analysis.erosion import (
-    BED_KEYS,
-    SERIES_KEYS,
-    ErosionSeries,
-    erosion_series,
-    final_deposit,
-    series_numbers,
-)
 from .cases import Case
 from .checks import (
     RunWarning,
@@ -38,6 +30,14 @@ from .checks import (
     result_warnings,
     slope_warning,
     solver_warning,
+)
+from .erosion import (
+    BED_KEYS,
+    SERIES_KEYS,
+    ErosionSeries,
+    erosion_series,
+    final_deposit,
+    series_numbers,
 )
 from .metrics import (
     front_position,
@@ -77,7 +77,7 @@ class RunResult:
     frames: tuple[np.ndarray, list[np.ndarray]] | None = None
     """(times [s], state data) of the series' frames, if it records them"""
     series: ErosionSeries | None = None
-    """the erosion time series (:mod:`pdeflow.analysis.erosion`) of a case that records
+    """the erosion time series (:mod:`pdeflow.erosion`) of a case that records
     it (:attr:`pdeflow.cases.Case.erosion_series`), else None"""
 
     @property

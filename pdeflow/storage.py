@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 from pde.trackers.base import InfoDict
 
-from . import systems
+from . import __version__, systems
 from .io import PendingFile, atomic_path, jsonable
 from .numerics.geometry import COORDINATES
 from .numerics.state import DRY_TOLERANCE, velocity_profile
@@ -106,8 +106,6 @@ def _variant_parts(case: Any, eq: Any) -> list[str]:
 def run_metadata(case: Any, model: str, *, overrides: Sequence[str] = (),
                  case_file: str | None = None, **extra: Any) -> dict[str, Any]:
     """Metadata of one model run of a :class:`pdeflow.cases.Case` for the stored file."""
-    from . import __version__
-
     eq = case.make_pde(model)
     variant = ", ".join([model, *_variant_parts(case, eq)])
     meta = {
@@ -165,8 +163,6 @@ class RunStorageTracker(FextraStorageTracker):
     def initialize(self, field: Any, info: InfoDict | None = None) -> float:
         import pde
         from pde import FileStorage
-
-        from . import __version__
 
         require_h5py()
         system = (systems.get(self.metadata["model"]) if "model" in self.metadata

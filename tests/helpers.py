@@ -47,11 +47,11 @@ def two_layer_column(n: int = 140, length: float = 7.0, **params):
 
 def ishigami_study(design: str, samples: int, seed: int, bound: float = 3,
                    delay: float | None = None, name: str | None = None) -> str:
-    """The text of a study file of ``pdeflow.study.testfunctions:ishigami`` (quantity
+    """The text of a study file of ``tests.studyfunctions:ishigami`` (quantity
     ``y``) over x1, x2, x3 uniform in [-bound, bound], with a fixed ``delay`` [s] per
     evaluation if given (used by the benchmarks too: benchmarks/study_scaling.py)."""
     lines = ["[study]", *([f'name = "{name}"'] if name else []),
-             'function = "pdeflow.study.testfunctions:ishigami"', f'design = "{design}"',
+             'function = "tests.studyfunctions:ishigami"', f'design = "{design}"',
              f"samples = {samples}", f"seed = {seed}", 'quantities = ["y"]', "[parameters]",
              *(f"x{i} = {{ range = [-{bound!r}, {bound!r}] }}" for i in (1, 2, 3)),
              *([f"delay = {{ values = [{delay!r}] }}"] if delay is not None else [])]

@@ -20,7 +20,10 @@ from urllib.parse import urlparse
 import pytest
 
 from pdeflow.analysis.sweep import run_sweep
-from pdeflow.app.browser import (
+from pdeflow.cases import load_case
+from pdeflow.simulate import run_model
+
+from .browser import (
     CHROMIUM,
     READY,
     app_server,
@@ -34,9 +37,6 @@ from pdeflow.app.browser import (
     slider_latency,
     text,
 )
-from pdeflow.cases import load_case
-from pdeflow.simulate import run_model
-
 from .helpers import cli_warnings
 
 pytestmark = pytest.mark.skipif(os.environ.get("PDEFLOW_SKIP_BROWSER") == "1",
@@ -55,7 +55,8 @@ docs/generate/teaching_screenshots.py, not asserted here."""
 def browser():
     if not Path(CHROMIUM).is_file():
         pytest.fail(f"{CHROMIUM} is missing: apt-get install chromium (CI: .ci/run does), "
-                    "or set PDEFLOW_SKIP_BROWSER=1 to skip the browser tests")
+                    "set PDEFLOW_CHROMIUM to another Chromium, or set "
+                    "PDEFLOW_SKIP_BROWSER=1 to skip the browser tests")
     try:
         import playwright  # noqa: F401
     except ImportError:

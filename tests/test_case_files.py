@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from pdeflow.analysis import mangeney, ritter
-from pdeflow.cases import SCHEMA, load_case
+from pdeflow.case_schema import SCHEMA
+from pdeflow.cases import load_case
 from pdeflow.simulate import run_model
 
 ROOT = Path(__file__).parents[1]

@@ -1,4 +1,4 @@
-"""The erosion diagnostics (pdeflow.analysis.erosion): exact on constructed beds, and in
+"""The erosion diagnostics (pdeflow.erosion): exact on constructed beds, and in
 a run over an erodible bed consistent with mass conservation; stored in the summary of
 bed cases only; the bed figure is written."""
 
@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pdeflow.analysis import erosion as E
+from pdeflow import erosion as E
 from pdeflow.cases import CaseError, load_case
 from pdeflow.simulate import print_summary, run_model
 

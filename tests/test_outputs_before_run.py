@@ -1,5 +1,5 @@
 """Issue 28: outputs checked before the run, size refused, interrupts (one line, no
-files), study files pointed to ``pdeflow study``, ``python -m`` entry points."""
+files), study files pointed to ``pdeflow study``, ``python -m pdeflow`` errors."""
 
 from __future__ import annotations
 
@@ -117,8 +117,8 @@ def test_a_study_file_given_to_run_points_to_study(capsys):
 
 
 @pytest.mark.parametrize("argv", [[], ["missing.toml"], ["--levels", "-1", str(CASE_51)]])
-def test_python_m_convergence_gives_the_commands_errors(argv):
-    proc = subprocess.run([sys.executable, "-m", "pdeflow.analysis.convergence", *argv],
+def test_python_m_converge_gives_the_commands_errors(argv):
+    proc = subprocess.run([sys.executable, "-m", "pdeflow", "converge", *argv],
                           cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2, proc
     assert proc.stderr.startswith("pdeflow: error:") and proc.stderr.count("\n") == 1

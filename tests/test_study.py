@@ -20,9 +20,9 @@ pytest.importorskip("distributed")
 from pdeflow.cli import main  # noqa: E402
 from pdeflow.study import load_study  # noqa: E402
 from pdeflow.study.designs import design_points  # noqa: E402
-from pdeflow.study.testfunctions import ishigami, ishigami_indices  # noqa: E402
 
 from .helpers import ishigami_study  # noqa: E402
+from .studyfunctions import ishigami, ishigami_indices  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE_51 = (ROOT / "cases" / "paper_5_1_dam_break.toml").as_posix()
@@ -85,7 +85,7 @@ def test_unknown_design_and_bad_workers(tmp_path, capsys):
 def test_designs_cover_ranges_and_kinds(tmp_path):
     text = """
 [study]
-function = "pdeflow.study.testfunctions:ishigami"
+function = "tests.studyfunctions:ishigami"
 design = "grid"
 quantities = ["y"]
 [parameters]
@@ -172,7 +172,7 @@ def test_sobol_indices_of_ishigami_through_the_pipeline(tmp_path):
 def test_pareto_front_of_schaffer_by_nsga2(tmp_path):
     text = """
 [study]
-function = "pdeflow.study.testfunctions:schaffer"
+function = "tests.studyfunctions:schaffer"
 design = "optimize"
 samples = 96
 population = 16

@@ -75,7 +75,7 @@ def _runs(n: dict[str, Any]) -> str:
             f"to rest; coarse grid dx = {COARSE * 1e3:g} mm for the whole sweep. Run-out = "
             "front - L0, the front being the downstream face of the last cell deeper than "
             "1 mm above the initial bed; flow duration = the first time from which the "
-            "front no longer moves (frames every 10 ms; `pdeflow.analysis.erosion`). "
+            "front no longer moves (frames every 10 ms; `pdeflow.erosion`). "
             f"{n['points']} runs, {n['wall_s']:.0f} s of run time; "
             f"{n['domain_end_runs']} of them let material (at least a thin film) out of the "
             "channel's open end, and their run-outs are lower bounds (marked ≥); the "

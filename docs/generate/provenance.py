@@ -60,7 +60,7 @@ PAGES: dict[str, Page] = {
                                  ("docs/generate/erodible_bed*.py", "docs/generate/run_cache.py",
                                   "docs/generate/law_set.py", "cases/erodible_bed.toml",
                                   "cases/paper_5_2_two_layer_law.toml",
-                                  "pdeflow/analysis/erosion.py", "docs/erodible_bed/sweep.csv")),
+                                  "pdeflow/erosion.py", "docs/erodible_bed/sweep.csv")),
     "docs/calibration_5_1.md": Page(
         "python docs/generate/calibration.py > docs/calibration_5_1.md",
         ("docs/generate/calibration.py", "cases/study_calibration_5_1.toml",
@@ -97,7 +97,8 @@ PAGES: dict[str, Page] = {
                                         "pdeflow/analysis/positivity.py")),
     "docs/teaching.md": Page("python docs/generate/teaching_screenshots.py",
                              ("docs/generate/teaching_screenshots.py", "pdeflow/app/**/*.py",
-                              "cases/paper_5_1_dam_break.toml", "cases/collapse_sweep.toml")),
+                              "tests/browser.py", "cases/paper_5_1_dam_break.toml",
+                              "cases/collapse_sweep.toml")),
     "docs/performance.md": Page("python benchmarks/run_benchmarks.py",
                                 ("benchmarks/*.py", "benchmarks/measurements/*.json")),
 }

@@ -27,7 +27,7 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))  # this checkout's pdeflow, as the server runs it
 
-from pdeflow.app.browser import (  # noqa: E402
+from tests.browser import (  # noqa: E402
     READY,
     app_server,
     chromium,

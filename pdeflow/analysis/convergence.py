@@ -274,9 +274,3 @@ def cmd_converge(args: argparse.Namespace) -> int:
     if args.summary:
         write_json(args.summary, res)
     return 0
-
-
-if __name__ == "__main__":  # python -m: the command's errors and exit codes
-    from pdeflow.cli import module_main
-
-    module_main("converge")

@@ -18,9 +18,13 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from pde import CartesianGrid
 
 from .. import systems
 from ..cases import BASELINE_MODEL, PAPER_MODEL
+from ..metrics import mass
+from ..numerics import layout as L
+from ..solvers.fv_split import SimulationBlowUp
 
 FLUXES = ("hll", "rusanov", "ifcp")
 SCHEMES = (("first-order", "minmod"), ("muscl", "minmod"), ("muscl", "mc"))
@@ -103,12 +107,6 @@ def draw_state(rng: np.random.Generator) -> StressState:
 
 def run_state(s: StressState, t_end: float = 0.1) -> StressResult:
     """Run ``s`` with fv-split (walls at both ends) to rest or ``t_end`` [s]."""
-    from pde import CartesianGrid
-
-    from ..metrics import mass
-    from ..numerics import layout as L
-    from ..solvers.fv_split import SimulationBlowUp
-
     n = next(iter(s.profiles.values())).size
     eq = systems.get(s.model).pde_class(bc=("wall", "wall"), **s.scheme, **s.params)
     state = eq.make_state(CartesianGrid([[0.0, s.length]], n), **s.profiles)

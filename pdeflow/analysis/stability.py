@@ -41,8 +41,10 @@ from functools import partial
 from typing import Any
 
 import numpy as np
+from pde.trackers.base import FinishedSimulation
 
 from ..numerics import layout as L
+from ..solvers.fv_split import FVSplitSolver, SimulationBlowUp
 from ..study.core import Executor, Study, serial
 from ..variant import Variant
 from .stability_problems import Problem, reference_speed, shear
@@ -114,10 +116,6 @@ def run(variant: Variant | str, problem: Problem, cfl: float, *,
 
 def _run_fv_split(variant: Variant, eq: Any, state: Any, problem: Problem, cfl: float,
                   max_steps: int) -> Outcome:
-    from pde.trackers.base import FinishedSimulation
-
-    from ..solvers.fv_split import FVSplitSolver, SimulationBlowUp
-
     solver = FVSplitSolver(eq, cfl=min(cfl, 0.5), max_steps=max_steps,
                            splitting=variant.splitting)
     solver.cfl = float(cfl)  # validation bypassed on purpose (module docstring)

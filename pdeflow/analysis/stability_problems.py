@@ -23,8 +23,12 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from pde import CartesianGrid
+from pde.trackers.base import FinishedSimulation
 
+from ..models import TwoLayerGranular
 from ..models.two_layer import hyperbolicity as hyp
+from ..solvers.fv_split import FVSplitSolver
 from ..variant import Variant
 
 G = 9.81  #: gravity of all problems [m/s^2]
@@ -58,10 +62,6 @@ class Problem:
     def make(self, variant: Variant):
         """Two-layer PDE (the variant's flux, reconstruction, limiter and hyperbolicity
         mode) and the initial state."""
-        from pde import CartesianGrid
-
-        from ..models import TwoLayerGranular
-
         grid = CartesianGrid([[0.0, self.length]], self.cells)
         eq = TwoLayerGranular(bc=self.bc, flux=variant.flux,
                               reconstruction=variant.reconstruction,
@@ -115,10 +115,6 @@ def cfl_problems(quick: bool = False) -> list[Problem]:
 def reference_speed(problem: Problem) -> float:
     """Largest HLL wave-speed bound [m/s] over every step of the reference solution
     (fv-split, hyperbolicity 'exact', CFL 0.3); stored in ``problem.s_ref``."""
-    from pde.trackers.base import FinishedSimulation
-
-    from ..solvers.fv_split import FVSplitSolver
-
     eq, state = problem.make(REFERENCE)
     P = eq.parameter_array()
     stepper = FVSplitSolver(eq, cfl=0.3, max_steps=1).make_stepper(state)

@@ -292,9 +292,3 @@ def _print_mass_fit(model: str, res: dict[str, Any], fraction: float) -> None:
            if res["prefactor_mass"] else "r_mass: no fit")
     print(f"{'':13} {fit}   (front holding {100 * fraction:.4g}% of the mass)   "
           f"a:r_mass {pts}")
-
-
-if __name__ == "__main__":  # python -m: the command's errors and exit codes
-    from pdeflow.cli import module_main
-
-    module_main("sweep")

@@ -16,9 +16,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from pde.trackers.base import FinishedSimulation
 
 from ..cases import Case
 from ..simulate import Run
+from ..solvers import SimulationBlowUp
 from ..variant import Variant
 from .points import Point
 
@@ -51,10 +53,6 @@ def _repeat(run: Any, repeats: int) -> list[float]:
 
 
 def _fv_split_run(run: Run, t: float, repeats: int) -> RunTiming:
-    from pde.trackers.base import FinishedSimulation
-
-    from ..solvers import SimulationBlowUp
-
     def once() -> tuple[float, np.ndarray, int, dict]:
         solver = run.make_solver()
         s = run.state.copy()

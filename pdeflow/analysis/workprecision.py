@@ -58,7 +58,7 @@ import re
 import statistics
 import sys
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -70,7 +70,7 @@ from ..variant import MAX_CFL, Variant
 from .exact import exact_solution_for
 from .points import Point, case_on_grid, resolve_case, with_sets
 from .timing import run_variant, timed
-from .workprecision_outputs import markdown_table, write_outputs
+from .workprecision_outputs import CompareResult, markdown_table, write_outputs
 
 DEFAULT_VARIANTS: tuple[str, ...] = (
     "hll/first-order", "rusanov/first-order", "ifcp/first-order",
@@ -103,19 +103,6 @@ def cell_edges(case: Case) -> np.ndarray:
 
 
 # --- the harness -----------------------------------------------------------------------
-
-@dataclass
-class CompareResult:
-    """Rows of a work-precision study and the files written."""
-
-    case: str
-    t: float
-    rows: list[dict[str, Any]]
-    files: dict[str, str] = field(default_factory=dict)
-
-    def to_json(self) -> dict[str, Any]:
-        return asdict(self)
-
 
 def _errors(data: np.ndarray, ref: np.ndarray, dx: float) -> tuple[float, float]:
     depth = float(np.abs(data[::2] - ref[::2]).sum() * dx)
@@ -407,9 +394,3 @@ def cmd_compare(args: argparse.Namespace) -> int:
         print(f"pdeflow compare: error: {err}", file=sys.stderr)
         return 2
     return 0
-
-
-if __name__ == "__main__":  # python -m: the command's errors and exit codes
-    from pdeflow.cli import module_main
-
-    module_main("compare")

@@ -1,17 +1,29 @@
 """The outputs of a work-precision study (:func:`pdeflow.analysis.workprecision.compare`):
-a Markdown table, a work-precision diagram and the JSON of the rows."""
+a Markdown table, a work-precision diagram and the JSON of the rows, and the result
+they are made of (:class:`CompareResult`, below the study that fills it)."""
 
 from __future__ import annotations
 
 import json
 import math
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..variant import Variant
 
-if TYPE_CHECKING:
-    from .workprecision import CompareResult
+
+@dataclass
+class CompareResult:
+    """Rows of a work-precision study and the files written."""
+
+    case: str
+    t: float
+    rows: list[dict[str, Any]]
+    files: dict[str, str] = field(default_factory=dict)
+
+    def to_json(self) -> dict[str, Any]:
+        return asdict(self)
 
 
 def _fmt(v: Any, spec: str) -> str:

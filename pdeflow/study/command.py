@@ -13,6 +13,8 @@ import argparse
 import sys
 from typing import Any
 
+from .spec import StudyError, load_study
+
 
 def add_arguments(ap: Any) -> None:
     """The study command's options."""
@@ -32,8 +34,6 @@ def add_arguments(ap: Any) -> None:
 
 def cmd_study(args: argparse.Namespace) -> int:
     """Run or resume the study, then write its report."""
-    from .spec import StudyError, load_study
-
     def log(msg: str) -> None:
         if not args.quiet:
             print(msg)

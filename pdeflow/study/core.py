@@ -39,6 +39,8 @@ from dataclasses import dataclass, field
 from functools import partial
 from typing import Any, Protocol
 
+from ..trackers.progress import PointsBar
+
 TARGET_BATCH_S = 0.5
 """wall time a batch should take [s]: scheduling overhead << 1 %, little lost on Ctrl-C"""
 
@@ -206,8 +208,6 @@ class Study:
         ``progress``: the label of a bar over the points on stderr (None: no bar)."""
         if progress is None or not isinstance(self.points, Sequence):
             return self.run(executor).rows
-        from ..trackers.progress import PointsBar
-
         bar = PointsBar(len(self.points), progress)
         try:
             return self.run(executor, on_rows=bar).rows

@@ -17,14 +17,15 @@ import warnings
 from dataclasses import dataclass
 from typing import Any
 
+from ..checks import RunWarning
+from ..numerics.warmup import prepare
+from ..simulate import case_steppers, run_model
 from .spec import SWEEP_KEYS, StudySpec
 
 
 def _silence_run_warnings() -> None:
     """A run's warnings are in its summary (quantity ``<model>.warnings``); thousands of
     evaluations printing them would bury the study's own output (worker processes only)."""
-    from ..checks import RunWarning
-
     warnings.simplefilter("ignore", RunWarning)
 
 
@@ -37,7 +38,6 @@ def _quantities(spec: StudySpec, point: dict[str, Any]) -> dict[str, Any]:
             raise KeyError(f"{spec.function} returned no {missing[0]!r}")
         return {q: out[q] for q in spec.quantities}
     from ..analysis.sweep import run_sweep
-    from ..simulate import run_model
 
     _silence_run_warnings()
     values: dict[str, Any] = {}
@@ -119,9 +119,6 @@ def warm(spec: StudySpec) -> float:
     the numba kernels (from the disk cache; compiled if absent), by a run of each needed
     model on a 16-cell grid for a few steps. Returns the time it took [s]. Run once per
     worker when the cluster starts, so that the loop's timing holds only evaluations."""
-    from ..numerics.warmup import prepare
-    from ..simulate import run_model
-
     t0 = time.perf_counter()
     _silence_run_warnings()
     if spec.function is not None:
@@ -148,8 +145,6 @@ def study_steppers(spec: StudySpec) -> list[Any]:
     is filled on two cores). A case that cannot be built is left out: its evaluations
     report the error. A parameter chosen among names (a basal friction law, a closure)
     may select other kernels: the case with each of its choices is warmed too."""
-    from ..simulate import case_steppers
-
     points: list[dict[str, Any]] = [{}]
     points += [{p.key: v} for p in spec.parameters
                if p.kind == "choice" and all(isinstance(x, str) for x in p.values)

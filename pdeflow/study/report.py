@@ -11,7 +11,10 @@ from typing import Any
 
 import numpy as np
 
+from .. import systems
 from ..io import atomic_path
+from ..models.base import field_units
+from ..simulate import summary_unit
 from .designs import sobol_indices
 from .results import ResultsTable
 from .spec import StudySpec
@@ -134,10 +137,6 @@ def unit_of(key: str) -> str | None:
     """The unit of a study column: a parameter ('two_layer.c', 'initial.H0', any
     '*_deg'), a run quantity ('two_layer.runout') or a sweep's fit ('sweep.m.exponent':
     '-'); None where none is known (derived expressions, objectives)."""
-    from .. import systems
-    from ..models.base import field_units
-    from ..simulate import summary_unit
-
     parts = key.split(".")
     if parts[0] == "sweep":
         return "-" if parts[-1] != "all_at_rest" else None

@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from ..metrics import front_position, total_depth
+from .metrics import front_position, total_depth
 
 ERODED_DEPTH = 1e-4
 """depth below the original bed surface [m] from which a cell counts as eroded for the

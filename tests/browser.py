@@ -1,8 +1,9 @@
 """The app in a real browser: ``pdeflow app`` in a subprocess, driven through Playwright
 in Debian's Chromium. Used by the browser tests and by
 ``docs/generate/teaching_screenshots.py``; needs ``playwright`` (the ``test`` extra) and
-``/usr/bin/chromium`` (``apt-get install chromium``; Playwright's own browser download is
-not used).
+Chromium at ``$PDEFLOW_CHROMIUM``, by default ``/usr/bin/chromium`` (``apt-get install
+chromium``; Playwright's own browser download is not used). Test support, outside the
+package (scripts import it as ``tests.browser`` with the checkout on ``sys.path``).
 """
 
 from __future__ import annotations
@@ -21,7 +22,8 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import urlparse
 
-CHROMIUM = "/usr/bin/chromium"
+CHROMIUM = os.environ.get("PDEFLOW_CHROMIUM", "/usr/bin/chromium")
+"""the Chromium executable: ``$PDEFLOW_CHROMIUM``, by default Debian's"""
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
                  "--no-first-run", "--disable-background-networking",
                  "--disable-component-update", "--disable-sync"]

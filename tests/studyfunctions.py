@@ -1,5 +1,6 @@
 """Functions with known answers, to check the study pipeline end to end
-(``function = "pdeflow.study.testfunctions:ishigami"`` in a study file)."""
+(``function = "tests.studyfunctions:ishigami"`` in a study file, with the checkout on
+``sys.path``). Test support, outside the package."""
 
 from __future__ import annotations
 

@@ -1,0 +1,35 @@
+"""What a case file may hold (the sections, keys and types of :class:`pdeflow.cases.Case`)
+and the error a bad one raises: below both the case and its validation
+(:mod:`pdeflow.case_validation`), which read them."""
+
+from __future__ import annotations
+
+FRAMES = ("interpolate", "step")
+"""output.frames choices (see :attr:`Case.frames`)"""
+SERIES = ("auto", "on", "off")
+"""output.erosion_series choices (see :attr:`Case.erosion_series`)"""
+SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
+    "case": {"name": (str,), "description": (str,), "t_end": (float, int),
+             "models": (list,)},
+    "grid": {"length": (float, int), "dx": (float, int), "cells": (int,),
+             "x_start": (float, int), "geometry": (str,)},
+    "boundaries": {"left": (str,), "right": (str,)},
+    "initial": {"shape": (str,), "L0": (float, int), "H0": (float, int),
+                "wedge_angle_deg": (float, int), "x_dam": (float, int),
+                "h_left": (float, int), "h_right": (float, int),
+                "upper_fraction": (float, int), "center": (float, int),
+                "height": (float, int), "slope_deg": (float, int), "path": (str,),
+                "bed_thickness": (float, int), "bed_length": (float, int)},
+    "numerics": {"solver": (str,), "cfl": (float, int), "dt": (float, int),
+                 "flux": (str,), "reconstruction": (str,), "limiter": (str,),
+                 "splitting": (str,)},
+    "output": {"snapshot_times": (list,), "front_threshold": (float, int),
+               "runout_mass_fraction": (float, int), "frames": (str,),
+               "erosion_series": (str,), "series_every": (float, int)},
+    "sweep": {"aspect_ratios": (list,)},
+}
+
+
+
+class CaseError(ValueError):
+    """An invalid case file or override; the message names the key and the file."""

@@ -1,0 +1,12 @@
+"""Checks of command-line options that several commands share (:mod:`pdeflow.cli`,
+:mod:`pdeflow.cli_stored`): below both, so that neither imports the other's."""
+
+from __future__ import annotations
+
+from .case_schema import CaseError
+
+
+def positive(name: str, value: float | None) -> None:
+    """CaseError (one line naming the option ``name``) unless ``value`` is None or > 0."""
+    if value is not None and not value > 0:
+        raise CaseError(f"{name} must be > 0, got {value!r}")
