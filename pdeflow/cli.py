@@ -187,7 +187,8 @@ def _run_and_write(args: argparse.Namespace, case: Any, outputs: Any, figures: A
     :class:`~pdeflow.figure_worker.RunFigures` (None: no figures)."""
     from .interrupts import received
     from .numerics.warmup import COLD, prepare, status
-    from .simulate import case_steppers, print_summary
+    from .simulate import case_steppers
+    from .summary_table import print_summary
 
     steppers = case_steppers(case)
     meanwhile = None

@@ -40,7 +40,8 @@ from pdeflow.models.two_layer.hyperbolicity import (  # noqa: E402
     lower_bound_fl,
     upper_bound_fr,
 )
-from pdeflow.simulate import print_summary, run_model  # noqa: E402
+from pdeflow.simulate import run_model  # noqa: E402
+from pdeflow.summary_table import print_summary  # noqa: E402
 
 from .helpers import cli_warnings, skip_or_fail_in_ci  # noqa: E402
 

@@ -102,7 +102,7 @@ def _api_rows(case_file: Path, overrides: list[str]) -> list[str]:
     """The rows of ``pdeflow run``'s table from the Python API (wall times left out)."""
     import io
 
-    from pdeflow.simulate import print_summary
+    from pdeflow.summary_table import print_summary
 
     case = load_case(case_file, overrides)
     out = io.StringIO()

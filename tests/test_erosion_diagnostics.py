@@ -12,7 +12,8 @@ import pytest
 
 from pdeflow import erosion as E
 from pdeflow.cases import CaseError, load_case
-from pdeflow.simulate import print_summary, run_model
+from pdeflow.simulate import run_model
+from pdeflow.summary_table import print_summary
 
 ROOT = Path(__file__).parents[1]
 CASE = ROOT / "cases" / "erodible_bed.toml"

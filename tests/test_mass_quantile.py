@@ -157,7 +157,8 @@ def test_summaries_and_the_table_carry_it(tmp_path):
     # within the material, and the run-out is the front minus L0 (same arithmetic: 1e-12)
     import io
 
-    from pdeflow.simulate import print_summary, run_model
+    from pdeflow.simulate import run_model
+    from pdeflow.summary_table import print_summary
 
     sets = ["grid.dx=0.1", "output.snapshot_times=[]"]
     for geometry in ("planar", "axisymmetric"):

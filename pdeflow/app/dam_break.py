@@ -33,8 +33,9 @@ from ..checks import run_warnings
 from ..numerics.geometry import COORDINATES
 from ..numerics.state import velocity_profile
 from ..plotting import DRY
-from ..simulate import Run, RunResult, print_summary, run_model
+from ..simulate import Run, RunResult, run_model
 from ..solvers.fv_split import SimulationBlowUp
+from ..summary_table import print_summary
 from ..trackers import FextraStorageTracker
 from .controls import ParameterControls, command_line, list_cases, served
 from .look import PageLayout, fit_height, legend_outside, style_figures

@@ -1,0 +1,76 @@
+"""The short table of a run's results that ``pdeflow run`` prints and the app shows: one
+column per model, one row per summary number the models have
+(:func:`pdeflow.simulate.summarize`), with units."""
+
+from __future__ import annotations
+
+import sys
+from typing import Any
+
+from .checks import mass_through_ends
+
+
+def _fmt(v: Any, unit: str = "") -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, float):
+        return f"{v:.4g}{unit}"
+    return f"{v}{unit}"
+
+
+def print_summary(summary: dict[str, Any], out: Any = None) -> None:
+    """A short human-readable table of the per-model results."""
+    out = out or sys.stdout
+    rows = [("stop time", "stop_time", " s"), ("lower stop", "lower_stop_time", " s"),
+            ("upper stop", "upper_stop_time", " s"), ("front", "front_position", " m"),
+            ("run-out", "runout", " m"),
+            ("front {q} mass", "front_mass_quantile", " m"),
+            ("run-out {q} mass", "runout_mass_quantile", " m"),
+            ("max F_extra/rho1", "max_fextra_over_rho1", " m2/s2"),
+            ("flow duration", "flow_duration", " s"),
+            ("front speed max", "front_velocity_max", " m/s"),
+            ("bed eroded", "bed_eroded_volume", " m2"),
+            ("bed eroded max", "bed_eroded_volume_max", " m2"),
+            ("bed deposited", "bed_deposited_volume", " m2"),
+            ("erosion depth", "bed_max_erosion_depth", " m"),
+            ("  at x", "bed_max_erosion_x", " m"), ("  at t", "bed_max_erosion_time", " s"),
+            ("bed moving max", "bed_moving_volume_max", " m2"),
+            ("mass error", "mass_relative_error", ""),
+            ("mass outflow", "mass_outflow", ""), ("steps", "steps", ""),
+            ("wall time", "wall_time_s", " s")]
+    models = summary["models"]
+    if any(s.get("geometry") == "axisymmetric" for s in models.values()):
+        # the front and the run-out are radii: R_f and R_f - R0
+        rows = [("front radius" if k == "front_position" else
+                 "radius {q} mass" if k == "front_mass_quantile" else label, k, u)
+                for label, k, u in rows]
+    # the fraction of the mass-quantile rows, e.g. '99%' (the case's, one for all models)
+    q = next((s["runout_mass_fraction"] for s in models.values()
+              if s.get("runout_mass_fraction") is not None), None)
+    rows = [(label.format(q=f"{100 * q:.4g}%" if q else ""), k, u) for label, k, u in rows]
+    # rows no model of the run has (a single-layer case: no lower/upper stop)
+    rows = [row for row in rows if any(row[1] in s for s in models.values())
+            or (row[1] == "mass_outflow" and any(mass_through_ends(s) is not None
+                                                 for s in models.values()))]
+    print(f"case {summary['case']}", file=out)
+    print(f"{'':18}" + "".join(f"{m:>16}" for m in models), file=out)
+    for label, key, unit in rows:
+        print(f"{label:18}" + "".join(f"{_cell(models[m], key, unit):>16}"
+                                      for m in models), file=out)
+
+
+def _cell(model_summary: dict[str, Any], key: str, unit: str) -> str:
+    """A table cell; a front or run-out cut off by the end of the domain reads '>= ...';
+    where mass left or entered through an open end, its share is the 'mass outflow'
+    [%] and the 'mass error' (then no conservation error) is '-'."""
+    through = mass_through_ends(model_summary)
+    if key in ("mass_relative_error", "mass_outflow"):
+        if (through is None) == (key == "mass_outflow"):
+            return "-"
+        if through is not None:
+            return f"{100 * through:.4g} %"
+    text = _fmt(model_summary.get(key), unit)
+    if key in ("front_position", "runout", "front_mass_quantile", "runout_mass_quantile") \
+            and model_summary.get("runout_lower_bound"):
+        return ">= " + text
+    return text
