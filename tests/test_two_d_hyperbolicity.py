@@ -63,6 +63,15 @@ def random_states(count: int, seed: int) -> list[State]:
     return states
 
 
+def banded_states(count: int, seed: int):
+    """:func:`random_states` that have a non-hyperbolic band, each with its edges
+    (F_c1, F_c2) [m/s] appended."""
+    for h1, u1, h2, u2, r in random_states(count, seed):
+        edges = band_edges(h1, h2, G, r)
+        if edges is not None:
+            yield h1, u1, h2, u2, r, *edges
+
+
 def hyperbolic_in(h1: float, u1: np.ndarray, h2: float, u2: np.ndarray, r: float,
                   n: np.ndarray) -> bool:
     """The 1D system along n (normal velocities) has four real roots: pdeflow's
@@ -90,11 +99,7 @@ def test_hyperbolic_in_a_direction_iff_the_normal_shear_is_outside_the_band():
     """Whether direction n is hyperbolic depends on |du . n| alone: inside the 1D band
     (F_c1, F_c2) the quartic has a complex pair, outside it has not."""
     checked = 0
-    for h1, u1, h2, u2, r in random_states(200, 3):
-        edges = band_edges(h1, h2, G, r)
-        if edges is None:
-            continue
-        lo, hi = edges
+    for h1, u1, h2, u2, r, lo, hi in banded_states(200, 3):
         for n in directions():
             dun = abs(float((u1 - u2) @ n))
             if min(abs(dun - lo), abs(dun - hi)) < 1e-6 * lo:
@@ -121,11 +126,10 @@ def test_restoring_along_du_to_the_lower_band_edge_makes_every_direction_hyperbo
     hair below: the kernels aim at the edge from the hyperbolic side), is hyperbolic in
     all 64 directions, and its total momentum is unchanged."""
     restored_count = 0
-    for h1, u1, h2, u2, r in random_states(300, 4):
-        edges = band_edges(h1, h2, G, r)
-        if edges is None or np.linalg.norm(u1 - u2) <= edges[0]:
+    for h1, u1, h2, u2, r, lo, _ in banded_states(300, 4):
+        if np.linalg.norm(u1 - u2) <= lo:
             continue
-        v1, v2 = restored(h1, u1, h2, u2, r, edges[0] * (1.0 - 1e-9))
+        v1, v2 = restored(h1, u1, h2, u2, r, lo * (1.0 - 1e-9))
         np.testing.assert_allclose(r * h1 * v1 + h2 * v2, r * h1 * u1 + h2 * u2,
                                    rtol=1e-12, atol=1e-12 * np.sqrt(G * (h1 + h2)) * (h1 + h2))
         (a, b), (c, d) = v1 - v2, u1 - u2
@@ -140,11 +144,7 @@ def test_a_state_above_the_band_is_hyperbolic_along_du_but_not_in_every_directio
     inside the band are not hyperbolic. So the 2D restoration must bring every |du| >
     F_c1 down to F_c1, not only those inside the band."""
     found = 0
-    for h1, u1, h2, u2, r in random_states(300, 5):
-        edges = band_edges(h1, h2, G, r)
-        if edges is None:
-            continue
-        lo, hi = edges
+    for h1, u1, h2, u2, r, _, hi in banded_states(300, 5):
         du = u1 - u2
         if np.linalg.norm(du) <= hi * (1.0 + 1e-6):
             continue
