@@ -56,27 +56,41 @@ STATUS_FAIL = 2  #: non-finite or negative state: the step was undone
 MAX_RETRIES = 30  #: halvings of dt tried on a step that left a depth negative
 
 
-@cached(inline="always")
-def update(q, base, rate, dt, weight, lo, hi):
-    """q <- weight * base + (1 - weight) * (q + dt * rate) in cells ``lo..hi``; returns
-    (max |mass rate|, ok).
+def update_function(width: int) -> Any:
+    """The state update of a model with ``width`` rows per layer (depth first) as a
+    Python closure: ``update(q, base, rate, dt, weight, lo, hi)``, see :func:`update`."""
 
-    ``ok`` is False if the result is not finite or a depth is negative beyond round-off
-    (round-off below zero is clipped by the source stage).
-    """
-    mass_rate = 0.0
-    ok = True
-    for k in range(q.shape[0]):
-        for i in range(lo, hi + 1):
-            v = weight * base[k, i] + (1.0 - weight) * (q[k, i] + dt * rate[k, i])
-            if k % 2 == 0:
-                mass_rate = max(mass_rate, abs(rate[k, i]))
-                if v < -1e-12 * (1.0 + abs(q[k, i])):
+    def update(q, base, rate, dt, weight, lo, hi):
+        """q <- weight * base + (1 - weight) * (q + dt * rate) in cells ``lo..hi``;
+        returns (max |mass rate|, ok).
+
+        ``ok`` is False if the result is not finite or a depth is negative beyond
+        round-off (round-off below zero is clipped by the source stage).
+        """
+        mass_rate = 0.0
+        ok = True
+        for k in range(q.shape[0]):
+            for i in range(lo, hi + 1):
+                v = weight * base[k, i] + (1.0 - weight) * (q[k, i] + dt * rate[k, i])
+                if k % width == 0:
+                    mass_rate = max(mass_rate, abs(rate[k, i]))
+                    if v < -1e-12 * (1.0 + abs(q[k, i])):
+                        ok = False
+                if not math.isfinite(v):
                     ok = False
-            if not math.isfinite(v):
-                ok = False
-            q[k, i] = v
-    return mass_rate, ok
+                q[k, i] = v
+        return mass_rate, ok
+
+    return update
+
+
+update = cached(inline="always")(update_function(2))
+"""the state update of the one-axis models (two rows per layer)"""
+
+
+def update_kernel(width: int) -> Any:
+    """The compiled state update for ``width`` rows per layer (:data:`update` for 2)."""
+    return update if width == 2 else njit(inline="always")(update_function(width))
 
 
 @cached(inline="always")
@@ -95,7 +109,16 @@ def _copy_range(dst, src, lo, hi):
         dst[i] = src[i]
 
 
-def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
+@cached(inline="always")
+def speed_scale(metric: np.ndarray, dx: float) -> float:
+    """On a 2D grid, max over axes of (dx / dx_a) times 2: what the advection stage
+    scales a face's wave speed by (:func:`pdeflow.numerics.advection.advection_kernel`),
+    for the speeds and accelerations the stepping loop adds to it."""
+    return max(dx / metric[L.M_AXES, 2], dx / metric[L.M_AXES, 5]) * 2.0
+
+
+def advect_step_function(order: int, strang: bool, update: Any = None, width: int = 2,
+                         two_d: bool = False) -> Any:
     """The advection stage of one step of the stepping loop, with Strang the first half
     source step before it, as a Python closure (compiled inside :func:`stepping_kernel`;
     the blow-up diagnosis runs it in Python with an instrumented ``update``):
@@ -112,9 +135,11 @@ def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
 
     Returns ``(dt, mass_rate, ok, a_lo, a_hi, changed)``: the step [s], the largest mass
     rate, whether the state is finite and non-negative, the cells the update touched and
-    whether the half source step changed anything.
+    whether the half source step changed anything. ``width``: the model's rows per
+    layer; ``two_d``: a 2D grid (the wave speeds are scaled, :func:`speed_scale`).
     """
     muscl = order == 2
+    update = update or update_kernel(width)
 
     def advect_step(advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
                     P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep,
@@ -129,7 +154,7 @@ def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
         if strang:
             # the first half source step may accelerate a layer by up to dt/2 |g_x|
             # (friction only brakes): choose dt with dt (smax + dt |g_x| / 2) = cfl dx
-            gx = abs(P[L.G_X])
+            gx = abs(P[L.G_X]) * speed_scale(metric, dx) if two_d else abs(P[L.G_X])
             den = smax + math.sqrt(smax * smax + 2.0 * gx * cfl * dx)
             if den > 0.0:
                 dt = min(dt, 2.0 * cfl * dx / den)
@@ -185,15 +210,27 @@ def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
     return advect_step
 
 
-def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int) -> Any:
+def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
+                      width: int = 2, two_d: bool = False) -> Any:
     """The stepping loop as a Python closure (compiled by :func:`stepping_kernel`, which
     documents it); ``advect_step`` is :func:`advect_step_function`, ``reach`` that of
-    its reconstruction order (:func:`pdeflow.numerics.resting.reach`)."""
+    its reconstruction order (:func:`pdeflow.numerics.resting.reach`), ``width`` the
+    model's rows per layer, ``two_d`` a 2D grid.
+
+    Windows of cells are ranges of the flattened cell index: on a 2D grid a window
+    widened by ``reach`` strides of the first axis (the largest) holds every cell within
+    ``reach`` of its cells along either axis, a conservative over-approximation of the
+    stencil (it also holds the rest of those rows); on a 1D grid the stride is 1.
+    """
 
     def advance(q, t, t_pause, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag,
                 rate, backup, diag_backup, work, prev, max_steps, stop_at_rest, advect, sources,
                 predictor, fallback):
         n = q.shape[1]
+        # a line of the last axis, and the largest stride in the cell index
+        line = int(metric[L.M_AXES, 4]) if two_d else n
+        stride = int(metric[L.M_AXES, 0]) if two_d else 1
+        scale = speed_scale(metric, dx) if two_d else 1.0
         steps = 0
         rec = work[:2]
         q0 = work[2]
@@ -225,21 +262,23 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int) ->
                 b_lo = 1
                 b_hi = 0
             else:
-                b_lo = max(v_lo - reach, 0)
-                b_hi = min(v_hi + reach, n - 1)
+                b_lo = max(v_lo - reach * stride, 0)
+                b_hi = min(v_hi + reach * stride, n - 1)
             if b_lo <= b_hi:
-                e_lo = max(b_lo - 1, 0)
-                e_hi = min(b_hi + 1, n - 1)
+                e_lo = max(b_lo - stride, 0)
+                e_hi = min(b_hi + stride, n - 1)
             else:
                 e_lo = n  # nothing is evaluated: every cell is at rest or dry
                 e_hi = n - 1
             s_rest = 0.0
             if e_lo > 0:
-                p_ok = extend_prefix(pre, q, p_ok, e_lo, g, dry)
+                p_ok = extend_prefix(pre, q, p_ok, e_lo, g, dry, width, line)
                 s_rest = pre[e_lo - 1]
             if e_hi < n - 1:
-                s_ok = extend_suffix(suf, q, s_ok, e_hi + 1, g, dry)
+                s_ok = extend_suffix(suf, q, s_ok, e_hi + 1, g, dry, width, line)
                 s_rest = max(s_rest, suf[e_hi + 1])
+            if two_d:
+                s_rest *= scale
             _copy_cells(backup, q, b_lo, b_hi)
             if strang or ifcp:
                 _copy_range(diag_keep, diag, 0, L.N_DIAG - 1)
@@ -297,7 +336,7 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int) ->
             s_lo = a_lo
             s_hi = a_hi
             if b_lo <= b_hi:
-                v_lo, v_hi = live_cells(q, backup, b_lo, b_hi)
+                v_lo, v_hi = live_cells(q, backup, b_lo, b_hi, width)
                 p_ok = min(p_ok, b_lo)
                 s_ok = max(s_ok, b_hi + 1)
             diag[L.D_LIVE_LO] = v_lo
@@ -327,7 +366,8 @@ PREDICTOR = types.FunctionType(types.none(STATE, f8, PARAMS, i8, i8))
 
 
 @functools.cache
-def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
+def stepping_kernel(order: int, strang: bool, ifcp: bool, width: int = 2,
+                    two_d: bool = False) -> Any:
     """The ``fv-split`` stepping loop for one reconstruction order, splitting and flux
     fallback, for any model (compiled on first use, see
     :func:`pdeflow.numerics.compiled.ready`): advance ``q`` from ``t`` to ``t_end`` with
@@ -364,8 +404,9 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
     :data:`STATUS_FAIL` (the last step produced a non-finite or negative state and was
     undone; ``q`` holds the last good state).
     """
-    step = njit(inline="always")(advect_step_function(order, strang))
-    return specialise(stepping_function(ifcp, strang, step, reach_of(order)), STATE, f8, f8, f8, f8,
+    step = njit(inline="always")(advect_step_function(order, strang, None, width, two_d))
+    loop = stepping_function(ifcp, strang, step, reach_of(order), width, two_d)
+    return specialise(loop, STATE, f8, f8, f8, f8,
                       METRIC, i8, i8, PARAMS, f8, f8, f8, f8, VECTOR, FIELDS, FIELDS, VECTOR,
                       WORK, FIELDS, i8, flag,
                       ADVECT, SOURCES, PREDICTOR if order == 2 else types.none,
@@ -382,7 +423,8 @@ class Stepper:
                  strang: bool, geometry: int):
         self.model = model
         self.ifcp = flux == L.FLUX_IFCP
-        self.loop = stepping_kernel(order, strang, self.ifcp)
+        self.two_d = geometry == L.GEOMETRY_PLANAR_2D
+        self.loop = stepping_kernel(order, strang, self.ifcp, model.layer_rows, self.two_d)
         self.advect = advection_kernel(model, flux, order, limiter, geometry)
         self.sources = model.sources
         self.predictor = model.predictor if order == 2 else None
@@ -441,6 +483,8 @@ def python_stepping(model: ModelKernels, flux: int, order: int, limiter: int,
     kernels, with ``update`` for :func:`update` (the blow-up diagnosis replays a step
     with an update that records what it wrote); called as the stepper."""
     compiled = scheme_stepper(model, flux, order, limiter, strang, geometry).ready()
+    width = model.layer_rows
     loop = stepping_function(compiled.ifcp, strang,
-                             advect_step_function(order, strang, update), reach_of(order))
+                             advect_step_function(order, strang, update, width, compiled.two_d),
+                             reach_of(order), width, compiled.two_d)
     return functools.partial(compiled.run, loop)
