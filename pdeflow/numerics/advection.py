@@ -22,10 +22,10 @@ The model gives each face's states in the face's normal frame and the rows its
 fluctuations go back into (:class:`~pdeflow.numerics.model_kernels.ModelKernels`); MUSCL
 reconstructs along each axis in turn. Boundaries use one ghost cell per side: a wall
 mirrors the state (h -> h, normal momentum -> -normal momentum), an open (transmissive)
-boundary copies it. Only faces next to a wet cell are visited: a face
-between two cells that are dry in every layer carries no fluctuation, so the loops run
-over the wet cells of the window they are given (the stepping loop narrows it further to
-the cells a step can change, :mod:`pdeflow.numerics.resting`).
+boundary copies it. Only faces next to a wet cell are visited: a face between two cells
+that are dry in every layer carries no mass, so the loops run, line by line, over the
+wet cells of the window they are given (the stepping loop narrows it further to the
+cells a step can change, :mod:`pdeflow.numerics.resting`).
 
 :func:`advection_kernel` builds this stage for one model, flux, reconstruction and
 limiter (nothing of the others is compiled); :func:`rate_kernel` is the same on the
@@ -273,6 +273,15 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
     return along
 
 
+@cached(inline="always")
+def _axis(metric: np.ndarray, a: int, dx: float) -> tuple[int, int, float, float]:
+    """Axis ``a`` of a 2D grid: its stride, its cells, 1 / its width [1/m] and what its
+    faces' speeds are scaled by, (dx / width) 2 (see :func:`advection_kernel`)."""
+    width = metric[L.M_AXES, 3 * a + 2]
+    return (int(metric[L.M_AXES, 3 * a]), int(metric[L.M_AXES, 3 * a + 1]), 1.0 / width,
+            dx / width * 2.0)
+
+
 ADVECT_SIGNATURE = (STATE, FIELDS, WORK, f8, METRIC, i8, i8, f8, f8, f8, i8, i8)
 
 
@@ -342,21 +351,13 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
             elif axisymmetric:
                 area_change(q, q, rate, r_lo, r_hi, metric, dry, width)
             return smax, r_lo, r_hi
-        smax = 0.0
-        for a in range(2):
-            stride = int(metric[L.M_AXES, 3 * a])
-            count = int(metric[L.M_AXES, 3 * a + 1])
-            width_a = metric[L.M_AXES, 3 * a + 2]
-            code_lo = (bc_left >> a) & 1
-            code_hi = (bc_right >> a) & 1
-            if a == 0:
-                s = along_x(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count,
-                            1.0 / width_a, code_lo, code_hi, g, r, dry)
-            else:
-                s = along_y(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count,
-                            1.0 / width_a, code_lo, code_hi, g, r, dry)
-            smax = max(smax, s * (dx / width_a) * 2.0)
-        return smax, r_lo, r_hi
+        stride, count, inv_width, scale = _axis(metric, 0, dx)
+        smax = scale * along_x(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count,
+                               inv_width, bc_left & 1, bc_right & 1, g, r, dry)
+        stride, count, inv_width, scale = _axis(metric, 1, dx)
+        s = scale * along_y(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count,
+                            inv_width, (bc_left >> 1) & 1, (bc_right >> 1) & 1, g, r, dry)
+        return max(smax, s), r_lo, r_hi
 
     return specialise(advect, *ADVECT_SIGNATURE)
 

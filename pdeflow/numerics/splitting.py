@@ -10,8 +10,8 @@ One step of length dt (Lie splitting, as in the paper):
 With MUSCL the advection is integrated with SSP-RK2 (Heun); with Strang splitting half
 a source step is applied before and after it.
 
-The loop is compiled once per reconstruction order, splitting and IFCP fallback
-(:func:`stepping_kernel`) and takes the model's kernels as arguments: its advection
+The loop is compiled once per reconstruction order, splitting, IFCP fallback, rows per
+layer of the model's state and number of the grid's axes (:func:`stepping_kernel`) and takes the model's kernels as arguments: its advection
 stage (:func:`pdeflow.numerics.advection.advection_kernel`, one per model, flux,
 reconstruction and limiter), source stage and MUSCL predictor, called once or twice per
 step through a function pointer. :func:`scheme_stepper` puts the two together for one
@@ -213,8 +213,8 @@ PREDICTOR = types.FunctionType(types.none(STATE, f8, PARAMS, i8, i8))
 @functools.cache
 def stepping_kernel(order: int, strang: bool, ifcp: bool, width: int = 2,
                     two_d: bool = False) -> Any:
-    """The ``fv-split`` stepping loop for one reconstruction order, splitting and flux
-    fallback, for any model (compiled on first use, see
+    """The ``fv-split`` stepping loop for one reconstruction order, splitting, flux
+    fallback, ``width`` rows per layer and a 1D or (``two_d``) 2D grid, for any model (compiled on first use, see
     :func:`pdeflow.numerics.compiled.ready`): advance ``q`` from ``t`` to ``t_end`` with
     the CFL-limited splitting scheme,
 
