@@ -11,10 +11,11 @@ With MUSCL the advection is integrated with SSP-RK2 (Heun); with Strang splittin
 a source step is applied before and after it.
 
 The loop is compiled once per reconstruction order, splitting, IFCP fallback, rows per
-layer of the model's state and number of the grid's axes (:func:`stepping_kernel`) and takes the model's kernels as arguments: its advection
-stage (:func:`pdeflow.numerics.advection.advection_kernel`, one per model, flux,
-reconstruction and limiter), source stage and MUSCL predictor, called once or twice per
-step through a function pointer. :func:`scheme_stepper` puts the two together for one
+layer of the model's state and number of the grid's axes (:func:`stepping_kernel`) and
+takes the model's kernels as arguments: its advection stage
+(:func:`pdeflow.numerics.advection.advection_kernel`, one per model, flux, reconstruction
+and limiter), source stage and MUSCL predictor, called once or twice per step through a
+function pointer. :func:`scheme_stepper` puts the two together for one
 scheme. Everything is cached on disk; all parameters are arrays and the grid an
 argument, so that sweeps never recompile.
 """
@@ -214,9 +215,9 @@ PREDICTOR = types.FunctionType(types.none(STATE, f8, PARAMS, i8, i8))
 def stepping_kernel(order: int, strang: bool, ifcp: bool, width: int = 2,
                     two_d: bool = False) -> Any:
     """The ``fv-split`` stepping loop for one reconstruction order, splitting, flux
-    fallback, ``width`` rows per layer and a 1D or (``two_d``) 2D grid, for any model (compiled on first use, see
-    :func:`pdeflow.numerics.compiled.ready`): advance ``q`` from ``t`` to ``t_end`` with
-    the CFL-limited splitting scheme,
+    fallback, ``width`` rows per layer and a 1D or (``two_d``) 2D grid, for any model
+    (compiled on first use, see :func:`pdeflow.numerics.compiled.ready`): advance ``q``
+    from ``t`` to ``t_end`` with the CFL-limited splitting scheme,
 
     ``advance(q, t, t_pause, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl,
     diag, rate, backup, diag_backup, work, prev, max_steps, stop_at_rest, advect, sources,
