@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from pdeflow.cases import load_case
-from pdeflow.numerics import splitting
+from pdeflow.numerics import advect_step, splitting
 from pdeflow.simulate import run_model
 from pdeflow.solvers import fv_split
 
@@ -27,7 +27,7 @@ def _python_loop(monkeypatch, reach: int | None, calls: list | None = None) -> N
     def update(q, base, rate, dt, weight, lo, hi):
         if calls is not None:
             calls.append((lo, hi))
-        return splitting.update(q, base, rate, dt, weight, lo, hi)
+        return advect_step.update(q, base, rate, dt, weight, lo, hi)
 
     monkeypatch.setattr(fv_split, "scheme_stepper",
                         lambda *scheme: splitting.python_stepping(*scheme, update))

@@ -1,4 +1,4 @@
-r"""Finite-volume advection rates (stage (29)) on a uniform 1D grid.
+r"""Finite-volume advection rates (stage (29)): one face loop over every axis of the grid.
 
 First order: the rate of cell i is -(D^+_{i-1/2} + D^-_{i+1/2}) / dx with the face
 fluctuations of :mod:`pdeflow.numerics.pvm` between the cell averages.
@@ -14,11 +14,18 @@ A(q_i^-, q_i^+) = f(q_i^+) - f(q_i^-) + B(q_i^-, q_i^+) is the path-conservative
 across the reconstruction inside the cell (Castro & Pares). Limited slopes of h keep the
 face depths between neighbouring averages, hence non-negative.
 
-Boundaries use one ghost cell: a wall mirrors the state (h -> h, hu -> -hu), an open
-(transmissive) boundary copies it. Only faces next to a wet cell are visited: a face
-between two cells that are dry in every layer carries no fluctuation, so the loops run
-over the wet cells of the window they are given (the stepping loop narrows it further to
-the cells a step can change, :mod:`pdeflow.numerics.resting`).
+The cells of any grid are flattened (``q[field, cell]``, :mod:`pdeflow.numerics.geometry`)
+and each axis is a stride in that index: the stage loops, axis by axis, over the faces
+of that axis next to the cells of its window, interior faces first, then the two
+boundary sides (a 1D grid is the one axis of stride 1, the arithmetic of the 1D scheme).
+The model gives each face's states in the face's normal frame and the rows its
+fluctuations go back into (:class:`~pdeflow.numerics.model_kernels.ModelKernels`); MUSCL
+reconstructs along each axis in turn. Boundaries use one ghost cell per side: a wall
+mirrors the state (h -> h, normal momentum -> -normal momentum), an open (transmissive)
+boundary copies it. Only faces next to a wet cell are visited: a face between two cells
+that are dry in every layer carries no mass, so the loops run, line by line, over the
+wet cells of the window they are given (the stepping loop narrows it further to the
+cells a step can change, :mod:`pdeflow.numerics.resting`).
 
 :func:`advection_kernel` builds this stage for one model, flux, reconstruction and
 limiter (nothing of the others is compiled); :func:`rate_kernel` is the same on the
@@ -31,6 +38,7 @@ import functools
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from . import layout as L
 from .compiled import FIELDS, METRIC, STATE, WORK, cached, f8, i8, kernel, specialise
@@ -39,24 +47,25 @@ from .state import velocity
 
 
 @cached
-def _is_wet(q: np.ndarray, i: int, dry: float) -> bool:
-    for k in range(0, q.shape[0], 2):
+def _is_wet(q: np.ndarray, i: int, dry: float, width: int) -> bool:
+    for k in range(0, q.shape[0], width):
         if q[k, i] > dry:
             return True
     return False
 
 
-@kernel(STATE, f8, i8, i8)
-def wet_cells(q: np.ndarray, dry: float, start: int, stop: int) -> tuple[int, int]:
-    """First and last index in ``start..stop`` of a cell where some layer's depth
-    (rows 0, 2, ... of ``q``) exceeds ``dry``; ``(1, 0)`` if there is none."""
+@kernel(STATE, f8, i8, i8, i8)
+def wet_cells(q: np.ndarray, dry: float, start: int, stop: int,
+              width: int) -> tuple[int, int]:
+    """First and last index in ``start..stop`` of a cell where some layer's depth (rows
+    0, ``width``, 2 ``width``, ... of ``q``) exceeds ``dry``; ``(1, 0)`` if none."""
     lo = start
-    while lo <= stop and not _is_wet(q, lo, dry):
+    while lo <= stop and not _is_wet(q, lo, dry, width):
         lo += 1
     if lo > stop:
         return 1, 0
     hi = stop
-    while hi > lo and not _is_wet(q, hi, dry):
+    while hi > lo and not _is_wet(q, hi, dry, width):
         hi -= 1
     return lo, hi
 
@@ -73,54 +82,210 @@ def _limited(a: float, b: float, limiter: int) -> float:
     return s * min(a, b)
 
 
-@kernel(STATE, WORK, i8, i8, i8, i8, f8, i8)
-def reconstruct_muscl(q: np.ndarray, work: np.ndarray, lo: int, hi: int, bc_left: int,
-                      bc_right: int, dry: float, limiter: int) -> None:
-    """Face values of cells lo..hi into work[0] (left face) and work[1] (right face):
-    (h, u) of each layer reconstructed linearly with limited slopes (ghost neighbours
-    from the boundary conditions)."""
-    n = q.shape[1]
-    nf = q.shape[0]
-    for i in range(lo, hi + 1):
-        for k in range(0, nf, 2):
-            h = q[k, i]
-            m = q[k + 1, i]
-            u = velocity(h, m, dry)
-            if i > 0:
-                hl = q[k, i - 1]
-                ul = velocity(hl, q[k + 1, i - 1], dry)
-            else:
-                hl = h
-                ul = -u if bc_left == L.BC_WALL else u
-            if i < n - 1:
-                hr = q[k, i + 1]
-                ur = velocity(hr, q[k + 1, i + 1], dry)
-            else:
-                hr = h
-                ur = -u if bc_right == L.BC_WALL else u
-            if hl <= dry or hr <= dry:
-                # next to a dry cell (a front or a heap's edge): first order, so that the
-                # face depth weighting the hydrostatic jump is the cell's own depth
-                sh = 0.0
-                su = 0.0
-            elif m == 0.0 and q[k + 1, max(i - 1, 0)] == 0.0 and \
-                    q[k + 1, min(i + 1, n - 1)] == 0.0:
-                # at rest with its neighbours: first order as well. A limited slope of h
-                # can make the hydrostatic force at a kink of a heap steeper than any
-                # slope of the data, so that friction no longer holds a heap the
-                # first-order scheme keeps exactly at rest; nothing moves here to gain
-                # accuracy on
-                sh = 0.0
-                su = 0.0
-            else:
-                sh = _limited(h - hl, hr - h, limiter)
-                su = _limited(u - ul, ur - u, limiter)
-            hm = h - 0.5 * sh
-            hp = h + 0.5 * sh
-            work[0, k, i] = hm
-            work[1, k, i] = hp
-            work[0, k + 1, i] = hm * (u - 0.5 * su) if hm > dry else 0.0
-            work[1, k + 1, i] = hp * (u + 0.5 * su) if hp > dry else 0.0
+@functools.cache
+def reconstruction(width: int, normal: int) -> Any:
+    """MUSCL's face values along one axis for a model with ``width`` rows per layer whose
+    momentum normal to the axis' faces is row ``normal`` of a layer (compiled for these
+    constants: the loops over a layer's rows unroll):
+
+    ``reconstruct_muscl(q, work, lo, hi, stride, count, bc_lo, bc_hi, dry, limiter)``
+    writes the face values of cells lo..hi along the axis (``stride`` in the cell index,
+    ``count`` cells) into work[0] (the face on the low side) and work[1] (the high
+    side): each layer's depth and velocities linearly with limited slopes; ghost
+    neighbours from the boundary codes of the axis' sides (a wall mirrors the normal
+    velocity)."""
+
+    def reconstruct_muscl(q, work, lo, hi, stride, count, bc_lo, bc_hi, dry, limiter):
+        block = stride * count
+        c0 = (lo // block) * block
+        while c0 <= hi:
+            for i in range(max(c0, lo), min(c0 + block - 1, hi) + 1):
+                has_l = i - c0 >= stride
+                has_r = i - c0 < block - stride
+                il = i - stride if has_l else i
+                ir = i + stride if has_r else i
+                for k in range(0, q.shape[0], width):
+                    h = q[k, i]
+                    hl = q[k, il]
+                    hr = q[k, ir]
+                    # next to a dry cell (a front or a heap's edge): first order, so that
+                    # the face depth weighting the hydrostatic jump is the cell's own
+                    flat = hl <= dry or hr <= dry
+                    if not flat:
+                        # at rest with its neighbours: first order as well. A limited
+                        # slope of h can make the hydrostatic force at a kink of a heap
+                        # steeper than any slope of the data, so that friction no longer
+                        # holds a heap the first-order scheme keeps exactly at rest;
+                        # nothing moves here to gain accuracy on
+                        flat = True
+                        for j in range(k + 1, k + width):
+                            if q[j, i] != 0.0 or q[j, il] != 0.0 or q[j, ir] != 0.0:
+                                flat = False
+                    sh = 0.0 if flat else _limited(h - hl, hr - h, limiter)
+                    hm = h - 0.5 * sh
+                    hp = h + 0.5 * sh
+                    work[0, k, i] = hm
+                    work[1, k, i] = hp
+                    for j in range(k + 1, k + width):
+                        u = velocity(h, q[j, i], dry)
+                        mirror = -u if j == k + normal else u
+                        if has_l:
+                            ul = velocity(hl, q[j, il], dry)
+                        else:
+                            ul = mirror if bc_lo == L.BC_WALL else u
+                        if has_r:
+                            ur = velocity(hr, q[j, ir], dry)
+                        else:
+                            ur = mirror if bc_hi == L.BC_WALL else u
+                        su = 0.0 if flat else _limited(u - ul, ur - u, limiter)
+                        work[0, j, i] = hm * (u - 0.5 * su) if hm > dry else 0.0
+                        work[1, j, i] = hp * (u + 0.5 * su) if hp > dry else 0.0
+            c0 += block
+
+    return specialise(reconstruct_muscl, STATE, WORK, i8, i8, i8, i8, i8, i8, f8, i8,
+                      helper=True)
+
+
+@cached(inline="always")
+def line_wet(q: np.ndarray, dry: float, width: int, base: int, stride: int, k0: int,
+             k1: int) -> tuple[int, int]:
+    """First and last k in ``k0..k1`` whose cell ``base + k stride`` is wet (some depth,
+    rows 0, ``width``, ..., above ``dry``); ``(1, 0)`` if none: :func:`wet_cells` along
+    one line of an axis."""
+    klo = k0
+    while klo <= k1 and not _is_wet(q, base + klo * stride, dry, width):
+        klo += 1
+    if klo > k1:
+        return 1, 0
+    khi = k1
+    while khi > klo and not _is_wet(q, base + khi * stride, dry, width):
+        khi -= 1
+    return klo, khi
+
+
+def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, axis: int,
+                    axisymmetric: bool, lines: bool) -> Any:
+    """The faces of one axis as a Python closure (inlined into the advection stage):
+
+    ``faces(q, qm, qp, rate, metric, lo, hi, stride, count, inv_dx, s_lo, s_hi, g, r,
+    dry) -> smax`` subtracts the fluctuations of the axis' faces next to the wet cells
+    of ``lo..hi`` (``qp``: the face values on the cells' high sides, ``qm`` on their low
+    sides) from ``rate``, weighted ``inv_dx`` [1/m] (axisymmetric: the metric's rows),
+    in the rows ``rows`` (``width`` rows per layer); line by line of the axis
+    (``lines``; else the one line of a 1D grid, whose wet cells are ``lo..hi``), in each
+    the faces between and beside its wet cells as on a 1D grid: interior faces first,
+    then the low and the high boundary sides, whose ghost cells have their normal
+    momenta times ``s_lo``, ``s_hi`` (-1: wall, 1: open). Returns the largest wave speed [m/s].
+
+    A line's faces beyond its last wet cell are not visited, as on a 1D grid: a face
+    between sub-dry traces of depth is not exactly zero (its hydrostatic jump), so
+    visiting them would change the numbers of a line that a 1D run has."""
+    identity = rows == tuple(range(len(rows)))
+
+    @njit(inline="always")
+    def line(qm, qp, rate, metric, base, stride, count, klo, khi, inv_dx, s_lo, s_hi,
+             g, r, dry):
+        w_l = inv_dx  # weights of a face's fluctuations in the cells on either side
+        w_r = inv_dx
+        smax = 0.0
+        for k in range(max(klo, 1), min(khi + 1, count - 1) + 1):
+            i = base + k * stride  # the face between cells i - stride and i
+            dm, dp, s = fluct(face(qp, i - stride, axis, 1.0), face(qm, i, axis, 1.0),
+                              g, r, dry)
+            smax = max(smax, s)
+            if axisymmetric:
+                w_l = metric[L.M_LEFT, i]
+                w_r = metric[L.M_RIGHT, i]
+            for j in range(len(rows)):
+                row = j if identity else rows[j]
+                rate[row, i - stride] -= dm[j] * w_l
+                rate[row, i] -= dp[j] * w_r
+        if klo == 0:
+            i = base
+            dm, dp, s = fluct(face(qm, i, axis, s_lo), face(qm, i, axis, 1.0), g, r, dry)
+            smax = max(smax, s)
+            if axisymmetric:
+                w_r = metric[L.M_RIGHT, i]
+            for j in range(len(rows)):
+                rate[j if identity else rows[j], i] -= dp[j] * w_r
+        if khi == count - 1:
+            i = base + (count - 1) * stride
+            dm, dp, s = fluct(face(qp, i, axis, 1.0), face(qp, i, axis, s_hi), g, r, dry)
+            smax = max(smax, s)
+            if axisymmetric:
+                w_l = metric[L.M_LEFT, i + 1]
+            for j in range(len(rows)):
+                rate[j if identity else rows[j], i] -= dm[j] * w_l
+        return smax
+
+    def faces(q, qm, qp, rate, metric, lo, hi, stride, count, inv_dx, s_lo, s_hi, g, r,
+              dry):
+        if not lines:
+            return line(qm, qp, rate, metric, 0, 1, count, lo, hi, inv_dx, s_lo, s_hi, g,
+                        r, dry)
+        smax = 0.0
+        block = stride * count
+        c0 = (lo // block) * block
+        while c0 <= hi:
+            for j in range(stride):
+                base = c0 + j  # the line of cells base + k stride, k = 0..count - 1
+                k0 = max(0, (lo - base + stride - 1) // stride)
+                k1 = min(count - 1, (hi - base) // stride)
+                klo, khi = line_wet(q, dry, width, base, stride, k0, k1)
+                if klo <= khi:
+                    smax = max(smax, line(qm, qp, rate, metric, base, stride, count, klo,
+                                          khi, inv_dx, s_lo, s_hi, g, r, dry))
+            c0 += block
+        return smax
+
+    return faces
+
+
+def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, axis: int,
+                   axisymmetric: bool, lines: bool) -> Any:
+    """One axis' part of the advection stage as a Python closure (inlined):
+    ``along(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count, inv_dx, bc_lo,
+    bc_hi, g, r, dry) -> smax``: MUSCL's face values along the axis in cells
+    ``r_lo..r_hi``, the axis' faces next to ``lo..hi`` (:func:`_faces_function`), the
+    MUSCL cell jump along the axis."""
+    rows = model.axis_rows(axis)
+    width = model.layer_rows
+    faces = njit(inline="always")(_faces_function(model.face, model.fluctuations(flux),
+                                                  rows, width, axis, axisymmetric, lines))
+    normal = rows[1]  # the row of a layer's momentum normal to the axis' faces
+    # the MUSCL kernels, only where they are called (see compiled.ready)
+    reconstruct = reconstruction(width, normal) if muscl else None
+    cell_jump = model.cell_jump if muscl else None
+
+    def along(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count, inv_dx, bc_lo,
+              bc_hi, g, r, dry):
+        if muscl:
+            reconstruct(q, work, r_lo, r_hi, stride, count, bc_lo, bc_hi, dry, limiter)
+            qm = work[0]
+            qp = work[1]
+        else:
+            qm = q  # first order: both face values are the cell average
+            qp = q
+        # a ghost cell: a wall mirrors the face value next to it, an open end copies it
+        s_lo = -1.0 if bc_lo == L.BC_WALL else 1.0
+        s_hi = -1.0 if bc_hi == L.BC_WALL else 1.0
+        smax = faces(q, qm, qp, rate, metric, lo, hi, stride, count, inv_dx, s_lo, s_hi, g,
+                     r, dry)
+        if muscl:
+            # axisymmetric too: the mean face area over the volume is 1/dr exactly
+            cell_jump(qm, qp, rate, r_lo, r_hi, inv_dx, g, r, dry, axis)
+        return smax
+
+    return along
+
+
+@cached(inline="always")
+def _axis(metric: np.ndarray, a: int, dx: float) -> tuple[int, int, float, float]:
+    """Axis ``a`` of a 2D grid: its stride, its cells, 1 / its width [1/m] and what its
+    faces' speeds are scaled by, (dx / width) 2 (see :func:`advection_kernel`)."""
+    width = metric[L.M_AXES, 3 * a + 2]
+    return (int(metric[L.M_AXES, 3 * a]), int(metric[L.M_AXES, 3 * a + 1]), 1.0 / width,
+            dx / width * 2.0)
 
 
 ADVECT_SIGNATURE = (STATE, FIELDS, WORK, f8, METRIC, i8, i8, f8, f8, f8, i8, i8)
@@ -132,19 +297,24 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
     r"""The advection stage of one model's scheme on one geometry: ``advect(q, rate,
     work, dx, metric, bc_left, bc_right, g, r, dry, start, stop) -> (smax, r_lo, r_hi)``.
 
-    Writes the rate of the state ``q`` (fields x cells) into ``rate`` in the cells it can
-    change, ``r_lo..r_hi``: the wet cells within ``start..stop`` (:func:`wet_cells`; all
-    others must be dry) widened by one, clipped to the grid; the rest of ``rate`` is left
-    as it was. Returns the largest wave speed over the faces visited [m/s] and
+    Writes the rate of the state ``q`` (fields x cells, flattened) into ``rate`` in the
+    cells it can change, ``r_lo..r_hi``: the wet cells within ``start..stop``
+    (:func:`wet_cells`; all others must be dry) widened by the largest stride of the
+    grid's axes (1 on a 1D grid), clipped to the grid; the rest of ``rate`` is left as it
+    was. Returns the largest wave speed over the faces visited [m/s], on a grid of
+    several axes each face's scaled by (dx / dx_a) times the number of axes, so that
+    ``cfl dx / smax`` bounds the sum over axes of the Courant numbers by ``cfl``; and
     ``r_lo, r_hi`` (``0.0, 1, 0`` if nothing is wet). ``work`` is scratch space of shape
     (2, fields, cells); ``g``, ``r``, ``dry``: the model's constants
     (:attr:`ModelKernels.constants`). ``model`` gives the face states, fluctuations and
     the MUSCL cell jump; ``flux`` (layout.FLUX_*), ``order`` (1: first order, 2: MUSCL)
-    and ``limiter`` (layout.LIMITER_*) choose the scheme.
+    and ``limiter`` (layout.LIMITER_*) choose the scheme. ``bc_left``, ``bc_right``: the
+    boundary codes of the low and high sides (several axes: :func:`layout.sides`).
 
     ``geometry`` (layout.GEOMETRY_*) and ``metric`` (the rows layout.M_* of
     :class:`~pdeflow.numerics.geometry.Metric`) weight the faces. Planar: every weight is
-    1/dx (``metric`` is not read). Axisymmetric, with face areas A and cell volumes V,
+    1/dx (``metric`` is not read); 2D: 1/dx_a on the faces of axis a (``metric``'s
+    row M_AXES gives the axes). Axisymmetric, with face areas A and cell volumes V,
 
     .. math:: \frac{dq_i}{dt} = -\frac{A_{i-1/2} D^+_{i-1/2} + A_{i+1/2} D^-_{i+1/2}
               + \bar A_i \mathcal{A}(q_i^-, q_i^+)}{V_i}
@@ -160,80 +330,51 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
     the area-weighted mean of its two one-sided slopes (exactly the slope where it is
     uniform), so that friction holds a cone whose flanks are below the friction angle.
     """
-    fluct = model.fluctuations(flux)
-    face = model.face
-    fields = model.fields
     muscl = order == 2
     axisymmetric = geometry == L.GEOMETRY_AXISYMMETRIC
-    # the MUSCL and axisymmetric kernels, only where they are called (see compiled.ready)
-    reconstruct = reconstruct_muscl if muscl else None
-    cell_jump = model.cell_jump if muscl else None
+    two_d = geometry == L.GEOMETRY_PLANAR_2D
+    width = model.layer_rows
+    along_x = njit(inline="always")(_axis_function(model, flux, muscl, limiter, 0,
+                                                   axisymmetric, two_d))
+    along_y = njit(inline="always")(_axis_function(model, flux, muscl, limiter, 1, False,
+                                                   True)) if two_d else None
     area_change = (_area_change_muscl if muscl else _area_change) if axisymmetric else None
 
     def advect(q, rate, work, dx, metric, bc_left, bc_right, g, r, dry, start, stop):
-        lo, hi = wet_cells(q, dry, start, stop)
+        lo, hi = wet_cells(q, dry, start, stop, width)
         n = q.shape[1]
         if lo > hi:
             return 0.0, 1, 0
-        r_lo = max(lo - 1, 0)
-        r_hi = min(hi + 1, n - 1)
+        reach = int(metric[L.M_AXES, 0]) if two_d else 1  # the largest stride
+        r_lo = max(lo - reach, 0)
+        r_hi = min(hi + reach, n - 1)
         rate[:, r_lo:r_hi + 1] = 0.0
-        if muscl:
-            reconstruct(q, work, r_lo, r_hi, bc_left, bc_right, dry, limiter)
-            qm = work[0]
-            qp = work[1]
-        else:
-            qm = q  # first order: both face values are the cell average
-            qp = q
-        inv_dx = 1.0 / dx
-        w_l = inv_dx  # weights of a face's fluctuations in the cells left and right
-        w_r = inv_dx
-        # at the ends of the grid a ghost cell: a wall mirrors the face value next to
-        # it, an open end copies it
-        s_left = -1.0 if bc_left == L.BC_WALL else 1.0
-        s_right = -1.0 if bc_right == L.BC_WALL else 1.0
-        smax = 0.0
-        for i in range(max(lo, 1), min(hi + 1, n - 1) + 1):
-            # face i - 1/2, between cells i - 1 and i
-            dm, dp, s = fluct(face(qp, i - 1, 1.0), face(qm, i, 1.0), g, r, dry)
-            smax = max(smax, s)
-            if axisymmetric:
-                w_l = metric[L.M_LEFT, i]
-                w_r = metric[L.M_RIGHT, i]
-            for k in range(fields):
-                rate[k, i - 1] -= dm[k] * w_l
-                rate[k, i] -= dp[k] * w_r
-        if lo == 0:
-            dm, dp, s = fluct(face(qm, 0, s_left), face(qm, 0, 1.0), g, r, dry)
-            smax = max(smax, s)
-            if axisymmetric:
-                w_r = metric[L.M_RIGHT, 0]
-            for k in range(fields):
-                rate[k, 0] -= dp[k] * w_r
-        if hi == n - 1:
-            dm, dp, s = fluct(face(qp, n - 1, 1.0), face(qp, n - 1, s_right), g, r, dry)
-            smax = max(smax, s)
-            if axisymmetric:
-                w_l = metric[L.M_LEFT, n]
-            for k in range(fields):
-                rate[k, n - 1] -= dm[k] * w_l
-        if muscl:
-            # axisymmetric too: the mean face area over the volume is 1/dr exactly
-            cell_jump(qm, qp, rate, r_lo, r_hi, inv_dx, g, r, dry)
-        if axisymmetric:
-            area_change(qm, qp, rate, r_lo, r_hi, metric, dry)
-        return smax, r_lo, r_hi
+        if not two_d:
+            smax = along_x(q, rate, work, metric, lo, hi, r_lo, r_hi, 1, n, 1.0 / dx,
+                           bc_left, bc_right, g, r, dry)
+            if axisymmetric and muscl:
+                area_change(work[0], work[1], rate, r_lo, r_hi, metric, dry, width)
+            elif axisymmetric:
+                area_change(q, q, rate, r_lo, r_hi, metric, dry, width)
+            return smax, r_lo, r_hi
+        stride, count, inv_width, scale = _axis(metric, 0, dx)
+        smax = scale * along_x(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count,
+                               inv_width, bc_left & 1, bc_right & 1, g, r, dry)
+        stride, count, inv_width, scale = _axis(metric, 1, dx)
+        s = scale * along_y(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count,
+                            inv_width, (bc_left >> 1) & 1, (bc_right >> 1) & 1, g, r, dry)
+        return max(smax, s), r_lo, r_hi
 
     return specialise(advect, *ADVECT_SIGNATURE)
 
 
 @cached
-def _area_change(q, unused, rate, lo, hi, metric, dry):
+def _area_change(q, unused, rate, lo, hi, metric, dry, width):
     """Subtract (A_{i+1/2} - A_{i-1/2}) / V_i F^adv(q_i) in the cells lo..hi, F^adv =
     (h u, h u^2) of each layer (first order: the cell averages)."""
     for i in range(lo, hi + 1):
         c = metric[L.M_AREA_CHANGE, i]
-        for k in range(0, q.shape[0], 2):
+        for k in range(0, q.shape[0], width):
             h = q[k, i]
             u = velocity(h, q[k + 1, i], dry)  # as the fluctuations: 0 in a dry layer
             rate[k, i] -= c * (u * h)
@@ -241,11 +382,11 @@ def _area_change(q, unused, rate, lo, hi, metric, dry):
 
 
 @cached
-def _area_change_muscl(qm, qp, rate, lo, hi, metric, dry):
+def _area_change_muscl(qm, qp, rate, lo, hi, metric, dry, width):
     """:func:`_area_change` with F^adv averaged over the cell's face values qm, qp."""
     for i in range(lo, hi + 1):
         c = metric[L.M_AREA_CHANGE, i]
-        for k in range(0, qm.shape[0], 2):
+        for k in range(0, qm.shape[0], width):
             hm = qm[k, i]
             hp = qp[k, i]
             um = velocity(hm, qm[k + 1, i], dry)

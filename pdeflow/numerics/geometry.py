@@ -5,12 +5,18 @@ A cell's average q_i changes by the fluxes through its faces weighted by their a
 .. math:: V_i \frac{dq_i}{dt} = -(A_{i+1/2} F_{i+1/2} - A_{i-1/2} F_{i-1/2}) + \dots
 
 On the planar slope (a 1D ``CartesianGrid``, per unit width) A = 1 and V = dx, and the
-update is the one of a uniform grid. On py-pde's ``PolarSymGrid`` (radial flow of an
-axisymmetric collapse on [0, R]) A_{i+1/2} = 2 pi r_{i+1/2} and
+update is the one of a uniform grid. On a 2D ``CartesianGrid`` the faces of each axis
+have area 1 and the cells dx dy: every face of axis a weighs 1/dx_a (the face loop only,
+:mod:`pdeflow.numerics.advection`; the models are 1D). On py-pde's ``PolarSymGrid``
+(radial flow of an axisymmetric collapse on [0, R]) A_{i+1/2} = 2 pi r_{i+1/2} and
 V_i = pi (r_{i+1/2}^2 - r_{i-1/2}^2); the axis r = 0 is a face of area 0.
 :class:`Metric` holds these as the array the advection kernels read (rows
 ``layout.M_*``); the kernels are specialised to the geometry's code (``layout.GEOMETRY_*``),
 so that the planar update is exactly the uniform-grid one.
+
+The kernels see the cells of any grid flattened, ``q[field, cell]`` with py-pde's
+``data[field, n0, n1]`` in C order (cell = i0 n1 + i1), and each axis as a stride in
+that index, a number of cells and a cell width (row ``layout.M_AXES``).
 """
 
 from __future__ import annotations
@@ -23,7 +29,7 @@ import numpy as np
 
 from . import layout as L
 
-COORDINATES = {"planar": "x", "axisymmetric": "r"}
+COORDINATES = {"planar": "x", "axisymmetric": "r", "planar-2d": "x"}
 """the name of each geometry's coordinate [m]"""
 
 
@@ -38,25 +44,42 @@ class Metric:
     dx: float
     """cell width dx or dr [m]"""
     faces: np.ndarray
-    """face positions [m], n + 1"""
+    """face positions [m] along the first axis, n + 1"""
     areas: np.ndarray
     """face areas: 1 (planar, per unit width) or 2 pi r [m], n + 1"""
     volumes: np.ndarray
-    """cell volumes: dx [m] (planar) or pi (r+^2 - r-^2) [m^2], n"""
+    """cell volumes: dx [m] (planar) or pi (r+^2 - r-^2) [m^2] or dx dy [m^2] (2D),
+    one per cell"""
+    shape: tuple[int, ...] = ()
+    """cells along each axis (default: one axis of ``volumes.size`` cells)"""
+    spacing: tuple[float, ...] = ()
+    """cell width along each axis [m] (default: ``(dx,)``)"""
+
+    @property
+    def axes(self) -> list[tuple[int, int, float]]:
+        """(stride in the flattened cell index, cells, width [m]) of each axis."""
+        shape = self.shape or (self.volumes.size,)
+        spacing = self.spacing or (self.dx,)
+        strides = [int(np.prod(shape[a + 1:])) for a in range(len(shape))]
+        return list(zip(strides, shape, spacing, strict=True))
 
     @property
     def code(self) -> int:
         """The geometry's code for the kernels (layout.GEOMETRY_*)."""
-        return L.GEOMETRIES[self.geometry]
+        return L.GRID_GEOMETRIES[self.geometry]
 
     def array(self) -> np.ndarray:
-        """The rows layout.M_* as one C-contiguous array of shape (N_METRIC, n + 1): per face
-        its weights in the cells left and right of it, per cell its area change."""
+        """The rows layout.M_* as one C-contiguous array of shape (N_METRIC, n + 1) (at
+        least 3 per axis wide): on a 1D grid per face its weights in the cells left and
+        right of it and per cell its area change; the axes (row M_AXES)."""
         n = self.volumes.size
-        out = np.zeros((L.N_METRIC, n + 1))
-        out[L.M_LEFT, 1:] = self.areas[1:] / self.volumes  # face i - 1/2 into cell i - 1
-        out[L.M_RIGHT, :n] = self.areas[:-1] / self.volumes
-        out[L.M_AREA_CHANGE, :n] = (self.areas[1:] - self.areas[:-1]) / self.volumes
+        axes = self.axes
+        out = np.zeros((L.N_METRIC, max(n + 1, 3 * len(axes))))
+        if len(axes) == 1:
+            out[L.M_LEFT, 1:n + 1] = self.areas[1:] / self.volumes  # face i - 1/2 into i - 1
+            out[L.M_RIGHT, :n] = self.areas[:-1] / self.volumes
+            out[L.M_AREA_CHANGE, :n] = (self.areas[1:] - self.areas[:-1]) / self.volumes
+        out[L.M_AXES, :3 * len(axes)] = np.ravel(axes)
         return out
 
     @property
@@ -73,10 +96,11 @@ class Metric:
         return float(np.sum(values * self.volumes))
 
 
-def geometry_of(grid: Any) -> str:
+def geometry_of(grid: Any, two_d: bool = False) -> str:
     """'planar' for a non-periodic 1D ``CartesianGrid``, 'axisymmetric' for a
-    ``PolarSymGrid`` starting at the axis; ValueError for any other grid. Cheap: no
-    arrays (the method-of-lines rate checks its grid on every call)."""
+    ``PolarSymGrid`` starting at the axis, with ``two_d`` 'planar-2d' for a non-periodic
+    2D ``CartesianGrid``; ValueError for any other grid. Cheap: no arrays (the
+    method-of-lines rate checks its grid on every call)."""
     from pde import CartesianGrid, PolarSymGrid
 
     if isinstance(grid, PolarSymGrid):
@@ -85,16 +109,26 @@ def geometry_of(grid: Any) -> str:
             raise ValueError("an axisymmetric grid must start at the axis: PolarSymGrid "
                              f"on [0, R], got [{r0:g}, {r1:g}] m")
         return "axisymmetric"
-    if not isinstance(grid, CartesianGrid) or grid.num_axes != 1:
-        raise ValueError(f"grid must be a 1D CartesianGrid or a PolarSymGrid, got {grid!r}")
-    if grid.periodic[0]:
+    axes = (1, 2) if two_d else (1,)
+    if not isinstance(grid, CartesianGrid) or grid.num_axes not in axes:
+        kinds = "a 1D or 2D" if two_d else "a 1D"
+        raise ValueError(f"grid must be {kinds} CartesianGrid or a PolarSymGrid, got {grid!r}")
+    if any(grid.periodic):
         raise ValueError("grid must not be periodic: use wall or open boundaries")
-    return "planar"
+    return "planar" if grid.num_axes == 1 else "planar-2d"
 
 
 def metric_of(grid: Any) -> Metric:
-    """The metric of a grid that :func:`geometry_of` accepts."""
-    geometry = geometry_of(grid)
+    """The metric of a grid that :func:`geometry_of` accepts, a 2D ``CartesianGrid``
+    included (for the face loop: the models are 1D)."""
+    geometry = geometry_of(grid, two_d=True)
+    if geometry == "planar-2d":
+        shape = tuple(int(n) for n in grid.shape)
+        spacing = tuple(float(d) for d in grid.discretization)
+        x0, x1 = grid.axes_bounds[0]
+        return Metric(geometry, COORDINATES[geometry], spacing[0],
+                      np.linspace(x0, x1, shape[0] + 1), np.ones(shape[0] + 1),
+                      np.full(shape[0] * shape[1], spacing[0] * spacing[1]), shape, spacing)
     if geometry == "axisymmetric":
         r1 = grid.axes_bounds[0][1]
         n = grid.shape[0]

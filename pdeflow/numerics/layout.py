@@ -44,6 +44,12 @@ BC_WALL = 0
 BC_OPEN = 1
 BOUNDARIES = {"wall": BC_WALL, "open": BC_OPEN}
 
+
+def sides(codes: tuple[int, ...]) -> int:
+    """One side's boundary codes of every axis of a grid as the one int the kernels take:
+    axis a's code in bit a (BC_* are 0 and 1), so that a 1D grid's is its code."""
+    return sum(int(code) << a for a, code in enumerate(codes))
+
 # --- interface fluxes, reconstructions, limiters ---------------------------------------
 FLUX_HLL = 0
 FLUX_RUSANOV = 1
@@ -88,7 +94,12 @@ N_LAW = 7
 GEOMETRY_PLANAR = 0  #: a 1D Cartesian grid: the planar slope, per unit width
 GEOMETRY_AXISYMMETRIC = 1  #: py-pde's PolarSymGrid: radial flow on a horizontal plane
 GEOMETRIES = {"planar": GEOMETRY_PLANAR, "axisymmetric": GEOMETRY_AXISYMMETRIC}
+GEOMETRY_PLANAR_2D = 2  #: a 2D Cartesian grid (the face loop only: no case file selects it yet)
+GRID_GEOMETRIES = {**GEOMETRIES, "planar-2d": GEOMETRY_PLANAR_2D}
+"""every geometry the kernels know (:data:`GEOMETRIES`: those a case file may name)"""
 M_LEFT = 0  #: metric row: A_{i-1/2} / V_{i-1}, face i - 1/2's weight in cell i - 1 [1/m]
 M_RIGHT = 1  #: metric row: A_{i-1/2} / V_i, face i - 1/2's weight in cell i [1/m]
 M_AREA_CHANGE = 2  #: metric row: (A_{i+1/2} - A_{i-1/2}) / V_i [1/m] (n entries)
-N_METRIC = 3
+M_AXES = 3  #: metric row: per axis a, [3a] its stride in the flattened cell index, [3a + 1]
+#: its number of cells, [3a + 2] its cell width [m] (read by the 2D kernels only)
+N_METRIC = 4

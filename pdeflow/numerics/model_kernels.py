@@ -21,20 +21,25 @@ class ModelKernels:
     """The kernels of one equation system (compared and hashed by identity, so that the
     kernel factories cache one build per bundle).
 
-    State ``q[field, cell]`` holds (depth, discharge) pairs of each layer, depths in
-    rows 0, 2, ... [m], discharges in rows 1, 3, ... [m^2/s].
+    State ``q[field, cell]`` holds each layer's depth [m] and then its discharge along
+    each axis [m^2/s] (:attr:`layer_rows` rows per layer; cells flattened, see
+    :mod:`.geometry`). The scheme reads no field by name: it takes a face's states in
+    the face's normal frame from :attr:`face` and puts the fluctuations back into the
+    rows :attr:`rows` names.
     """
 
     fields: int
     """rows of the state"""
     face: Any
-    """``face(q, i, sign) -> tuple``: the state of cell (or face value) i, momenta times
-    ``sign`` (-1: a wall's mirror image)"""
+    """``face(q, i, axis, sign) -> tuple``: the state of cell (or face value) i in the
+    frame of a face normal to ``axis``: each layer's depth, momentum normal to the face
+    times ``sign`` (-1: a wall's mirror image), then its tangential momenta"""
     fluctuations: Callable[[int], Any]
-    """flux code (layout.FLUX_*) -> ``fluct(left, right, g, r, dry) -> (D^-, D^+, smax)``"""
+    """flux code (layout.FLUX_*) -> ``fluct(left, right, g, r, dry) -> (D^-, D^+, smax)``
+    in the face's normal frame (tuples as :attr:`face`'s)"""
     cell_jump: Any
-    """MUSCL: ``cell_jump(qm, qp, rate, lo, hi, inv_dx, g, r, dry)`` subtracts the flux
-    difference across the reconstruction inside cells lo..hi"""
+    """MUSCL: ``cell_jump(qm, qp, rate, lo, hi, inv_dx, g, r, dry, axis)`` subtracts the
+    flux difference along ``axis`` across the reconstruction inside cells lo..hi"""
     sources: Any
     """source stage on cells lo..hi: ``sources(q, dt, t, P, diag, lo, hi)``"""
     source_stage: Any
@@ -50,3 +55,12 @@ class ModelKernels:
     constants: Callable[[np.ndarray], tuple[float, float, float]]
     """``P -> (g_z [m/s^2], coupling r [-] (0 without), dry tolerance [m])``: the
     scalars the advection kernels take"""
+    layer_rows: int = 2
+    """rows per layer: its depth, then its discharge along each axis"""
+    rows: tuple[tuple[int, ...], ...] = ()
+    """per axis, the row of ``q`` each entry of a fluctuation (a :attr:`face` tuple) goes
+    back into (default: one axis, in the order of ``q``)"""
+
+    def axis_rows(self, axis: int) -> tuple[int, ...]:
+        """:attr:`rows` of ``axis`` (the identity if none are given)."""
+        return self.rows[axis] if self.rows else tuple(range(self.fields))

@@ -10,11 +10,12 @@ One step of length dt (Lie splitting, as in the paper):
 With MUSCL the advection is integrated with SSP-RK2 (Heun); with Strang splitting half
 a source step is applied before and after it.
 
-The loop is compiled once per reconstruction order, splitting and IFCP fallback
-(:func:`stepping_kernel`) and takes the model's kernels as arguments: its advection
-stage (:func:`pdeflow.numerics.advection.advection_kernel`, one per model, flux,
-reconstruction and limiter), source stage and MUSCL predictor, called once or twice per
-step through a function pointer. :func:`scheme_stepper` puts the two together for one
+The loop is compiled once per reconstruction order, splitting, IFCP fallback, rows per
+layer of the model's state and number of the grid's axes (:func:`stepping_kernel`) and
+takes the model's kernels as arguments: its advection stage
+(:func:`pdeflow.numerics.advection.advection_kernel`, one per model, flux, reconstruction
+and limiter), source stage and MUSCL predictor, called once or twice per step through a
+function pointer. :func:`scheme_stepper` puts the two together for one
 scheme. Everything is cached on disk; all parameters are arrays and the grid an
 argument, so that sweeps never recompile.
 """
@@ -22,13 +23,13 @@ argument, so that sweeps never recompile.
 from __future__ import annotations
 
 import functools
-import math
 from typing import Any
 
 import numpy as np
 from numba import njit, types
 
 from . import layout as L
+from .advect_step import _copy_cells, _copy_range, advect_step_function, speed_scale
 from .advection import ADVECT_SIGNATURE, advection_kernel
 from .compiled import (
     FIELDS,
@@ -37,7 +38,6 @@ from .compiled import (
     STATE,
     VECTOR,
     WORK,
-    cached,
     entry,
     f8,
     first_class,
@@ -56,144 +56,27 @@ STATUS_FAIL = 2  #: non-finite or negative state: the step was undone
 MAX_RETRIES = 30  #: halvings of dt tried on a step that left a depth negative
 
 
-@cached(inline="always")
-def update(q, base, rate, dt, weight, lo, hi):
-    """q <- weight * base + (1 - weight) * (q + dt * rate) in cells ``lo..hi``; returns
-    (max |mass rate|, ok).
-
-    ``ok`` is False if the result is not finite or a depth is negative beyond round-off
-    (round-off below zero is clipped by the source stage).
-    """
-    mass_rate = 0.0
-    ok = True
-    for k in range(q.shape[0]):
-        for i in range(lo, hi + 1):
-            v = weight * base[k, i] + (1.0 - weight) * (q[k, i] + dt * rate[k, i])
-            if k % 2 == 0:
-                mass_rate = max(mass_rate, abs(rate[k, i]))
-                if v < -1e-12 * (1.0 + abs(q[k, i])):
-                    ok = False
-            if not math.isfinite(v):
-                ok = False
-            q[k, i] = v
-    return mass_rate, ok
-
-
-@cached(inline="always")
-def _copy_cells(dst, src, lo, hi):
-    """dst[..., lo:hi + 1] = src[..., lo:hi + 1] for 2D arrays (a loop: numba compiles
-    an array-to-array slice assignment with its shape-mismatch error message, seconds)."""
-    for k in range(dst.shape[0]):
-        for i in range(lo, hi + 1):
-            dst[k, i] = src[k, i]
-
-
-@cached(inline="always")
-def _copy_range(dst, src, lo, hi):
-    """dst[lo:hi + 1] = src[lo:hi + 1] for 1D arrays (see :func:`_copy_cells`)."""
-    for i in range(lo, hi + 1):
-        dst[i] = src[i]
-
-
-def advect_step_function(order: int, strang: bool, update: Any = update) -> Any:
-    """The advection stage of one step of the stepping loop, with Strang the first half
-    source step before it, as a Python closure (compiled inside :func:`stepping_kernel`;
-    the blow-up diagnosis runs it in Python with an instrumented ``update``):
-
-    ``advect_step(advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
-    P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, e_lo, e_hi,
-    b_lo, b_hi, s_rest)`` advances the cells ``b_lo..b_hi`` with the model's kernels (see
-    :func:`stepping_kernel`): the cells the step may change, saved in ``backup`` (and,
-    for Strang, the bookkeeping in ``diag_keep``, ``fex_keep``). The advection stages
-    evaluate the wet cells of ``e_lo..e_hi`` (``b`` widened by one, so that every face
-    of a cell of ``b`` is evaluated) and update only those of ``b``; ``s_rest`` [m/s]
-    is the largest wave speed of the faces at rest they skip
-    (:mod:`pdeflow.numerics.resting`), so that dt is that of a full sweep.
-
-    Returns ``(dt, mass_rate, ok, a_lo, a_hi, changed)``: the step [s], the largest mass
-    rate, whether the state is finite and non-negative, the cells the update touched and
-    whether the half source step changed anything.
-    """
-    muscl = order == 2
-
-    def advect_step(advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
-                    P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep,
-                    first, e_lo, e_hi, b_lo, b_hi, s_rest):
-        fex = diag[L.N_DIAG:]
-        smax, a_lo, a_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry,
-                                  e_lo, e_hi)
-        smax = max(smax, s_rest)
-        a_lo = max(a_lo, b_lo)
-        a_hi = min(a_hi, b_hi)
-        dt = t_end - t
-        if strang:
-            # the first half source step may accelerate a layer by up to dt/2 |g_x|
-            # (friction only brakes): choose dt with dt (smax + dt |g_x| / 2) = cfl dx
-            gx = abs(P[L.G_X])
-            den = smax + math.sqrt(smax * smax + 2.0 * gx * cfl * dx)
-            if den > 0.0:
-                dt = min(dt, 2.0 * cfl * dx / den)
-        elif smax > 0.0:
-            dt = min(dt, cfl * dx / smax)
-        changed = 0.0
-        if strang:
-            h_lo = b_lo if first else a_lo
-            h_hi = b_hi if first else a_hi
-            for attempt in range(40):
-                diag[L.D_DT] = 0.5 * dt
-                sources(q, 0.5 * dt, t, P, diag, h_lo, h_hi)
-                changed = diag[L.D_CHANGED]
-                # (a deposit can lift a cell of sub-dry layers above dry: search wider)
-                smax2, a_lo, a_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry,
-                                           e_lo, e_hi)
-                smax2 = max(smax2, s_rest)
-                a_lo = max(a_lo, b_lo)
-                a_hi = min(a_hi, b_hi)
-                if smax2 * dt <= cfl * dx * (1.0 + 1e-9) or attempt == 39:
-                    break
-                # the half source step made the waves faster than dt allows (erosion
-                # can deepen the upper layer 1/r-fold): undo it and retry shorter
-                _copy_cells(q, backup, b_lo, b_hi)
-                _copy_range(diag, diag_keep, 0, L.N_DIAG - 1)
-                _copy_range(fex, fex_keep, b_lo, b_hi)
-                dt = min(0.5 * dt, cfl * dx / smax2)
-        if not muscl:
-            mass_rate, ok = update(q, q, rate, dt, 0.0, a_lo, a_hi)
-            return dt, mass_rate, ok, a_lo, a_hi, changed
-        _copy_cells(q0, q, b_lo, b_hi)
-        mass_rate, ok = update(q, q0, rate, dt, 0.0, a_lo, a_hi)
-        if ok:
-            predictor(q, dt, P, a_lo, a_hi)
-            _, c_lo, c_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry, e_lo,
-                                   e_hi)
-            c_lo = max(c_lo, b_lo)
-            c_hi = min(c_hi, b_hi)
-            # cells of the first stage that the second does not reach get rate 0
-            for i in range(a_lo, a_hi + 1):
-                if i < c_lo or i > c_hi:
-                    rate[:, i] = 0.0
-            if a_lo > a_hi:
-                a_lo = c_lo
-                a_hi = c_hi
-            elif c_lo <= c_hi:
-                a_lo = min(a_lo, c_lo)
-                a_hi = max(a_hi, c_hi)
-            mass2, ok = update(q, q0, rate, dt, 0.5, a_lo, a_hi)
-            mass_rate = max(mass_rate, mass2)
-        return dt, mass_rate, ok, a_lo, a_hi, changed
-
-    return advect_step
-
-
-def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int) -> Any:
+def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
+                      width: int = 2, two_d: bool = False) -> Any:
     """The stepping loop as a Python closure (compiled by :func:`stepping_kernel`, which
     documents it); ``advect_step`` is :func:`advect_step_function`, ``reach`` that of
-    its reconstruction order (:func:`pdeflow.numerics.resting.reach`)."""
+    its reconstruction order (:func:`pdeflow.numerics.resting.reach`), ``width`` the
+    model's rows per layer, ``two_d`` a 2D grid.
+
+    Windows of cells are ranges of the flattened cell index: on a 2D grid a window
+    widened by ``reach`` strides of the first axis (the largest) holds every cell within
+    ``reach`` of its cells along either axis, a conservative over-approximation of the
+    stencil (it also holds the rest of those rows); on a 1D grid the stride is 1.
+    """
 
     def advance(q, t, t_pause, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag,
                 rate, backup, diag_backup, work, prev, max_steps, stop_at_rest, advect, sources,
                 predictor, fallback):
         n = q.shape[1]
+        # a line of the last axis, and the largest stride in the cell index
+        line = int(metric[L.M_AXES, 4]) if two_d else n
+        stride = int(metric[L.M_AXES, 0]) if two_d else 1
+        scale = speed_scale(metric, dx) if two_d else 1.0
         steps = 0
         rec = work[:2]
         q0 = work[2]
@@ -225,21 +108,23 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int) ->
                 b_lo = 1
                 b_hi = 0
             else:
-                b_lo = max(v_lo - reach, 0)
-                b_hi = min(v_hi + reach, n - 1)
+                b_lo = max(v_lo - reach * stride, 0)
+                b_hi = min(v_hi + reach * stride, n - 1)
             if b_lo <= b_hi:
-                e_lo = max(b_lo - 1, 0)
-                e_hi = min(b_hi + 1, n - 1)
+                e_lo = max(b_lo - stride, 0)
+                e_hi = min(b_hi + stride, n - 1)
             else:
                 e_lo = n  # nothing is evaluated: every cell is at rest or dry
                 e_hi = n - 1
             s_rest = 0.0
             if e_lo > 0:
-                p_ok = extend_prefix(pre, q, p_ok, e_lo, g, dry)
+                p_ok = extend_prefix(pre, q, p_ok, e_lo, g, dry, width, line)
                 s_rest = pre[e_lo - 1]
             if e_hi < n - 1:
-                s_ok = extend_suffix(suf, q, s_ok, e_hi + 1, g, dry)
+                s_ok = extend_suffix(suf, q, s_ok, e_hi + 1, g, dry, width, line)
                 s_rest = max(s_rest, suf[e_hi + 1])
+            if two_d:
+                s_rest *= scale
             _copy_cells(backup, q, b_lo, b_hi)
             if strang or ifcp:
                 _copy_range(diag_keep, diag, 0, L.N_DIAG - 1)
@@ -297,7 +182,7 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int) ->
             s_lo = a_lo
             s_hi = a_hi
             if b_lo <= b_hi:
-                v_lo, v_hi = live_cells(q, backup, b_lo, b_hi)
+                v_lo, v_hi = live_cells(q, backup, b_lo, b_hi, width)
                 p_ok = min(p_ok, b_lo)
                 s_ok = max(s_ok, b_hi + 1)
             diag[L.D_LIVE_LO] = v_lo
@@ -327,11 +212,12 @@ PREDICTOR = types.FunctionType(types.none(STATE, f8, PARAMS, i8, i8))
 
 
 @functools.cache
-def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
-    """The ``fv-split`` stepping loop for one reconstruction order, splitting and flux
-    fallback, for any model (compiled on first use, see
-    :func:`pdeflow.numerics.compiled.ready`): advance ``q`` from ``t`` to ``t_end`` with
-    the CFL-limited splitting scheme,
+def stepping_kernel(order: int, strang: bool, ifcp: bool, width: int = 2,
+                    two_d: bool = False) -> Any:
+    """The ``fv-split`` stepping loop for one reconstruction order, splitting, flux
+    fallback, ``width`` rows per layer and a 1D or (``two_d``) 2D grid, for any model
+    (compiled on first use, see :func:`pdeflow.numerics.compiled.ready`): advance ``q``
+    from ``t`` to ``t_end`` with the CFL-limited splitting scheme,
 
     ``advance(q, t, t_pause, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl,
     diag, rate, backup, diag_backup, work, prev, max_steps, stop_at_rest, advect, sources,
@@ -364,8 +250,9 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool) -> Any:
     :data:`STATUS_FAIL` (the last step produced a non-finite or negative state and was
     undone; ``q`` holds the last good state).
     """
-    step = njit(inline="always")(advect_step_function(order, strang))
-    return specialise(stepping_function(ifcp, strang, step, reach_of(order)), STATE, f8, f8, f8, f8,
+    step = njit(inline="always")(advect_step_function(order, strang, None, width, two_d))
+    loop = stepping_function(ifcp, strang, step, reach_of(order), width, two_d)
+    return specialise(loop, STATE, f8, f8, f8, f8,
                       METRIC, i8, i8, PARAMS, f8, f8, f8, f8, VECTOR, FIELDS, FIELDS, VECTOR,
                       WORK, FIELDS, i8, flag,
                       ADVECT, SOURCES, PREDICTOR if order == 2 else types.none,
@@ -382,7 +269,8 @@ class Stepper:
                  strang: bool, geometry: int):
         self.model = model
         self.ifcp = flux == L.FLUX_IFCP
-        self.loop = stepping_kernel(order, strang, self.ifcp)
+        self.two_d = geometry == L.GEOMETRY_PLANAR_2D
+        self.loop = stepping_kernel(order, strang, self.ifcp, model.layer_rows, self.two_d)
         self.advect = advection_kernel(model, flux, order, limiter, geometry)
         self.sources = model.sources
         self.predictor = model.predictor if order == 2 else None
@@ -441,6 +329,8 @@ def python_stepping(model: ModelKernels, flux: int, order: int, limiter: int,
     kernels, with ``update`` for :func:`update` (the blow-up diagnosis replays a step
     with an update that records what it wrote); called as the stepper."""
     compiled = scheme_stepper(model, flux, order, limiter, strang, geometry).ready()
+    width = model.layer_rows
     loop = stepping_function(compiled.ifcp, strang,
-                             advect_step_function(order, strang, update), reach_of(order))
+                             advect_step_function(order, strang, update, width, compiled.two_d),
+                             reach_of(order), width, compiled.two_d)
     return functools.partial(compiled.run, loop)

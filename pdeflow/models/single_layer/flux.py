@@ -24,9 +24,9 @@ from ...numerics.state import velocity
 
 
 @cached(inline="always")
-def face(q, i, sign):
+def face(q, i, axis, sign):
     """State ``(h, hu)`` of cell (or face value) ``i`` of ``q``, the momentum times
-    ``sign`` (-1: the mirror image of a wall's ghost cell)."""
+    ``sign`` (-1: the mirror image of a wall's ghost cell; one axis: ``axis`` is 0)."""
     return q[0, i], sign * q[1, i]
 
 
@@ -76,9 +76,9 @@ def _single(rusanov: bool, ifcp: bool):
 
 @cached
 def cell_jump(qm: np.ndarray, qp: np.ndarray, rate: np.ndarray, lo: int, hi: int,
-                     inv_dx: float, g: float, r: float, dry: float) -> None:
+                     inv_dx: float, g: float, r: float, dry: float, axis: int) -> None:
     """Subtract the flux difference across the reconstruction inside cells lo..hi
-    (single layer; ``r`` unused)."""
+    (single layer; ``r`` unused; one axis: ``axis`` is 0)."""
     for i in range(lo, hi + 1):
         hl, hr = qm[0, i], qp[0, i]
         ul = velocity(hl, qm[1, i], dry)

@@ -119,8 +119,9 @@ def internal_speed(h1: float, u1: float, h2: float, u2: float, g: float,
 
 
 @cached(inline="always")
-def face(q, i, sign):
-    """State ``(h1, h1u1, h2, h2u2)`` of cell ``i`` of ``q``, momenta times ``sign``."""
+def face(q, i, axis, sign):
+    """State ``(h1, h1u1, h2, h2u2)`` of cell ``i`` of ``q``, momenta times ``sign``
+    (one axis: ``axis`` is 0)."""
     return q[0, i], sign * q[1, i], q[2, i], sign * q[3, i]
 
 
@@ -237,9 +238,10 @@ def _two_layer(rusanov: bool, ifcp: bool):
 
 @cached
 def cell_jump(qm: np.ndarray, qp: np.ndarray, rate: np.ndarray, lo: int,
-                        hi: int, inv_dx: float, g: float, r: float, dry: float) -> None:
+                        hi: int, inv_dx: float, g: float, r: float, dry: float,
+                        axis: int) -> None:
     """Subtract the path-conservative jump across the linear reconstruction inside cells
-    lo..hi (two layers)."""
+    lo..hi (two layers; one axis: ``axis`` is 0)."""
     for i in range(lo, hi + 1):
         h1l, h1r = qm[0, i], qp[0, i]
         h2l, h2r = qm[2, i], qp[2, i]
