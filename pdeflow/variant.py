@@ -23,15 +23,20 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-from .models.base import MAX_CFL as BASE_MAX_CFL
-from .numerics import layout as L
+from .numerics.scheme import (
+    FLUXES,
+    LIMITERS,
+    MAX_CFL,
+    RECONSTRUCTIONS,
+    SPLITTINGS,
+    Scheme,
+    SchemeError,
+    check_choice,
+)
 
-FLUXES: tuple[str, ...] = tuple(L.FLUXES)
-RECONSTRUCTIONS: tuple[str, ...] = tuple(L.RECONSTRUCTIONS)
-MAX_CFL = BASE_MAX_CFL
-"""The largest Courant number of each reconstruction (see pdeflow.models.base)."""
-LIMITERS: tuple[str, ...] = tuple(L.LIMITERS)
-SPLITTINGS: tuple[str, ...] = ("lie", "strang")
+__all__ = ["FLUXES", "HYPERBOLICITY", "LIMITERS", "MAX_CFL", "RECONSTRUCTIONS",
+           "SPLITTINGS", "Scheme", "Variant", "VariantError", "variant_of"]
+
 HYPERBOLICITY: tuple[str, ...] = ("exact", "bound", "none")
 MOL_SOLVERS: dict[str, str] = {"mol-rk": "runge-kutta", "mol-euler": "euler"}
 """short method-of-lines names -> py-pde solver names; any other py-pde solver is
@@ -70,46 +75,78 @@ def solver_names() -> list[str]:
     return sorted(names, key=lambda n: (n != "fv-split", n))
 
 
-class VariantError(ValueError):
+class VariantError(SchemeError):
     """A variant name or field that is not one of the allowed choices."""
 
 
 def _choice(what: str, value: str, allowed: tuple[str, ...], name: str | None) -> None:
-    if value not in allowed:
-        where = f"variant {name!r}: " if name else ""
+    where = f"variant {name!r}: " if name else ""
+    try:
+        check_choice(what, value, allowed, where)
+    except SchemeError as err:
         why = (f" (py-pde's {value!r} cannot run a case: {UNFIT_SOLVERS[value]})"
                if what.endswith("solver") and value in UNFIT_SOLVERS else "")
-        raise VariantError(f"{where}{what} must be one of {list(allowed)}, got "
-                           f"{value!r}{why}")
+        raise VariantError(f"{err}{why}") from None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Variant:
-    """How a case is solved: discretisation, splitting, hyperbolicity, integrator.
+    """How a case is solved: a :class:`~pdeflow.numerics.scheme.Scheme` (flux,
+    reconstruction, limiter, splitting), the hyperbolicity treatment and the integrator.
 
     ``solver`` is ``"fv-split"`` (the paper's split scheme, a CFL time step) or a
     py-pde solver name run with a fixed step on the method-of-lines rate (see
-    :data:`MOL_SOLVERS`); ``splitting`` applies to fv-split only.
+    :data:`MOL_SOLVERS`); the scheme's splitting applies to fv-split only. Built from
+    the scheme's fields (``Variant(flux="rusanov")``) or from a scheme
+    (``Variant(scheme=Scheme(...))``); ``flux``, ``reconstruction``, ``limiter`` and
+    ``splitting`` read the scheme.
     """
 
-    flux: str = "hll"
-    reconstruction: str = "first-order"
-    limiter: str = "minmod"
-    splitting: str = "lie"
-    hyperbolicity: str = "exact"
-    solver: str = "fv-split"
+    scheme: Scheme
+    hyperbolicity: str
+    solver: str
 
-    def __post_init__(self) -> None:
+    def __init__(self, flux: str = "hll", reconstruction: str = "first-order",
+                 limiter: str = "minmod", splitting: str = "lie",
+                 hyperbolicity: str = "exact", solver: str = "fv-split", *,
+                 scheme: Scheme | None = None):
+        if scheme is None:
+            name = _compose(f"{flux}/{reconstruction}" + (
+                f"/{limiter}" if reconstruction == "muscl" else ""), splitting,
+                hyperbolicity, solver)
+            try:
+                scheme = Scheme(flux, reconstruction, limiter, splitting)
+            except SchemeError as err:
+                raise VariantError(f"variant {name!r}: {err}") from None
+        object.__setattr__(self, "scheme", scheme)
+        object.__setattr__(self, "hyperbolicity", hyperbolicity)
+        object.__setattr__(self, "solver", solver)
         name = self._compose()
-        _choice("flux", self.flux, FLUXES, name)
-        _choice("reconstruction", self.reconstruction, RECONSTRUCTIONS, name)
-        _choice("limiter", self.limiter, LIMITERS, name)
-        _choice("splitting", self.splitting, SPLITTINGS, name)
         _choice("hyperbolicity", self.hyperbolicity, HYPERBOLICITY, name)
         _choice("solver", self.solver, tuple(solver_names()), name)
         if self.solver != "fv-split" and self.splitting != "lie":
             raise VariantError(f"variant {name!r}: splitting applies to the fv-split "
                                "solver only (the method of lines does not split)")
+
+    @property
+    def flux(self) -> str:
+        """The scheme's interface flux."""
+        return self.scheme.flux
+
+    @property
+    def reconstruction(self) -> str:
+        """The scheme's reconstruction."""
+        return self.scheme.reconstruction
+
+    @property
+    def limiter(self) -> str:
+        """The scheme's slope limiter (of 'muscl')."""
+        return self.scheme.limiter
+
+    @property
+    def splitting(self) -> str:
+        """The scheme's splitting (fv-split only)."""
+        return self.scheme.splitting
 
     # --- names ---------------------------------------------------------------------------
     @classmethod
@@ -146,17 +183,8 @@ class Variant:
         return cls(**kwargs)
 
     def _compose(self) -> str:
-        scheme = f"{self.flux}/{self.reconstruction}"
-        if self.reconstruction == "muscl":
-            scheme += f"/{self.limiter}"
-        hyp = "" if self.hyperbolicity == "exact" else f"@{self.hyperbolicity}"
-        if self.solver == "fv-split":
-            split = "" if self.splitting == "lie" else f"+{self.splitting}"
-            return f"{scheme}{split}{hyp}"
-        mol = {v: k for k, v in MOL_SOLVERS.items()}.get(self.solver, f"mol-{self.solver}")
-        if scheme == "hll/first-order":
-            return f"{mol}{hyp}"
-        return f"{mol}:{scheme}{hyp}"
+        return _compose(self.scheme.spatial, self.splitting, self.hyperbolicity,
+                        self.solver)
 
     @property
     def name(self) -> str:
@@ -196,6 +224,18 @@ class Variant:
         if self.solver == "fv-split":
             out["splitting"] = self.splitting
         return out
+
+
+def _compose(spatial: str, splitting: str, hyperbolicity: str, solver: str) -> str:
+    """The name of a variant from its parts (the scheme's spatial name)."""
+    hyp = "" if hyperbolicity == "exact" else f"@{hyperbolicity}"
+    if solver == "fv-split":
+        split = "" if splitting == "lie" else f"+{splitting}"
+        return f"{spatial}{split}{hyp}"
+    mol = {v: k for k, v in MOL_SOLVERS.items()}.get(solver, f"mol-{solver}")
+    if spatial == "hll/first-order":
+        return f"{mol}{hyp}"
+    return f"{mol}:{spatial}{hyp}"
 
 
 def variant_of(numerics: dict[str, Any], hyperbolicity: str = "exact") -> Variant:
