@@ -87,7 +87,7 @@ class RunResult:
         """F_extra/rho1 of the last step, per cell [m^2/s^2] (zeros for one layer)."""
         if self.diagnostics is None:
             return np.zeros(self.x.size)
-        return self.diagnostics.fextra_over_rho1.copy()
+        return self.diagnostics.cells.copy()
 
     def final_arrays(self) -> dict[str, np.ndarray]:
         """x, depths and velocities of the final state (keys as in the ``--final`` npz)."""
@@ -222,7 +222,9 @@ class Run:
                 f"a negative depth); nothing is kept. Use a smaller numerics.dt, or the "
                 f"fv-split solver (CFL-limited).",
                 report={"variant": self.variant.name}, state=final.data.copy())
-        diag = (SplitDiagnostics.from_array(data, self.pde.system.diagnostics)
+        system = self.pde.system
+        diag = (SplitDiagnostics.from_array(data, system.diagnostics,
+                                            system.cell_diagnostic)
                 if isinstance(data, np.ndarray) and not self.variant.is_mol else None)
         t_final = float(sinfo.get("rest_time", info["controller"].get("t_final",
                                                                       case.t_end)))
@@ -340,7 +342,7 @@ def summarize(res: RunResult, mass0: float, wall: float,
     out: dict[str, Any] = {
         "model": res.model,
         "solver": case.solver,
-        "geometry": case.geometry,
+        "geometry": metric.geometry,  # from the grid
         "bed": case.bed_kind(res.model),
         "t_final": res.t_final,
         "at_rest": at_rest,
