@@ -89,6 +89,11 @@ def _choice(what: str, value: str, allowed: tuple[str, ...], name: str | None) -
         raise VariantError(f"{err}{why}") from None
 
 
+def _of_scheme(field: str, what: str) -> Any:
+    """A read-only property: the scheme's ``field``."""
+    return property(lambda self: getattr(self.scheme, field), doc=f"The scheme's {what}.")
+
+
 @dataclass(frozen=True, init=False)
 class Variant:
     """How a case is solved: a :class:`~pdeflow.numerics.scheme.Scheme` (flux,
@@ -128,25 +133,10 @@ class Variant:
             raise VariantError(f"variant {name!r}: splitting applies to the fv-split "
                                "solver only (the method of lines does not split)")
 
-    @property
-    def flux(self) -> str:
-        """The scheme's interface flux."""
-        return self.scheme.flux
-
-    @property
-    def reconstruction(self) -> str:
-        """The scheme's reconstruction."""
-        return self.scheme.reconstruction
-
-    @property
-    def limiter(self) -> str:
-        """The scheme's slope limiter (of 'muscl')."""
-        return self.scheme.limiter
-
-    @property
-    def splitting(self) -> str:
-        """The scheme's splitting (fv-split only)."""
-        return self.scheme.splitting
+    flux = _of_scheme("flux", "interface flux")
+    reconstruction = _of_scheme("reconstruction", "reconstruction")
+    limiter = _of_scheme("limiter", "slope limiter (of 'muscl')")
+    splitting = _of_scheme("splitting", "splitting (fv-split only)")
 
     # --- names ---------------------------------------------------------------------------
     @classmethod
