@@ -44,6 +44,8 @@ def test_the_pde_assembles_a_model_and_a_scheme():
     assert by_name.scheme == by_fields.scheme == Scheme("rusanov", "muscl", "mc",
                                                         "strang")
     assert pdeflow.SingleLayerGranular().scheme == Scheme()
+    given = pdeflow.Scheme(flux="ifcp")  # the package's name for it
+    assert pdeflow.SingleLayerGranular(scheme=given).scheme is given
     assert not hasattr(by_name, "scheme_codes") and not hasattr(by_name, "variant")
     with pytest.raises(ValueError, match="the scheme or its fields, not both"):
         pdeflow.SingleLayerGranular(scheme=Scheme(), flux="hll")
@@ -78,6 +80,7 @@ def test_a_case_builds_its_pde_with_its_variants_scheme():
     assert run.pde.scheme == run.variant.scheme == Scheme("hll", "muscl", "minmod",
                                                           "strang")
     assert "splitting" not in run.solver_arguments()  # the solver reads the PDE's
+    assert run.make_solver().scheme is run.pde.scheme
 
 
 def test_the_geometry_of_the_steppers_comes_from_the_grid():
