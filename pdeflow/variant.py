@@ -94,39 +94,34 @@ def _of_scheme(field: str, what: str) -> Any:
     return property(lambda self: getattr(self.scheme, field), doc=f"The scheme's {what}.")
 
 
-@dataclass(frozen=True, init=False)
+def _scheme(name: str | None, *fields: str) -> Scheme:
+    """``Scheme(*fields)``, or VariantError naming the variant ``name``."""
+    try:
+        return Scheme(*fields)
+    except SchemeError as err:
+        where = f"variant {name!r}: " if name else ""
+        raise VariantError(f"{where}{err}") from None
+
+
+@dataclass(frozen=True)
 class Variant:
     """How a case is solved: a :class:`~pdeflow.numerics.scheme.Scheme` (flux,
     reconstruction, limiter, splitting), the hyperbolicity treatment and the integrator.
 
     ``solver`` is ``"fv-split"`` (the paper's split scheme, a CFL time step) or a
     py-pde solver name run with a fixed step on the method-of-lines rate (see
-    :data:`MOL_SOLVERS`); the scheme's splitting applies to fv-split only. Built from
-    the scheme's fields (``Variant(flux="rusanov")``) or from a scheme
-    (``Variant(scheme=Scheme(...))``); ``flux``, ``reconstruction``, ``limiter`` and
-    ``splitting`` read the scheme.
+    :data:`MOL_SOLVERS`); the scheme's splitting applies to fv-split only. ``flux``,
+    ``reconstruction``, ``limiter`` and ``splitting`` read the scheme.
     """
 
-    scheme: Scheme
-    hyperbolicity: str
-    solver: str
+    scheme: Scheme = Scheme()
+    hyperbolicity: str = "exact"
+    solver: str = "fv-split"
 
-    def __init__(self, flux: str = "hll", reconstruction: str = "first-order",
-                 limiter: str = "minmod", splitting: str = "lie",
-                 hyperbolicity: str = "exact", solver: str = "fv-split", *,
-                 scheme: Scheme | None = None):
-        if scheme is None:
-            name = _compose(f"{flux}/{reconstruction}" + (
-                f"/{limiter}" if reconstruction == "muscl" else ""), splitting,
-                hyperbolicity, solver)
-            try:
-                scheme = Scheme(flux, reconstruction, limiter, splitting)
-            except SchemeError as err:
-                raise VariantError(f"variant {name!r}: {err}") from None
-        object.__setattr__(self, "scheme", scheme)
-        object.__setattr__(self, "hyperbolicity", hyperbolicity)
-        object.__setattr__(self, "solver", solver)
-        name = self._compose()
+    def __post_init__(self) -> None:
+        if not isinstance(self.scheme, Scheme):
+            raise VariantError(f"scheme must be a Scheme, got {self.scheme!r}")
+        name = self.name
         _choice("hyperbolicity", self.hyperbolicity, HYPERBOLICITY, name)
         _choice("solver", self.solver, tuple(solver_names()), name)
         if self.solver != "fv-split" and self.splitting != "lie":
@@ -165,21 +160,22 @@ class Variant:
                 raise VariantError(f"variant {text!r}: the method of lines must be one "
                                    f"of {known}, got {parts['mol']!r}{why}")
             kwargs["solver"] = solver
-        else:
-            kwargs["splitting"] = parts.get("split") or "lie"
-        if parts.get("flux"):
-            kwargs.update(flux=parts["flux"], reconstruction=parts["rec"],
-                          limiter=parts.get("lim") or "minmod")
-        return cls(**kwargs)
-
-    def _compose(self) -> str:
-        return _compose(self.scheme.spatial, self.splitting, self.hyperbolicity,
-                        self.solver)
+        splitting = parts.get("split") or "lie"
+        scheme = (parts["flux"], parts["rec"], parts.get("lim") or "minmod") \
+            if parts.get("flux") else ("hll", "first-order", "minmod")
+        return cls(_scheme(text, *scheme, splitting), **kwargs)
 
     @property
     def name(self) -> str:
         """Canonical name (defaults left out); ``Variant.parse(v.name) == v``."""
-        return self._compose()
+        hyp = "" if self.hyperbolicity == "exact" else f"@{self.hyperbolicity}"
+        if self.solver == "fv-split":
+            return f"{self.scheme.name}{hyp}"
+        mol = {v: k for k, v in MOL_SOLVERS.items()}.get(self.solver,
+                                                         f"mol-{self.solver}")
+        if self.scheme.spatial == "hll/first-order":
+            return f"{mol}{hyp}"
+        return f"{mol}:{self.scheme.spatial}{hyp}"
 
     def __str__(self) -> str:
         return self.name
@@ -216,18 +212,6 @@ class Variant:
         return out
 
 
-def _compose(spatial: str, splitting: str, hyperbolicity: str, solver: str) -> str:
-    """The name of a variant from its parts (the scheme's spatial name)."""
-    hyp = "" if hyperbolicity == "exact" else f"@{hyperbolicity}"
-    if solver == "fv-split":
-        split = "" if splitting == "lie" else f"+{splitting}"
-        return f"{spatial}{split}{hyp}"
-    mol = {v: k for k, v in MOL_SOLVERS.items()}.get(solver, f"mol-{solver}")
-    if spatial == "hll/first-order":
-        return f"{mol}{hyp}"
-    return f"{mol}:{spatial}{hyp}"
-
-
 def variant_of(numerics: dict[str, Any], hyperbolicity: str = "exact") -> Variant:
     """The variant that a case file's ``[numerics]`` table and two-layer
     ``hyperbolicity`` select; VariantError names the case file's key that is wrong."""
@@ -244,4 +228,6 @@ def variant_of(numerics: dict[str, Any], hyperbolicity: str = "exact") -> Varian
     if fields["solver"] != "fv-split":
         fields["splitting"] = "lie"  # the method of lines does not split
     _choice("two_layer.hyperbolicity", hyperbolicity, HYPERBOLICITY, None)
-    return Variant(hyperbolicity=hyperbolicity, **fields)
+    scheme = _scheme(None, *(fields[k] for k in ("flux", "reconstruction", "limiter",
+                                                  "splitting")))
+    return Variant(scheme, hyperbolicity, fields["solver"])

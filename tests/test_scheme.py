@@ -15,7 +15,7 @@ from pdeflow.numerics.scheme import MAX_CFL, Scheme, SchemeError
 from pdeflow.numerics.splitting import scheme_stepper
 from pdeflow.simulate import Run, case_steppers
 from pdeflow.solvers import FVSplitSolver
-from pdeflow.variant import Variant, VariantError
+from pdeflow.variant import Variant, VariantError, variant_of
 
 CASES = Path(__file__).parents[1] / "cases"
 
@@ -69,7 +69,9 @@ def test_a_variant_is_a_scheme_with_a_hyperbolicity_treatment_and_an_integrator(
                                                                   "strang")
     assert Variant(scheme=v.scheme, hyperbolicity="bound") == v
     with pytest.raises(VariantError, match=r"^variant 'roe/first-order': flux must be"):
-        Variant(flux="roe")
+        Variant.parse("roe/first-order")
+    with pytest.raises(VariantError, match=r"^numerics.flux must be one of"):
+        variant_of({"flux": "roe"})
 
 
 def test_a_case_builds_its_pde_with_its_variants_scheme():
