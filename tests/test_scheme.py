@@ -95,3 +95,18 @@ def test_the_geometry_of_the_steppers_comes_from_the_grid():
         assert stepper is scheme_stepper(eq.kernels, *eq.scheme.codes, False,
                                          L.GEOMETRY_AXISYMMETRIC)
         assert Run(case, model).metric.geometry == "axisymmetric"
+
+
+def test_a_run_derives_its_grids_metric_once(monkeypatch):
+    """The run, its solver and its summary share one metric of the grid."""
+    from pdeflow.models import base
+
+    calls = []
+    real = base.metric_of
+    monkeypatch.setattr(base, "metric_of", lambda grid: calls.append(grid) or real(grid))
+    case = load_case(CASES / "ritter_dam_break.toml", ["grid.cells=20",
+                                                      "case.t_end=0.05"])
+    run = Run(case, "single_layer")
+    result = run.execute()
+    assert len(calls) == 1 and result.metric is run.metric
+    assert run.pde.metric(case.make_grid()) is not run.metric  # another grid: its own

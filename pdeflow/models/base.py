@@ -275,11 +275,15 @@ class GranularPDE(PDEBase):
         return geometry
 
     def metric(self, grid: Any) -> Metric:
-        """The finite-volume metric of ``grid`` (:func:`~pdeflow.numerics.geometry.metric_of`:
-        the geometry derived once, from the grid), checked against the boundaries."""
-        metric = metric_of(grid)
-        self._check_geometry(metric.geometry)
-        return metric
+        """The finite-volume metric of ``grid`` (:func:`~pdeflow.numerics.geometry.metric_of`),
+        checked against the boundaries; derived once per grid (the last grid's is kept:
+        a run, its solver and its summary share it)."""
+        last = self.__dict__.get("_metric")
+        if last is None or last[0] is not grid:
+            metric = metric_of(grid)
+            self._check_geometry(metric.geometry)
+            self._metric = (grid, metric)
+        return self._metric[1]
 
     def make_state(self, grid: CartesianGrid, **profiles: np.ndarray) -> FieldCollection:
         """State from depth and velocity profiles (names: the system's
