@@ -112,12 +112,8 @@ def case_steppers(case: Case) -> list[Stepper]:
     before the runs, all at once."""
     if case.solver != "fv-split":
         return []
-    grid = case.make_grid()
-    steppers = []
-    for model in case.models:
-        pde = case.make_pde(model)
-        steppers.append(split_stepper(pde, pde.metric(grid)))
-    return steppers
+    grid = case.make_grid()  # the geometry comes from the grid
+    return [split_stepper(pde, pde.metric(grid)) for pde in map(case.make_pde, case.models)]
 
 
 class Run:
