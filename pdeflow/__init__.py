@@ -14,12 +14,14 @@ from .models import (  # noqa: E402
     TwoLayerGranular,
     TwoLayerParameters,
 )
+from .numerics.scheme import Scheme  # noqa: E402
 from .solvers import FVSplitSolver, SimulationBlowUp  # noqa: E402
 
 __version__ = "0.1.0"
 
 __all__ = [
     "FVSplitSolver",
+    "Scheme",
     "SimulationBlowUp",
     "SingleLayerGranular",
     "SingleLayerParameters",

@@ -287,10 +287,9 @@ class Case:
         """The PDE of the registered model ``model`` with this case's parameters,
         boundaries and scheme."""
         system = systems.get(model)
-        num = self.data.get("numerics", {})
-        scheme = {k: num[k] for k in ("flux", "reconstruction", "limiter") if k in num}
         try:
-            return system.pde_class(self.data.get(model, {}), bc=self.bc, **scheme)
+            return system.pde_class(self.data.get(model, {}), bc=self.bc,
+                                    scheme=self.variant.scheme)
         except ValueError as err:
             raise self._err(f"[numerics] {err}") from None
 

@@ -11,8 +11,6 @@ from __future__ import annotations
 
 import time
 import warnings
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -46,12 +44,12 @@ from .metrics import (
 )
 from .models.base import GranularPDE
 from .numerics import layout as L
-from .numerics.layout import GEOMETRIES
-from .numerics.splitting import Stepper, scheme_stepper
+from .numerics.geometry import Metric
+from .numerics.splitting import Stepper
 from .numerics.state import velocity_profile
 from .numerics.warmup import prepare
 from .solvers.diagnostics import SplitDiagnostics
-from .solvers.fv_split import SimulationBlowUp, scheme_codes
+from .solvers.fv_split import SimulationBlowUp, split_stepper
 from .trackers import FextraStorageTracker
 from .trackers.series import SeriesTracker
 from .variant import Variant
@@ -69,6 +67,8 @@ class RunResult:
     diagnostics: SplitDiagnostics | None
     """the fv-split solver's record (None for py-pde's solvers)"""
     info: dict[str, Any]
+    metric: Metric
+    """the grid's finite-volume metric (its geometry, face areas, cell volumes)"""
     snapshots: dict[float, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
     """t -> (state data, F_extra/rho1 per cell)"""
     summary: dict[str, Any] = field(default_factory=dict)
@@ -87,7 +87,7 @@ class RunResult:
         """F_extra/rho1 of the last step, per cell [m^2/s^2] (zeros for one layer)."""
         if self.diagnostics is None:
             return np.zeros(self.x.size)
-        return self.diagnostics.fextra_over_rho1.copy()
+        return self.diagnostics.cells.copy()
 
     def final_arrays(self) -> dict[str, np.ndarray]:
         """x, depths and velocities of the final state (keys as in the ``--final`` npz)."""
@@ -112,9 +112,8 @@ def case_steppers(case: Case) -> list[Stepper]:
     before the runs, all at once."""
     if case.solver != "fv-split":
         return []
-    geometry = GEOMETRIES[case.geometry]
-    return [scheme_stepper(*scheme_codes(case.make_pde(m), case.splitting, geometry))
-            for m in case.models]
+    grid = case.make_grid()  # the geometry comes from the grid
+    return [split_stepper(pde, pde.metric(grid)) for pde in map(case.make_pde, case.models)]
 
 
 class Run:
@@ -126,8 +125,10 @@ class Run:
         variant: how to solve it; default: what the case file selects.
         backend: ``"numba"`` (compiled stepping loop) or ``"numpy"`` (fv-split only).
 
-    Attributes ``case``, ``variant``, ``pde`` and ``state`` (the initial state) are built
-    here, once; :meth:`execute` may be called more than once (it never changes them).
+    Attributes ``case``, ``variant``, ``pde`` (with the variant's scheme), ``state``
+    (the initial state) and ``metric`` (of its grid: the geometry, derived from the grid
+    once) are built here, once; :meth:`execute` may be called more than once (it never
+    changes them).
     """
 
     def __init__(self, case: Case, model: str, variant: Variant | str | None = None, *,
@@ -139,6 +140,7 @@ class Run:
         self.model = model
         self.backend = backend
         self.pde, self.state = self.case.make_state(model)
+        self.metric = self.pde.metric(self.state.grid)
 
     def solver_arguments(self) -> dict[str, Any]:
         """Keyword arguments of py-pde's ``solve`` that select the integrator."""
@@ -146,7 +148,7 @@ class Run:
             return {"solver": self.variant.solver,
                     "dt": float(self.case.data.get("numerics", {}).get("dt", 1e-4))}
         return {"solver": "fv-split", "cfl": self.case.cfl, "backend": self.backend,
-                "splitting": self.variant.splitting, "outputs": self.case.frames}
+                "outputs": self.case.frames}  # the scheme is the PDE's
 
     def make_solver(self) -> Any:
         """The py-pde solver of this run (for timing the bare stepper, as the
@@ -172,7 +174,7 @@ class Run:
                         cost_warning(case, model)):
             if message:
                 warnings.warn(message, RunWarning, stacklevel=2)
-        mass0 = mass(self.state.data, self.pde.metric(self.state.grid).cells,
+        mass0 = mass(self.state.data, self.metric.cells,
                      self.pde.system.densities(self.pde.parameters))
         snaps = FextraStorageTracker(sorted(case.snapshot_times))
         trackers: list[Any] = [snaps] if case.snapshot_times else []
@@ -186,15 +188,14 @@ class Run:
         if not self.variant.is_mol and self.backend == "numba":
             # compiling (first run on a machine) or loading the kernels is not the run's
             # wall time, nor should it hold up its progress bar
-            prepare(scheme_stepper(*scheme_codes(self.pde, self.variant.splitting,
-                                                 GEOMETRIES[case.geometry])))
-        with _observer_clock(observers) as observed:
-            wall0 = time.perf_counter()
-            final, info = self.pde.solve(self.state, t_range=case.t_end,
-                                         tracker=trackers, ret_info=True,
-                                         **self.solver_arguments())
-            # the run alone: a movie or a live plot takes longer than the run itself
-            wall = time.perf_counter() - wall0 - observed[0]
+            prepare(split_stepper(self.pde, self.metric))
+        wall0 = time.perf_counter()
+        final, info = self.pde.solve(self.state, t_range=case.t_end, tracker=trackers,
+                                     ret_info=True, **self.solver_arguments())
+        # fv-split's wall time is its stepping alone (a movie or a live plot takes
+        # longer than the run itself); py-pde's solvers have no clock of their own:
+        # the whole solve, observers included
+        wall = info.get("solver", {}).get("wall_time", time.perf_counter() - wall0)
         stop = str(info.get("controller", {}).get("stop_reason", ""))
         from .interrupts import RunInterrupted, received
 
@@ -217,13 +218,15 @@ class Run:
                 f"a negative depth); nothing is kept. Use a smaller numerics.dt, or the "
                 f"fv-split solver (CFL-limited).",
                 report={"variant": self.variant.name}, state=final.data.copy())
-        diag = (SplitDiagnostics.from_array(data, self.pde.system.diagnostics)
+        system = self.pde.system
+        diag = (SplitDiagnostics.from_array(data, system.diagnostics,
+                                            system.cell_diagnostic)
                 if isinstance(data, np.ndarray) and not self.variant.is_mol else None)
         t_final = float(sinfo.get("rest_time", info["controller"].get("t_final",
                                                                       case.t_end)))
         if diag is not None and diag.t > 0:
             t_final = diag.t
-        result = RunResult(model, case, self.pde, final, t_final, diag, info)
+        result = RunResult(model, case, self.pde, final, t_final, diag, info, self.metric)
         result.snapshots = snaps.snapshots
         if series is not None:
             result.frames = series.frames
@@ -234,49 +237,13 @@ class Run:
         return result
 
 
-@contextmanager
-def _observer_clock(trackers: list[Any]) -> Iterator[list[float]]:
-    """Within the block, the wall time [s] the ``trackers`` spend in their py-pde calls
-    (initialize, handle, finalize) adds up in the list's one item: the time of a run's
-    observers (movie, live plot, progress, storage), which the run's wall time leaves
-    out."""
-    spent = [0.0]
-    depth = [0]  # a tracker's call may make another (e.g. finalize a handle): once
-
-    def timed(call: Any) -> Any:
-        def wrapper(*args: Any, **kwargs: Any) -> Any:
-            depth[0] += 1
-            t0 = time.perf_counter()
-            try:
-                return call(*args, **kwargs)
-            finally:
-                depth[0] -= 1
-                if depth[0] == 0:
-                    spent[0] += time.perf_counter() - t0
-        return wrapper
-
-    from pde.trackers.base import TrackerBase
-
-    trackers = [t for t in trackers if isinstance(t, TrackerBase)]  # not names
-    names = ("initialize", "handle", "finalize")
-    for t in trackers:
-        for name in names:
-            setattr(t, name, timed(getattr(t, name)))
-    try:
-        yield spent
-    finally:
-        for t in trackers:  # the instance's wrappers go; its class's methods remain
-            for name in names:
-                t.__dict__.pop(name, None)
-
-
 def run_series(res: RunResult, tracker: SeriesTracker) -> ErosionSeries:
     """The erosion series of the run ``res`` from the frames of ``tracker``: fronts above
     the initial bed and, for a model with an erodible layer, the bed's erosion (booked
     exchange volumes on a planar grid only, as in the summary)."""
     case = res.case
     times, frames = tracker.frames
-    metric = res.pde.metric(res.state.grid)
+    metric = res.metric
     xs = res.x - case.x_start
     bed0 = case.bed(res.model, xs)
     layer = res.pde.system.bed_layer
@@ -345,7 +312,7 @@ def mass_front(res: RunResult, bed: np.ndarray | None = None) -> float | None:
     :func:`pdeflow.metrics.front_position` measures above the bed), else of the
     layers' mass (relative densities)."""
     d = res.state.data
-    metric = res.pde.metric(res.state.grid)
+    metric = res.metric
     depth = (weighted_depth(d, res.pde.system.densities(res.pde.parameters)) if bed is None
              else total_depth(d) - bed)
     return mass_quantile_position(metric.faces, metric.volumes, depth,
@@ -361,7 +328,7 @@ def summarize(res: RunResult, mass0: float, wall: float,
     dx = case.dx
     d = res.state.data
     weights = res.pde.system.densities(res.pde.parameters)
-    metric = res.pde.metric(res.state.grid)
+    metric = res.metric
     cells = metric.cells
     bed = case.bed(res.model, res.x - case.x_start)
     front = front_position(res.x, d, case.front_threshold, dx, bed)
@@ -371,7 +338,7 @@ def summarize(res: RunResult, mass0: float, wall: float,
     out: dict[str, Any] = {
         "model": res.model,
         "solver": case.solver,
-        "geometry": case.geometry,
+        "geometry": metric.geometry,  # from the grid
         "bed": case.bed_kind(res.model),
         "t_final": res.t_final,
         "at_rest": at_rest,

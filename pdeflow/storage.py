@@ -82,13 +82,13 @@ def require_h5py() -> None:
 # --- metadata -----------------------------------------------------------------------------
 def _variant_parts(case: Any, eq: Any) -> list[str]:
     """What distinguishes this run's numerics and closure from the paper's defaults:
-    the PDE's scheme (``eq.variant``, e.g. 'hll/first-order'), the splitting, for
+    the PDE's scheme (``eq.scheme.spatial``, e.g. 'hll/first-order'), the splitting, for
     two layers the exchange closure and the hyperbolicity mode, and a basal friction
     law other than Coulomb's."""
     num = case.data.get("numerics", {})
     parts = [case.solver]
-    if getattr(eq, "variant", None):
-        parts.append(str(eq.variant))
+    if getattr(eq, "scheme", None):
+        parts.append(eq.scheme.spatial)
     else:
         parts += [f"{k}={num[k]}" for k in ("flux", "reconstruction", "limiter") if k in num]
     splitting = getattr(case, "splitting", num.get("splitting"))

@@ -84,6 +84,11 @@ class EquationSystem:
     """the keys :attr:`summarize` adds to the common summary"""
     has_fextra: bool = False
     """whether F_extra (the hyperbolicity-restoring exchange) is part of the model"""
+    cell_diagnostic: str | None = None
+    """the name of the model's per-cell diagnostic of the last step (what its source
+    stage writes after the scheme's slots of the diagnostics array, e.g.
+    'fextra_over_rho1'), as :class:`~pdeflow.solvers.diagnostics.SplitDiagnostics` reads
+    it; None: the model writes none (the values stay 0)"""
     bytes_per_cell: int = 200
     """peak memory of a run per cell [bytes] (see pdeflow.checks): tracemalloc's peak
     over a run on 200,000 cells without snapshots, rounded up (312 bytes two layers,

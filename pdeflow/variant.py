@@ -23,15 +23,20 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-from .models.base import MAX_CFL as BASE_MAX_CFL
-from .numerics import layout as L
+from .numerics.scheme import (
+    FLUXES,
+    LIMITERS,
+    MAX_CFL,
+    RECONSTRUCTIONS,
+    SPLITTINGS,
+    Scheme,
+    SchemeError,
+    check_choice,
+)
 
-FLUXES: tuple[str, ...] = tuple(L.FLUXES)
-RECONSTRUCTIONS: tuple[str, ...] = tuple(L.RECONSTRUCTIONS)
-MAX_CFL = BASE_MAX_CFL
-"""The largest Courant number of each reconstruction (see pdeflow.models.base)."""
-LIMITERS: tuple[str, ...] = tuple(L.LIMITERS)
-SPLITTINGS: tuple[str, ...] = ("lie", "strang")
+__all__ = ["FLUXES", "HYPERBOLICITY", "LIMITERS", "MAX_CFL", "RECONSTRUCTIONS",
+           "SPLITTINGS", "Scheme", "Variant", "VariantError", "variant_of"]
+
 HYPERBOLICITY: tuple[str, ...] = ("exact", "bound", "none")
 MOL_SOLVERS: dict[str, str] = {"mol-rk": "runge-kutta", "mol-euler": "euler"}
 """short method-of-lines names -> py-pde solver names; any other py-pde solver is
@@ -70,46 +75,63 @@ def solver_names() -> list[str]:
     return sorted(names, key=lambda n: (n != "fv-split", n))
 
 
-class VariantError(ValueError):
+class VariantError(SchemeError):
     """A variant name or field that is not one of the allowed choices."""
 
 
 def _choice(what: str, value: str, allowed: tuple[str, ...], name: str | None) -> None:
-    if value not in allowed:
-        where = f"variant {name!r}: " if name else ""
+    where = f"variant {name!r}: " if name else ""
+    try:
+        check_choice(what, value, allowed, where)
+    except SchemeError as err:
         why = (f" (py-pde's {value!r} cannot run a case: {UNFIT_SOLVERS[value]})"
                if what.endswith("solver") and value in UNFIT_SOLVERS else "")
-        raise VariantError(f"{where}{what} must be one of {list(allowed)}, got "
-                           f"{value!r}{why}")
+        raise VariantError(f"{err}{why}") from None
+
+
+def _of_scheme(field: str, what: str) -> Any:
+    """A read-only property: the scheme's ``field``."""
+    return property(lambda self: getattr(self.scheme, field), doc=f"The scheme's {what}.")
+
+
+def _scheme(name: str | None, *fields: str) -> Scheme:
+    """``Scheme(*fields)``, or VariantError naming the variant ``name``."""
+    try:
+        return Scheme(*fields)
+    except SchemeError as err:
+        where = f"variant {name!r}: " if name else ""
+        raise VariantError(f"{where}{err}") from None
 
 
 @dataclass(frozen=True)
 class Variant:
-    """How a case is solved: discretisation, splitting, hyperbolicity, integrator.
+    """How a case is solved: a :class:`~pdeflow.numerics.scheme.Scheme` (flux,
+    reconstruction, limiter, splitting), the hyperbolicity treatment and the integrator.
 
     ``solver`` is ``"fv-split"`` (the paper's split scheme, a CFL time step) or a
     py-pde solver name run with a fixed step on the method-of-lines rate (see
-    :data:`MOL_SOLVERS`); ``splitting`` applies to fv-split only.
+    :data:`MOL_SOLVERS`); the scheme's splitting applies to fv-split only. ``flux``,
+    ``reconstruction``, ``limiter`` and ``splitting`` read the scheme.
     """
 
-    flux: str = "hll"
-    reconstruction: str = "first-order"
-    limiter: str = "minmod"
-    splitting: str = "lie"
+    scheme: Scheme = Scheme()
     hyperbolicity: str = "exact"
     solver: str = "fv-split"
 
     def __post_init__(self) -> None:
-        name = self._compose()
-        _choice("flux", self.flux, FLUXES, name)
-        _choice("reconstruction", self.reconstruction, RECONSTRUCTIONS, name)
-        _choice("limiter", self.limiter, LIMITERS, name)
-        _choice("splitting", self.splitting, SPLITTINGS, name)
+        if not isinstance(self.scheme, Scheme):
+            raise VariantError(f"scheme must be a Scheme, got {self.scheme!r}")
+        name = self.name
         _choice("hyperbolicity", self.hyperbolicity, HYPERBOLICITY, name)
         _choice("solver", self.solver, tuple(solver_names()), name)
         if self.solver != "fv-split" and self.splitting != "lie":
             raise VariantError(f"variant {name!r}: splitting applies to the fv-split "
                                "solver only (the method of lines does not split)")
+
+    flux = _of_scheme("flux", "interface flux")
+    reconstruction = _of_scheme("reconstruction", "reconstruction")
+    limiter = _of_scheme("limiter", "slope limiter (of 'muscl')")
+    splitting = _of_scheme("splitting", "splitting (fv-split only)")
 
     # --- names ---------------------------------------------------------------------------
     @classmethod
@@ -138,30 +160,22 @@ class Variant:
                 raise VariantError(f"variant {text!r}: the method of lines must be one "
                                    f"of {known}, got {parts['mol']!r}{why}")
             kwargs["solver"] = solver
-        else:
-            kwargs["splitting"] = parts.get("split") or "lie"
-        if parts.get("flux"):
-            kwargs.update(flux=parts["flux"], reconstruction=parts["rec"],
-                          limiter=parts.get("lim") or "minmod")
-        return cls(**kwargs)
-
-    def _compose(self) -> str:
-        scheme = f"{self.flux}/{self.reconstruction}"
-        if self.reconstruction == "muscl":
-            scheme += f"/{self.limiter}"
-        hyp = "" if self.hyperbolicity == "exact" else f"@{self.hyperbolicity}"
-        if self.solver == "fv-split":
-            split = "" if self.splitting == "lie" else f"+{self.splitting}"
-            return f"{scheme}{split}{hyp}"
-        mol = {v: k for k, v in MOL_SOLVERS.items()}.get(self.solver, f"mol-{self.solver}")
-        if scheme == "hll/first-order":
-            return f"{mol}{hyp}"
-        return f"{mol}:{scheme}{hyp}"
+        splitting = parts.get("split") or "lie"
+        scheme = (parts["flux"], parts["rec"], parts.get("lim") or "minmod") \
+            if parts.get("flux") else ("hll", "first-order", "minmod")
+        return cls(_scheme(text, *scheme, splitting), **kwargs)
 
     @property
     def name(self) -> str:
         """Canonical name (defaults left out); ``Variant.parse(v.name) == v``."""
-        return self._compose()
+        hyp = "" if self.hyperbolicity == "exact" else f"@{self.hyperbolicity}"
+        if self.solver == "fv-split":
+            return f"{self.scheme.name}{hyp}"
+        mol = {v: k for k, v in MOL_SOLVERS.items()}.get(self.solver,
+                                                         f"mol-{self.solver}")
+        if self.scheme.spatial == "hll/first-order":
+            return f"{mol}{hyp}"
+        return f"{mol}:{self.scheme.spatial}{hyp}"
 
     def __str__(self) -> str:
         return self.name
@@ -214,4 +228,6 @@ def variant_of(numerics: dict[str, Any], hyperbolicity: str = "exact") -> Varian
     if fields["solver"] != "fv-split":
         fields["splitting"] = "lie"  # the method of lines does not split
     _choice("two_layer.hyperbolicity", hyperbolicity, HYPERBOLICITY, None)
-    return Variant(hyperbolicity=hyperbolicity, **fields)
+    scheme = _scheme(None, *(fields[k] for k in ("flux", "reconstruction", "limiter",
+                                                  "splitting")))
+    return Variant(scheme, hyperbolicity, fields["solver"])

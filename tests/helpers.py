@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import importlib
 import os
 import sys
@@ -14,7 +15,7 @@ import pytest
 from pde import CartesianGrid
 
 import pdeflow
-from pdeflow.numerics.splitting import scheme_stepper
+from pdeflow.solvers.fv_split import split_stepper
 
 
 def grid(n: int = 100, lo: float = 0.0, hi: float = 1.0) -> CartesianGrid:
@@ -27,7 +28,8 @@ def step(eq, state, t_end: float, cfl: float = 0.3, stop_at_rest: bool = False,
     q = state.data.copy()
     diag = eq.new_diagnostics(q.shape[1])
     metric = eq.metric(state.grid)
-    stepper = scheme_stepper(eq.kernels, *eq.scheme_codes, strang, metric.code)
+    scheme = dataclasses.replace(eq.scheme, splitting="strang" if strang else "lie")
+    stepper = split_stepper(eq, metric, scheme)
     t, steps, status = stepper(q, 0.0, t_end, metric.dx, metric.array(), *eq.bc_codes,
                                eq.parameter_array(), cfl, diag, np.empty_like(q),
                                np.empty_like(q), np.empty((3, *q.shape)), max_steps,

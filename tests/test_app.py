@@ -165,7 +165,7 @@ def test_scheme_and_case_choices_become_overrides():
     assert page.controls.overrides() == [
         "numerics.flux='ifcp'", "numerics.reconstruction='muscl'",
         "numerics.limiter='mc'", "numerics.splitting='strang'"]
-    assert page.run.case.make_pde("two_layer").variant == "ifcp/muscl/mc"
+    assert page.run.case.make_pde("two_layer").scheme.name == "ifcp/muscl/mc+strang"
     page.controls.case_select.value = "ritter_dam_break.toml"  # one model, no column
     assert page.run.case.models == ["single_layer"]
     for name in ("H0", "L0", "phi_b_two", "k", "c", "density_ratio"):

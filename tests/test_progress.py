@@ -17,7 +17,6 @@ import pdeflow
 from pdeflow.cases import load_case
 from pdeflow.cli import build_parser
 from pdeflow.numerics import warmup
-from pdeflow.numerics.splitting import scheme_stepper
 from pdeflow.solvers import fv_split
 from pdeflow.trackers import ProgressBar
 
@@ -108,8 +107,8 @@ def test_prepare_says_when_it_compiles(monkeypatch):
     """``pdeflow run`` compiles (or loads) the kernels before its runs and, when it has
     to compile them, says so with the time it took."""
     log = io.StringIO()
-    eq, _ = _readme_state()
-    stepper = scheme_stepper(*fv_split.scheme_codes(eq))
+    eq, state = _readme_state()
+    stepper = fv_split.split_stepper(eq, eq.metric(state.grid))
     monkeypatch.setattr(warmup, "status", lambda work=None: warmup.COLD)
     seconds = warmup.prepare(stepper, log=log)
     assert seconds > 0

@@ -6,6 +6,7 @@ import pytest
 import pdeflow
 from pdeflow.analysis import ritter
 from pdeflow.cases import CaseError, load_case
+from pdeflow.numerics.scheme import Scheme
 
 from .helpers import grid, step, two_layer_column
 
@@ -74,6 +75,6 @@ def test_case_file_selects_variant(tmp_path):
     c = load_case(case, ["numerics.flux='rusanov'", "numerics.reconstruction='muscl'",
                          "numerics.splitting='strang'"])
     eq = c.make_pde("two_layer")
-    assert eq.variant == "rusanov/muscl/minmod" and c.splitting == "strang"
+    assert eq.scheme == Scheme("rusanov", "muscl", "minmod", "strang")
     with pytest.raises(CaseError, match="flux must be one of"):
         load_case(case, ["numerics.flux='roe'"])

@@ -376,7 +376,7 @@ def test_ifcp_steps_that_are_not_positive_are_redone_with_hll():
             n = q.shape[1]
             diag = eq.new_diagnostics(n)
             # the bare advection update of this flux from the current state
-            kernels = scheme_stepper(eq.kernels, *eq.scheme_codes, False,
+            kernels = scheme_stepper(eq.kernels, *eq.scheme.codes, False,
                                      L.GEOMETRY_PLANAR).ready()
             P = eq.parameter_array()
             *_, ok, _, _, _ = advect_step_function(1, False)(

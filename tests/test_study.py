@@ -307,14 +307,14 @@ def test_summary_keys_catalogue_matches_the_summaries():
 
 PREPARE_STUDY_KERNELS = r"""
 import json, sys
-from pdeflow.numerics.splitting import scheme_stepper
-from pdeflow.solvers.fv_split import scheme_codes
+from pdeflow.solvers.fv_split import split_stepper
 from pdeflow.study import load_study
 from pdeflow.numerics.warmup import prepare
 from pdeflow.study.evaluate import study_steppers
 spec = load_study(sys.argv[1])
-kernels = [k for m in spec.models() for k in scheme_stepper(
-    *scheme_codes(spec.case.make_pde(m), spec.case.splitting)).kernels]
+grid = spec.case.make_grid()
+pdes = [spec.case.make_pde(m) for m in spec.models()]
+kernels = [k for pde in pdes for k in split_stepper(pde, pde.metric(grid)).kernels]
 before = sum(len(k.signatures) for k in kernels)
 prepare(study_steppers(spec))
 print("SIGNATURES" + json.dumps([before, [len(k.signatures) for k in kernels]]))

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from pdeflow.cases import load_case
-from pdeflow.variant import Variant, VariantError
+from pdeflow.variant import Scheme, Variant, VariantError
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -44,7 +44,7 @@ def test_bad_names_say_what_is_wrong(bad, word):
 
 def test_method_of_lines_does_not_split():
     with pytest.raises(VariantError, match="splitting"):
-        Variant(solver="runge-kutta", splitting="strang")
+        Variant(Scheme(splitting="strang"), solver="runge-kutta")
 
 
 def test_a_case_round_trips_through_its_variant():

@@ -60,12 +60,10 @@ class Problem:
         return self.length / self.cells
 
     def make(self, variant: Variant):
-        """Two-layer PDE (the variant's flux, reconstruction, limiter and hyperbolicity
-        mode) and the initial state."""
+        """Two-layer PDE (the variant's scheme and hyperbolicity mode) and the initial
+        state."""
         grid = CartesianGrid([[0.0, self.length]], self.cells)
-        eq = TwoLayerGranular(bc=self.bc, flux=variant.flux,
-                              reconstruction=variant.reconstruction,
-                              limiter=variant.limiter,
+        eq = TwoLayerGranular(bc=self.bc, scheme=variant.scheme,
                               **{**self.params, "hyperbolicity": variant.hyperbolicity})
         return eq, eq.make_state(grid, **self.profiles(grid.axes_coords[0]))
 

@@ -173,8 +173,7 @@ def case_law(case: Case) -> str:
 
 def case_scheme(case: Case) -> str:
     """The case's fv-split variant by its ``pdeflow compare`` name."""
-    name = case.make_pde(case.models[0]).variant
-    return name + ("+strang" if case.splitting == "strang" else "")
+    return case.make_pde(case.models[0]).scheme.name
 
 
 def toml_value(value: Any) -> str:

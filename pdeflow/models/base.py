@@ -25,14 +25,10 @@ from pde.pdes.base import PDEBase
 
 from ..numerics import layout as L
 from ..numerics.geometry import Metric, geometry_of, metric_of
+from ..numerics.scheme import Scheme
 from ..numerics.state import DRY_TOLERANCE
 
 BC_NAMES = L.BOUNDARIES
-RECONSTRUCTIONS = L.RECONSTRUCTIONS
-MAX_CFL = {"first-order": 1.0, "muscl": 0.5}
-"""The largest Courant number of each reconstruction: the first-order update is positive
-up to 1; MUSCL's SSP-RK2 update with limited slopes keeps depths non-negative only up to
-1/2 (docs/stability.md)."""
 
 
 @functools.cache
@@ -176,8 +172,9 @@ class SharedParameters(ParametersBase):
 
 class GranularPDE(PDEBase):
     """Base of the models' PDE classes (:class:`TwoLayerGranular`,
-    :class:`SingleLayerGranular`, ...): everything model-specific comes from the class's
-    :attr:`system` (its :class:`~pdeflow.systems.EquationSystem`)."""
+    :class:`SingleLayerGranular`, ...): a model (its class's :attr:`system`, an
+    :class:`~pdeflow.systems.EquationSystem`, and its :attr:`parameters`) assembled
+    with a :attr:`scheme` (:class:`~pdeflow.numerics.scheme.Scheme`) and boundaries."""
 
     explicit_time_dependence = False
     check_implementation = False
@@ -198,37 +195,34 @@ class GranularPDE(PDEBase):
         return self.system.kernels_for(self.parameters)
 
     def __init__(self, parameters: SharedParameters | dict | None = None, *,
-                 bc: Sequence[str] = ("wall", "open"), flux: str = "hll",
-                 reconstruction: str = "first-order", limiter: str = "minmod",
+                 bc: Sequence[str] = ("wall", "open"), scheme: Scheme | str | None = None,
+                 flux: str | None = None, reconstruction: str | None = None,
+                 limiter: str | None = None, splitting: str | None = None,
                  **kwargs: Any):
         """
         Args:
             parameters: the model's parameters (a :attr:`parameters_class` or a dict of
                 its fields).
             bc: boundary at (left, right): 'wall' (reflective) or 'open' (transmissive).
-            flux: interface flux: 'hll' (the paper's), 'rusanov', or 'ifcp' (sharper;
-                Roe's scheme for one layer).
-            reconstruction: 'first-order' (the paper's) or 'muscl' (second order in
-                space; the fv-split solver then advects with SSP-RK2).
-            limiter: slope limiter of 'muscl': 'minmod' or 'mc' (monotonised central).
+            scheme: how fv-split discretises it (a
+                :class:`~pdeflow.numerics.scheme.Scheme` or its name, e.g.
+                'hll/muscl/mc+strang'); default: the paper's, 'hll/first-order'.
+            flux, reconstruction, limiter, splitting: the scheme's fields, instead of
+                ``scheme`` (a convenience): flux 'hll' (the paper's), 'rusanov' or
+                'ifcp' (sharper; Roe's scheme for one layer); reconstruction
+                'first-order' (the paper's) or 'muscl' (second order in space,
+                advected with SSP-RK2); limiter of 'muscl' 'minmod' or 'mc'; splitting
+                'lie' (the paper's) or 'strang'.
             **kwargs: individual parameters overriding ``parameters``.
         """
         super().__init__()
         if isinstance(bc, str) or len(bc) != 2 or any(b not in BC_NAMES for b in bc):
             raise ValueError(
                 f"bc must be a pair of 'wall' or 'open' (left, right), got {bc!r}")
-        if flux not in L.FLUXES:
-            raise ValueError(f"flux must be one of {list(L.FLUXES)}, got {flux!r}")
-        if reconstruction not in RECONSTRUCTIONS:
-            raise ValueError(f"reconstruction must be one of {list(RECONSTRUCTIONS)}, "
-                             f"got {reconstruction!r}")
-        if limiter not in L.LIMITERS:
-            raise ValueError(f"limiter must be one of {list(L.LIMITERS)}, got {limiter!r}")
         self.bc = tuple(bc)
         self.bc_codes = (BC_NAMES[bc[0]], BC_NAMES[bc[1]])
-        self.flux = flux
-        self.reconstruction = reconstruction
-        self.limiter = limiter
+        self.scheme: Scheme = _scheme_of(scheme, flux=flux, reconstruction=reconstruction,
+                                         limiter=limiter, splitting=splitting)
         if isinstance(parameters, self.parameters_class):
             parameters = parameters.to_dict()
         self.parameters = self.parameters_class.from_dict({**(parameters or {}),
@@ -236,19 +230,7 @@ class GranularPDE(PDEBase):
 
     def __repr__(self) -> str:
         return (f"{type(self).__name__}({self.parameters}, bc={self.bc}, "
-                f"{self.variant})")
-
-    @property
-    def scheme_codes(self) -> tuple[int, int, int]:
-        """(flux, order, limiter) codes for the kernels."""
-        return (L.FLUXES[self.flux], RECONSTRUCTIONS[self.reconstruction],
-                L.LIMITERS[self.limiter])
-
-    @property
-    def variant(self) -> str:
-        """Short name of the spatial discretisation, e.g. 'hll/first-order'."""
-        v = f"{self.flux}/{self.reconstruction}"
-        return v + (f"/{self.limiter}" if self.reconstruction == "muscl" else "")
+                f"scheme={self.scheme.name!r})")
 
     # --- parameters -----------------------------------------------------------------------
     def parameter_array(self) -> np.ndarray:
@@ -280,9 +262,13 @@ class GranularPDE(PDEBase):
         return float(grid.discretization[0])
 
     def geometry(self, grid: Any) -> str:
-        """The geometry of ``grid`` (:func:`~pdeflow.numerics.geometry.geometry_of`); on
-        an axisymmetric grid the left boundary is the axis and must be 'wall'."""
-        geometry = geometry_of(grid)
+        """The geometry of ``grid`` (:func:`~pdeflow.numerics.geometry.geometry_of`),
+        checked against the boundaries (:meth:`_check_geometry`); cheap, no arrays."""
+        return self._check_geometry(geometry_of(grid))
+
+    def _check_geometry(self, geometry: str) -> str:
+        """``geometry``, or ValueError: on an axisymmetric grid the left boundary is the
+        axis and must be 'wall'."""
         if geometry == "axisymmetric" and self.bc[0] != "wall":
             raise ValueError(f"on an axisymmetric grid the left boundary is the axis: "
                              f"bc[0] must be 'wall', got {self.bc[0]!r}")
@@ -290,9 +276,14 @@ class GranularPDE(PDEBase):
 
     def metric(self, grid: Any) -> Metric:
         """The finite-volume metric of ``grid`` (:func:`~pdeflow.numerics.geometry.metric_of`),
-        after :meth:`geometry`'s checks."""
-        self.geometry(grid)
-        return metric_of(grid)
+        checked against the boundaries; derived once per grid (the last grid's is kept:
+        a run, its solver and its summary share it)."""
+        last = self.__dict__.get("_metric")
+        if last is None or last[0] is not grid:
+            metric = metric_of(grid)
+            self._check_geometry(metric.geometry)
+            self._metric = (grid, metric)
+        return self._metric[1]
 
     def make_state(self, grid: CartesianGrid, **profiles: np.ndarray) -> FieldCollection:
         """State from depth and velocity profiles (names: the system's
@@ -319,10 +310,9 @@ class GranularPDE(PDEBase):
             fields.append(ScalarField(grid, h * u, label=layer.discharge))
         return FieldCollection(fields)
 
-    def check_state(self, state: FieldCollection) -> float:
-        """Validate a state for this model (and its grid, see :meth:`metric`); return dx."""
-        self.geometry(state.grid)
-        dx = float(state.grid.discretization[0])
+    def check_state(self, state: FieldCollection) -> Metric:
+        """Validate a state for this model and return its grid's :meth:`metric`."""
+        metric = self.metric(state.grid)
         if state.data.shape[0] != len(self.field_names):
             raise ValueError(f"state must have {len(self.field_names)} fields "
                              f"{self.field_names}, got {state.data.shape[0]}")
@@ -339,13 +329,13 @@ class GranularPDE(PDEBase):
                 raise ValueError(f"{self.field_names[k]} must be >= 0 m, got "
                                  f"{state.data[k, bad[0]]:g} in cell {bad[0]} "
                                  f"(x={x[bad[0]]:g} m) and {bad.size - 1} more")
-        return dx
+        return metric
 
     # --- rates ----------------------------------------------------------------------------
     def evolution_rate(self, state: FieldCollection, t: float = 0) -> FieldCollection:
         """Method-of-lines rate: HLL flux divergence (29) plus sources (26)-(27)."""
         self._require_numpy_variant(state.grid)
-        dx = self.check_grid(state.grid)
+        dx = float(state.grid.discretization[0])
         P = self.parameter_array()
         q = state.data
         rate, _ = self.kernels.numpy_advection(q, dx, self.bc_codes, P)
@@ -355,10 +345,10 @@ class GranularPDE(PDEBase):
         return out
 
     def _require_numpy_variant(self, grid: Any) -> None:
-        if self.flux != "hll" or self.reconstruction != "first-order":
+        if self.scheme.spatial != "hll/first-order":
             raise NotImplementedError(
-                f"the numpy backend implements hll/first-order only, not {self.variant}; "
-                "use the numba backend")
+                f"the numpy backend implements hll/first-order only, not "
+                f"{self.scheme.spatial}; use the numba backend")
         if self.geometry(grid) != "planar":
             raise NotImplementedError("the numpy backend implements the planar geometry "
                                       "only; use the numba backend")
@@ -379,7 +369,7 @@ class GranularPDE(PDEBase):
         P = self.parameter_array()
         bcl, bcr = self.bc_codes
         g, r, dry = self.kernels.constants(P)
-        advect = ready(rate_kernel(self.kernels, *self.scheme_codes, metric.code))
+        advect = ready(rate_kernel(self.kernels, *self.scheme.codes, metric.code))
         sources = ready(self.kernels.mol_sources)
         shape = (2, *state.data.shape)  # closure arrays are read-only in numba
 
@@ -427,3 +417,18 @@ class GranularPDE(PDEBase):
             return state_data, post_step_data
 
         return post_step_hook, self.new_diagnostics(state.grid.shape[0])
+
+
+def _scheme_of(scheme: Scheme | str | None, **fields: str | None) -> Scheme:
+    """The scheme of ``GranularPDE(scheme=..., flux=..., ...)``: ``scheme`` (a
+    :class:`Scheme` or its name) or the scheme of the given ``fields`` (the others the
+    paper's), not both (ValueError)."""
+    given = {k: v for k, v in fields.items() if v is not None}
+    if scheme is not None and given:
+        raise ValueError(f"give the scheme or its fields, not both: scheme={scheme!r} "
+                         f"and {', '.join(f'{k}={v!r}' for k, v in given.items())}")
+    if isinstance(scheme, Scheme):
+        return scheme
+    if scheme is not None:
+        return Scheme.parse(scheme)
+    return Scheme(**given)

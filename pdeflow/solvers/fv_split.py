@@ -17,17 +17,31 @@ that the hook wraps.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
+import time
 from typing import Any
 
 import numpy as np
 from pde.solvers.base import SolverBase
 from pde.trackers.base import FinishedSimulation
 
-from ..models.base import MAX_CFL, GranularPDE, check_range
+from ..models.base import GranularPDE, check_range
 from ..numerics import layout as L
-from ..numerics.splitting import STATUS_FAIL, STATUS_REST, python_stepping, scheme_stepper
+from ..numerics.geometry import Metric
+from ..numerics.scheme import SPLITTINGS, Scheme, check_choice
+from ..numerics.splitting import (
+    STATUS_FAIL,
+    STATUS_REST,
+    Stepper,
+    python_stepping,
+    scheme_stepper,
+)
+from .blowup import SimulationBlowUp, cell_values, diagnose_blowup, fmt_values
 from .outputs import StepAhead, pending_output
+
+__all__ = ["FVSplitSolver", "SimulationBlowUp", "diagnose_blowup", "split_stepper",
+           "stepper_codes"]
 
 
 class _RestProfilerFilter(logging.Filter):
@@ -48,128 +62,20 @@ class _RestProfilerFilter(logging.Filter):
 logging.getLogger("pde.solvers.controller").addFilter(_RestProfilerFilter())
 
 
-def scheme_codes(pde: GranularPDE, splitting: str = "lie",
-                 geometry: int = L.GEOMETRY_PLANAR) -> tuple[Any, int, int, int, bool, int]:
-    """(model kernels, flux, order, limiter, strang, geometry): the scheme of ``pde`` with
-    ``splitting`` on a grid of ``geometry`` (layout.GEOMETRY_*), as
-    :func:`pdeflow.numerics.splitting.scheme_stepper` takes it."""
-    return (pde.kernels, *pde.scheme_codes, splitting == "strang", geometry)
+def stepper_codes(pde: GranularPDE, metric: Metric,
+                  scheme: Scheme | None = None) -> tuple[Any, int, int, int, bool, int]:
+    """(model kernels, flux, order, limiter, strang, geometry): ``scheme`` (default: the
+    PDE's) with the model's kernels on the grid of ``metric``, as
+    :func:`pdeflow.numerics.splitting.scheme_stepper` takes them."""
+    scheme = pde.scheme if scheme is None else scheme
+    return (pde.kernels, *scheme.codes, scheme.strang, metric.code)
 
 
-class SimulationBlowUp(FloatingPointError):
-    """Raised when a step produced a non-finite or negative state (state kept).
-
-    Attributes (None where unknown):
-        t: time at the start of the failed step [s] = time of the kept state.
-        step: number of the failed step (1 = the first step of the run).
-        cell: index of the offending cell; ``x`` its centre [m].
-        cell_state: the kept state in that cell, depths [m] and velocities [m/s].
-        variant: model, scheme, splitting, hyperbolicity mode and CFL number.
-        state: copy of the last good state data (fields x cells).
-        report: everything above plus dt [s], the failed values, the stage, the range
-            of bad cells (see :func:`diagnose_blowup`).
-    """
-
-    def __init__(self, message: str, *, report: dict[str, Any] | None = None,
-                 state: np.ndarray | None = None):
-        super().__init__(message)
-        self.report: dict[str, Any] = dict(report or {})
-        self.state = state
-        self.t: float | None = self.report.get("t")
-        self.step: int | None = self.report.get("step")
-        self.cell: int | None = self.report.get("cell")
-        self.x: float | None = self.report.get("x")
-        self.cell_state: dict[str, float] | None = self.report.get("cell_state")
-        self.variant: str | None = self.report.get("variant")
-
-
-def _cell_values(pde: GranularPDE, q: np.ndarray, i: int) -> dict[str, float]:
-    """Depths [m] and velocities [m/s] of the state ``q`` in cell ``i``."""
-    out: dict[str, float] = {}
-    for k in range(0, len(pde.field_names), 2):
-        h = float(q[k, i])
-        name = pde.field_names[k]
-        out[name] = h
-        with np.errstate(all="ignore"):
-            out["u" + name[1:]] = float(q[k + 1, i] / h) if h > 0 else 0.0
-    return out
-
-
-def _fmt_values(values: dict[str, float]) -> str:
-    return ", ".join(f"{k}={v:.6g}" for k, v in values.items())
-
-
-def diagnose_blowup(pde: GranularPDE, q_good: np.ndarray, t: float, t_end: float,
-                    replay: Any) -> dict[str, Any]:
-    """Find where and how the failed step from the kept state ``q_good`` went wrong.
-
-    ``replay(q, t, t_end, update)`` must take exactly one step of the solver's stepping
-    kernel from ``q`` (a copy) at time ``t`` [s], with its state updates performed by
-    ``update(q, base, rate, dt, weight, lo, hi)`` (the kernel's ``_update``: ``q <-
-    weight base + (1 - weight) (q + dt rate)`` in cells ``lo..hi``, returning
-    ``(max |mass rate|, ok)``). The recording
-    update here repeats that arithmetic in numpy and keeps the update that failed, so the
-    step is recomputed exactly, stages and all, in plain Python.
-
-    Returns a dict with ``cell``, ``x`` [m], ``dt`` [s], ``stage`` (1: advection or
-    predictor, 2: corrector of SSP-RK2), ``failed`` (the failed values of all fields in
-    that cell), ``bad_cells`` (indices of all bad cells), ``cause`` (text); or only
-    ``cause`` if the kept state itself is bad (a source stage produced it) or the step
-    could not be replayed.
-    """
-    names = pde.field_names
-    bad_state = ~np.isfinite(q_good)
-    bad_state[::2] |= q_good[::2] < 0
-    if bad_state.any():
-        cells = np.nonzero(bad_state.any(axis=0))[0]
-        return {"cause": "the state before the step is not finite or has a negative "
-                         "depth (produced by a source stage)",
-                "cell": int(cells[0]), "bad_cells": cells.tolist(), "stage": 0,
-                "failed": {n: float(q_good[k, cells[0]]) for k, n in enumerate(names)}}
-    records: list[dict[str, Any]] = []
-
-    def update(q: np.ndarray, base: np.ndarray, rate: np.ndarray, dt: float,
-               weight: float, lo: int, hi: int) -> tuple[float, bool]:
-        v = q.copy()
-        cells = slice(lo, hi + 1)
-        with np.errstate(all="ignore"):
-            v[:, cells] = weight * base[:, cells] + (1.0 - weight) * (
-                q[:, cells] + dt * rate[:, cells])
-            bad = np.zeros(q.shape, dtype=bool)
-            bad[:, cells] = ~np.isfinite(v[:, cells])
-            bad[::2, cells] |= v[::2, cells] < -1e-12 * (1.0 + np.abs(q[::2, cells]))
-            mass_rate = float(np.max(np.abs(rate[::2, cells]))) if hi >= lo else 0.0
-        records.append({"dt": float(dt), "after": v.copy(), "bad": bad,
-                        "first_stage": weight == 0.0})
-        q[...] = v
-        return mass_rate, not bool(bad.any())
-
-    try:
-        replay(q_good.copy(), t, t_end, update)
-    except Exception as err:  # pragma: no cover - diagnostics must not mask the blow-up
-        return {"cause": f"the failed step could not be replayed ({err!r})"}
-    # an IFCP step that fails is redone with HLL: the last attempt is the one that counts
-    starts = [k for k, rec in enumerate(records) if rec["first_stage"]]
-    records = records[starts[-1]:] if starts else records
-    failed = [(k, rec) for k, rec in enumerate(records) if rec["bad"].any()]
-    if not failed:
-        return {"cause": "the replayed step did not fail (non-deterministic failure?)"}
-    stage, rec = failed[0]
-    bad = rec["bad"]
-    after = rec["after"]
-    cells = np.nonzero(bad.any(axis=0))[0]
-    nonfinite = np.nonzero((~np.isfinite(after)).any(axis=0))[0]
-    if nonfinite.size:
-        cell = int(nonfinite[0])
-        cause = "non-finite values"
-    else:
-        with np.errstate(all="ignore"):
-            rel = np.min(after[::2] / (1.0 + np.abs(q_good[::2])), axis=0)
-        cell = int(cells[np.argmin(rel[cells])])
-        cause = "a negative depth"
-    return {"cause": cause, "cell": cell, "bad_cells": cells.tolist(), "dt": rec["dt"],
-            "stage": stage + 1,
-            "failed": {n: float(after[k, cell]) for k, n in enumerate(names)}}
+def split_stepper(pde: GranularPDE, metric: Metric,
+                  scheme: Scheme | None = None) -> Stepper:
+    """The compiled stepping loop of ``scheme`` (default: the PDE's) for the model of
+    ``pde`` on the grid of ``metric`` (not compiled before its first call)."""
+    return scheme_stepper(*stepper_codes(pde, metric, scheme))
 
 
 class FVSplitSolver(SolverBase):
@@ -178,19 +84,21 @@ class FVSplitSolver(SolverBase):
     name = "fv-split"
 
     def __init__(self, pde: GranularPDE, *, backend: str = "numba", cfl: float = 0.3,
-                 splitting: str = "lie", stop_at_rest: bool = True,
+                 splitting: str | None = None, stop_at_rest: bool = True,
                  max_steps: int = 100_000_000, t_end: float | None = None,
                  outputs: str = "interpolate"):
         """
         Args:
             pde: a :class:`~pdeflow.models.TwoLayerGranular` or
-                :class:`~pdeflow.models.SingleLayerGranular` (its flux and reconstruction
-                choose the advection stage; MUSCL is advanced with SSP-RK2/Heun).
+                :class:`~pdeflow.models.SingleLayerGranular`; its ``scheme`` (flux,
+                reconstruction, limiter, splitting) is the solver's (MUSCL is advanced
+                with SSP-RK2/Heun).
             backend: 'numba' (compiled loop) or 'numpy' (Python loop, for debugging).
             cfl: Courant number in (0, 1] (paper: 0.3); (0, 0.5] with MUSCL, whose
                 SSP-RK2 update keeps depths non-negative only up to 1/2.
             splitting: 'lie' (advection, then sources: the paper's) or 'strang' (half a
-                source step on each side of the advection step).
+                source step on each side of the advection step) instead of the PDE's
+                scheme's; None: the scheme's.
             stop_at_rest: end the run once nothing moves or changes any more.
             max_steps: safety limit on the number of steps per call.
             t_end: end of the run [s] (``GranularPDE.solve`` passes its ``t_range``):
@@ -211,13 +119,16 @@ class FVSplitSolver(SolverBase):
             raise ValueError(f"backend must be 'numba' or 'numpy', got {backend!r}")
         super().__init__(pde, backend="numba" if backend == "auto" else backend)
         self.cfl = check_range("cfl", cfl, 0, 1, low_open=True)
-        if pde.reconstruction == "muscl":
+        scheme = pde.scheme
+        if splitting is not None:
+            check_choice("splitting", splitting, SPLITTINGS)
+            scheme = dataclasses.replace(scheme, splitting=splitting)
+        self.scheme: Scheme = scheme
+        """the scheme this solver steps with: the PDE's (its splitting as given)"""
+        if scheme.max_cfl < 1:
             # SSP-RK2 with limited reconstructions keeps depths non-negative only up to 1/2
-            check_range("cfl (with reconstruction='muscl')", cfl, 0, MAX_CFL["muscl"],
-                        low_open=True)
-        if splitting not in ("lie", "strang"):
-            raise ValueError(f"splitting must be 'lie' or 'strang', got {splitting!r}")
-        self.splitting = splitting
+            check_range(f"cfl (with reconstruction={scheme.reconstruction!r})", cfl, 0,
+                        scheme.max_cfl, low_open=True)
         self.stop_at_rest = bool(stop_at_rest)
         self.max_steps = int(max_steps)
         self.t_end = None if t_end is None else float(t_end)
@@ -229,32 +140,20 @@ class FVSplitSolver(SolverBase):
     def make_stepper(self, state: Any, dt: float | None = None):
         """Return ``stepper(state, t_start, t_end) -> t`` advancing with CFL steps."""
         pde: GranularPDE = self.pde
-        dx = pde.check_state(state)
-        metric = pde.metric(state.grid)
-        M = metric.array()
-        if self._backend == "numba":
-            # the compiled loop is pdeflow's own kernel: py-pde's numba backend (and the
-            # numba modules its import pulls in) is not needed for it
-            self.info["backend"] = {"name": "numba", "implementation": "numba"}
-        else:
-            self._select_backend(state)
-        if self.backend_name == "numba":
-            # the compiled loop calls the source stage itself: no hook to compile (the
-            # state was checked above, as the hook would)
-            hook, diag = None, pde.new_diagnostics(state.grid.shape[0])
-        else:
-            hook, diag = pde.make_post_step_hook(state, backend=self.backend)
-        self.diagnostics = diag
+        metric = pde.check_state(state)  # the grid's geometry, derived here once
+        dx, M = metric.dx, metric.array()
+        hook, diag = self._hook(state)
         self.info.update(dt=None, steps=0, dt_adaptive=True, stochastic=False,
-                         cfl=self.cfl, post_step_data=diag, variant=pde.variant,
-                         splitting=self.splitting)
+                         cfl=self.cfl, post_step_data=diag,
+                         variant=self.scheme.spatial, splitting=self.scheme.splitting,
+                         wall_time=0.0)
         P = pde.parameter_array()
         bcl, bcr = pde.bc_codes
         rate = np.empty_like(state.data)
         backup = np.empty_like(state.data)
         work = np.empty((3, *state.data.shape))
         prev = np.empty_like(state.data)
-        scheme = scheme_codes(pde, self.splitting, metric.code)
+        scheme = stepper_codes(pde, metric, self.scheme)
         cfl = self.cfl
         stop = self.stop_at_rest
 
@@ -279,7 +178,7 @@ class FVSplitSolver(SolverBase):
 
         ahead: list[StepAhead] = []  # the state past the last output time, if any
 
-        def stepper(state: Any, t_start: float, t_end: float) -> float:
+        def step(state: Any, t_start: float, t_end: float) -> float:
             t_pause = float(t_end)
             t_run = t_pause if self.t_end is None else max(self.t_end, t_pause)
             done, t_start = self._resume(ahead, state, float(t_start), t_pause)
@@ -298,7 +197,7 @@ class FVSplitSolver(SolverBase):
             if t_pause < t < t_run and self.outputs == "interpolate":
                 # the step went past the output time: output the state at that time,
                 # continue from the step's end at the next call
-                dt = float(diag[L.D_DT]) * (2.0 if self.splitting == "strang" else 1.0)
+                dt = float(diag[L.D_DT]) * (2.0 if self.scheme.strang else 1.0)
                 ahead.append(pending_output(state.data, prev, t, dt,
                                             status == STATUS_REST))
                 ahead[0].interpolate(state.data, t_pause)
@@ -306,6 +205,37 @@ class FVSplitSolver(SolverBase):
             if status == STATUS_REST:
                 self._at_rest(t)
             return float(t)
+
+        return self._timed(step)
+
+    def _hook(self, state: Any) -> tuple[Any, np.ndarray]:
+        """(post-step hook or None, diagnostics array) of the backend: the compiled loop
+        calls the source stage itself, so it needs no hook (the state was checked, as
+        the hook would)."""
+        if self._backend == "numba":
+            # the compiled loop is pdeflow's own kernel: py-pde's numba backend (and the
+            # numba modules its import pulls in) is not needed for it
+            self.info["backend"] = {"name": "numba", "implementation": "numba"}
+        else:
+            self._select_backend(state)
+        if self.backend_name == "numba":
+            hook, diag = None, self.pde.new_diagnostics(state.grid.shape[0])
+        else:
+            hook, diag = self.pde.make_post_step_hook(state, backend=self.backend)
+        self.diagnostics = diag
+        return hook, diag
+
+    def _timed(self, step: Any) -> Any:
+        """``step`` with its wall time added to ``info["wall_time"]`` [s]: the run's
+        own time, without its observers (py-pde's trackers run between the calls of
+        the stepper), which the summary reports as the run's wall time."""
+
+        def stepper(state: Any, t_start: float, t_end: float) -> float:
+            t0 = time.perf_counter()
+            try:
+                return step(state, t_start, t_end)
+            finally:
+                self.info["wall_time"] += time.perf_counter() - t0
 
         return stepper
 
@@ -348,7 +278,8 @@ class FVSplitSolver(SolverBase):
             t_kept = t_start
         step = int(self.info["steps"]) + 1
         mode = getattr(getattr(pde, "parameters", None), "hyperbolicity", None)
-        variant = (f"{pde.__class__.__name__}, fv-split {pde.variant}, {self.splitting} "
+        variant = (f"{pde.__class__.__name__}, fv-split {self.scheme.spatial}, "
+                   f"{self.scheme.splitting} "
                    f"splitting" + (f", hyperbolicity {mode!r}" if mode else "")
                    + f", cfl={self.cfl}")
         x_c = state.grid.axes_coords[0]
@@ -357,12 +288,12 @@ class FVSplitSolver(SolverBase):
         where = ""
         if cell is not None:
             report["x"] = float(x_c[cell])
-            report["cell_state"] = _cell_values(pde, state.data if t_kept == t else
+            report["cell_state"] = cell_values(pde, state.data if t_kept == t else
                                                 entry, cell)
             bad = report.get("bad_cells", [cell])
             where = (f": cell {cell} (x={x_c[cell]:.6g} m) went to "
-                     f"{_fmt_values(report['failed'])} from "
-                     f"{_fmt_values(report['cell_state'])} (depths m, velocities m/s); "
+                     f"{fmt_values(report['failed'])} from "
+                     f"{fmt_values(report['cell_state'])} (depths m, velocities m/s); "
                      f"{len(bad)} bad cell(s) in x=[{x_c[min(bad)]:.6g}, "
                      f"{x_c[max(bad)]:.6g}] m")
         dt = report.get("dt")
@@ -402,7 +333,7 @@ class FVSplitSolver(SolverBase):
 
         pde: GranularPDE = self.pde
         pde._require_numpy_variant(state.grid)
-        if self.splitting != "lie":
+        if self.scheme.strang:
             raise NotImplementedError("the numpy loop implements Lie splitting only")
         def advance(q: np.ndarray, t: float, t_pause: float, t_end: float):
             steps = 0

@@ -180,7 +180,8 @@ SYSTEM = systems.register(systems.EquationSystem(
     parameters_class=TwoLayerParameters, pde_class=TwoLayerGranular, kernels=KERNELS,
     law_kernels=LAW_KERNELS, diagnostics=T.DIAGNOSTICS,
     densities=lambda p: (p.density_ratio, 1.0), layer_depths=layer_depths,
-    summarize=summarize, has_fextra=True, bytes_per_cell=320,
+    summarize=summarize, has_fextra=True, cell_diagnostic="fextra_over_rho1",
+    bytes_per_cell=320,
     paper_runout_law=(1.61, 0.84), bed_layer=1,
     quantities=(
         Q("lower_stop_time", "lower stop", "s"), Q("upper_stop_time", "upper stop", "s"),
