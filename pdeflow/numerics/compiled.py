@@ -117,11 +117,13 @@ def cached(func: Callable | None = None, *, inline: str = "never") -> Any:
 
 
 def specialise(func: Callable, *arg_types: Any, helper: bool = False,
-               pointer: bool = True) -> Any:
+               pointer: bool = True, inline: str = "never") -> Any:
     """A numba kernel of the closure ``func`` with the one signature ``arg_types``,
     disk-cached (see the module docstring); compiled by :func:`ready`. ``helper``: only
     other kernels call it (see :func:`cached`);
-    ``pointer``: it is also called through a function pointer (:func:`first_class`)."""
+    ``pointer``: it is also called through a function pointer (:func:`first_class`).
+    Without ``arg_types`` (a helper, e.g. ``inline="always"``) it declares no signature
+    and is compiled by the kernels that call it, as :func:`cached` helpers are."""
     if config.DISABLE_JIT:
         return func
     # numba names compiled code after the function's qualified name and a per-process
@@ -130,8 +132,9 @@ def specialise(func: Callable, *arg_types: Any, helper: bool = False,
     # from the disk cache may run one's code for the other (numba issue #10486). Here
     # the name carries what the closure is made of.
     func.__qualname__ += "_" + digest(func)[:12]
-    compiled = _jit(func, helper=helper, pointer=pointer)
-    _SIGNATURES[compiled] = tuple(arg_types)
+    compiled = _jit(func, helper=helper, pointer=pointer, inline=inline)
+    if arg_types:
+        _SIGNATURES[compiled] = tuple(arg_types)
     _SPECIALISED.append(compiled)
     return compiled
 

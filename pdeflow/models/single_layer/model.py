@@ -24,7 +24,7 @@ from ... import systems
 from ..base import GranularPDE, SharedParameters, check_range, stop_time
 from ..friction_laws import FrictionLawParameters
 from . import layout as S
-from .kernels import KERNELS, LAW_KERNELS
+from .kernels import KERNELS, kernels
 
 
 @dataclass
@@ -78,7 +78,7 @@ SYSTEM = systems.register(systems.EquationSystem(
     name="single_layer", label="single layer", adjective="single-layer",
     layers=(systems.Layer("h", "hu", "u", "single layer", "single"),),
     parameters_class=SingleLayerParameters, pde_class=SingleLayerGranular,
-    kernels=KERNELS, law_kernels=LAW_KERNELS, diagnostics=S.DIAGNOSTICS,
+    kernels=KERNELS, law_kernels=kernels, diagnostics=S.DIAGNOSTICS,
     densities=lambda p: (1.0,),
     layer_depths=lambda h, x, ini, p: (h,),
     summarize=summarize, bytes_per_cell=180, paper_runout_law=(2.25, 1.06),

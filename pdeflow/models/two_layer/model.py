@@ -30,7 +30,7 @@ from ...numerics.geometry import Metric
 from ..base import GranularPDE, SharedParameters, check_range, stop_time
 from ..friction_laws import FrictionLawParameters
 from . import layout as T
-from .kernels import KERNELS, LAW_KERNELS
+from .kernels import KERNELS, kernels
 
 HYPERBOLICITY_MODES = L.HYPERBOLICITY_MODES
 
@@ -178,7 +178,7 @@ SYSTEM = systems.register(systems.EquationSystem(
     layers=(systems.Layer("h1", "h1u1", "u1", "upper layer", "upper"),
             systems.Layer("h2", "h2u2", "u2", "lower layer", "lower")),
     parameters_class=TwoLayerParameters, pde_class=TwoLayerGranular, kernels=KERNELS,
-    law_kernels=LAW_KERNELS, diagnostics=T.DIAGNOSTICS,
+    law_kernels=kernels, diagnostics=T.DIAGNOSTICS,
     densities=lambda p: (p.density_ratio, 1.0), layer_depths=layer_depths,
     summarize=summarize, has_fextra=True, bytes_per_cell=320,
     paper_runout_law=(1.61, 0.84), bed_layer=1,
