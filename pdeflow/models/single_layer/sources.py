@@ -38,7 +38,7 @@ def stage_kernels(law: BasalLaw | None) -> StageKernels:
     Coulomb's closed-form step, tan(phi_b)), compiled with the law's kernels as
     constants."""
     if law is None:
-        return _stage(basal_friction, basal_velocity)
+        return _stage(basal_friction, basal_velocity, coulomb=True)
     return _stage(law_friction, _law_step(law_velocity(law)))
 
 
@@ -73,9 +73,14 @@ def _law_step(velocity_after: Any) -> Any:
     return specialise(basal_velocity_law, helper=True, inline="always")
 
 
-def _stage(step_friction: Any, after_friction: Any) -> StageKernels:
+def _stage(step_friction: Any, after_friction: Any, coulomb: bool = False) -> StageKernels:
     """The stage kernels with friction ``after_friction(b, h, dt, g, step_friction(dt,
-    g, P))`` (see :func:`basal_friction`, :func:`basal_velocity`)."""
+    g, P))`` (see :func:`basal_friction`, :func:`basal_velocity`); ``coulomb``: named
+    as the module's names they are bound to (a new interpreter imports them)."""
+
+    def named(kernel: Any) -> str | None:
+        return kernel.__name__ if coulomb else None
+
 
     def sources_single(q, dt, t, P, diag, lo, hi):
         """Implicit basal friction (and gravity along the bed) of the single layer on
@@ -104,7 +109,8 @@ def _stage(step_friction: Any, after_friction: Any) -> StageKernels:
             q[1, i] = m
         _close_stage(diag, t, moving, fast)
 
-    sources = specialise(sources_single, STATE, f8, f8, PARAMS, VECTOR, i8, i8)
+    sources = specialise(sources_single, STATE, f8, f8, PARAMS, VECTOR, i8, i8,
+                         name=named(sources_single))
 
     def source_stage_single(q, dt, t, P, diag):
         """:func:`sources_single` on every cell."""
@@ -124,8 +130,10 @@ def _stage(step_friction: Any, after_friction: Any) -> StageKernels:
                     q[1, i] = 0.0
 
     return StageKernels(
-        sources, specialise(source_stage_single, STATE, f8, f8, PARAMS, VECTOR),
-        specialise(predictor_single, STATE, f8, PARAMS, i8, i8))
+        sources, specialise(source_stage_single, STATE, f8, f8, PARAMS, VECTOR,
+                            name=named(source_stage_single)),
+        specialise(predictor_single, STATE, f8, PARAMS, i8, i8,
+                   name=named(predictor_single)))
 
 
 @cached(inline="always")

@@ -80,16 +80,18 @@ class FrictionKernels(NamedTuple):
 
 
 @functools.cache
-def friction_kernels(params: Any, both: Any, lower: Any) -> FrictionKernels:
+def friction_kernels(params: Any, both: Any, lower: Any,
+                     coulomb: bool = False) -> FrictionKernels:
     """The kernels of stages (32)-(34) with the basal law whose parameters tuple is
     ``params(P)`` and whose stage (32) at the bed is ``both`` (two wet layers, as
     :func:`bed_under_both`) and ``lower`` (the lower layer alone, as
-    :func:`bed_under_lower`), each compiled with them as constants."""
+    :func:`bed_under_lower`), each compiled with them as constants (``coulomb``: the
+    paper's, :data:`COULOMB`, whose predictor a new interpreter imports by name)."""
     implicit = _implicit_friction(both, lower)
     bisect = _bisect_fextra(implicit)
     to_edge = _restore_to_edge(both, implicit, bisect)
     return FrictionKernels(params, implicit, bisect, _restore_hyperbolicity(to_edge),
-                           to_edge, _predictor(params, implicit))
+                           to_edge, _predictor(params, implicit, coulomb))
 
 
 @functools.cache
@@ -252,7 +254,7 @@ def _restore_hyperbolicity(restore_to_edge: Any) -> Any:
 
 
 @functools.cache
-def _predictor(friction_params: Any, implicit_friction: Any) -> Any:
+def _predictor(friction_params: Any, implicit_friction: Any, coulomb: bool) -> Any:
     def predictor_two_layer(q, dt, P, lo, hi):
         """Zero the momentum of layers that the implicit friction (32) would hold at rest,
         in place, in the cells ``lo..hi``. Applied to the intermediate stage of SSP-RK2:
@@ -274,10 +276,11 @@ def _predictor(friction_params: Any, implicit_friction: Any) -> Any:
             if u2 == 0.0:
                 q[3, i] = 0.0
 
-    return specialise(predictor_two_layer, STATE, f8, PARAMS, i8, i8)
+    return specialise(predictor_two_layer, STATE, f8, PARAMS, i8, i8,
+                      name="predictor_two_layer" if coulomb else None)
 
 
-COULOMB = friction_kernels(friction_params, bed_under_both, bed_under_lower)
+COULOMB = friction_kernels(friction_params, bed_under_both, bed_under_lower, coulomb=True)
 """the kernels of the paper's Coulomb friction at the bed"""
 implicit_friction = COULOMB.implicit_friction
 bisect_fextra = COULOMB.bisect_fextra

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import functools
 import math
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from ...numerics import layout as L
 from ...numerics.compiled import PARAMS, STATE, VECTOR, cached, f8, i8, specialise
@@ -42,12 +42,12 @@ from .laws import law_bed
 class StageKernels(NamedTuple):
     """The source-stage kernels of one basal law."""
 
-    sources: object
+    sources: Any
     """``(q, dt, t, P, diag, lo, hi)``: stages (31)-(34) on the cells lo..hi (the
     others must be dry and at rest, where the stage changes nothing)"""
-    source_stage: object
+    source_stage: Any
     """``(q, dt, t, P, diag)``: the same on every cell (the post-step hook's kernel)"""
-    predictor: object
+    predictor: Any
     """``(q, dt, P, lo, hi)``: MUSCL's friction predictor"""
 
 
@@ -56,9 +56,10 @@ def stage_kernels(law: BasalLaw | None) -> StageKernels:
     """The two layers' source-stage kernels with the basal law ``law`` (None: the
     paper's Coulomb friction, tan(phi_B)), compiled with the law's kernels as
     constants."""
-    bed = (coulomb_params, bed_under_both, bed_under_lower) if law is None else law_bed(law)
-    fk = friction_kernels(*bed)
-    sources = _sources(fk)
+    coulomb = law is None
+    bed = (coulomb_params, bed_under_both, bed_under_lower) if coulomb else law_bed(law)
+    fk = friction_kernels(*bed, coulomb=coulomb)
+    sources = _sources(fk, coulomb)
 
     def source_stage_two_layer(q, dt, t, P, diag):
         """Stages (31)-(34) on the two-layer state ``q`` in place, for a step ``dt``
@@ -67,13 +68,14 @@ def stage_kernels(law: BasalLaw | None) -> StageKernels:
         F_extra/rho1 per cell [m^2/s^2]."""
         sources(q, dt, t, P, diag, 0, q.shape[1] - 1)
 
-    return StageKernels(sources,
-                        specialise(source_stage_two_layer, STATE, f8, f8, PARAMS, VECTOR),
-                        fk.predictor)
+    return StageKernels(sources, specialise(
+        source_stage_two_layer, STATE, f8, f8, PARAMS, VECTOR,
+        name="source_stage_two_layer" if coulomb else None), fk.predictor)
 
 
-def _sources(fk: FrictionKernels) -> object:
-    """The stage on a range of cells with the friction kernels ``fk``."""
+def _sources(fk: FrictionKernels, coulomb: bool) -> Any:
+    """The stage on a range of cells with the friction kernels ``fk`` (``coulomb``:
+    named as the module's name it is bound to, which a new interpreter imports)."""
     friction_params = fk.friction_params
     implicit_friction = fk.implicit_friction
     restore_to_edge = fk.restore_to_edge
@@ -184,7 +186,8 @@ def _sources(fk: FrictionKernels) -> object:
             q[3, i] = m2
         _close_stage(diag, t, moving1, fast1, moving2, fast2, changed)
 
-    return specialise(sources_two_layer, STATE, f8, f8, PARAMS, VECTOR, i8, i8)
+    return specialise(sources_two_layer, STATE, f8, f8, PARAMS, VECTOR, i8, i8,
+                      name="sources_two_layer" if coulomb else None)
 
 
 @cached(inline="always")
