@@ -23,6 +23,7 @@ import numpy as np
 from ... import systems
 from ..base import GranularPDE, SharedParameters, check_range, stop_time
 from ..friction_laws import FrictionLawParameters
+from ..parameters import parameter_vector
 from . import layout as S
 from .kernels import KERNELS, kernels
 
@@ -44,10 +45,7 @@ class SingleLayerParameters(FrictionLawParameters, SharedParameters):
 
     def to_array(self) -> np.ndarray:
         """Kernel parameter vector (layout in :mod:`.layout`)."""
-        th = math.radians(self.theta_deg)
-        P = np.zeros(S.SIZE)
-        P[S.G_Z] = self.g * math.cos(th)
-        P[S.G_X] = self.g * math.sin(th)
+        P = parameter_vector(self, S.SIZE)
         P[S.TAN_B] = math.tan(math.radians(self.phi_b_deg))
         P[S.DRY] = self.dry_tolerance
         P[S.SLOW_U] = self.rest_speed

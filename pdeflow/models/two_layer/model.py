@@ -29,6 +29,7 @@ from ...numerics import layout as L
 from ...numerics.geometry import Metric
 from ..base import GranularPDE, SharedParameters, check_range, stop_time
 from ..friction_laws import FrictionLawParameters
+from ..parameters import parameter_vector
 from . import layout as T
 from .kernels import KERNELS, kernels
 
@@ -95,10 +96,7 @@ class TwoLayerParameters(FrictionLawParameters, SharedParameters):
 
     def to_array(self) -> np.ndarray:
         """Kernel parameter vector (layout in :mod:`.layout`)."""
-        th = math.radians(self.theta_deg)
-        P = np.zeros(T.SIZE)
-        P[T.G_Z] = self.g * math.cos(th)
-        P[T.G_X] = self.g * math.sin(th)
+        P = parameter_vector(self, T.SIZE)
         P[T.R] = self.density_ratio
         P[T.TAN_INT] = math.tan(math.radians(self.phi_int_deg))
         P[T.TAN_B] = math.tan(math.radians(self.phi_b_deg))
