@@ -30,10 +30,10 @@ def _numpy_advection(q: np.ndarray, dx: float, bc: tuple[int, int],
 def kernels(law: BasalLaw | None = None) -> ModelKernels:
     """The Savage-Hutter-type layer with the implicit basal friction of ``law`` (None:
     Coulomb's closed form)."""
-    stage = stage_kernels(law)
+    sources, source_stage, predictor = stage_kernels(law)
     return ModelKernels(
         fields=2, face=face, fluctuations=fluctuations, cell_jump=cell_jump,
-        sources=stage.sources, source_stage=stage.source_stage, predictor=stage.predictor,
+        sources=sources, source_stage=source_stage, predictor=predictor,
         mol_sources=source_rate(law), numpy_advection=_numpy_advection,
         numpy_sources=functools.partial(source_rate_np, law=law), constants=_constants)
 

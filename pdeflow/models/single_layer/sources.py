@@ -11,7 +11,7 @@ friction stops in that step.
 from __future__ import annotations
 
 import functools
-from typing import Any, NamedTuple
+from typing import Any
 
 from ...numerics import layout as L
 from ...numerics.compiled import PARAMS, STATE, VECTOR, cached, f8, i8, specialise
@@ -21,22 +21,13 @@ from ...numerics.state import velocity
 from . import layout as S
 
 
-class StageKernels(NamedTuple):
-    """The source-stage kernels of one basal law."""
-
-    sources: Any
-    """``(q, dt, t, P, diag, lo, hi)``: the stage on the cells lo..hi"""
-    source_stage: Any
-    """``(q, dt, t, P, diag)``: the same on every cell (the post-step hook's kernel)"""
-    predictor: Any
-    """``(q, dt, P, lo, hi)``: MUSCL's friction predictor"""
-
-
 @functools.cache
-def stage_kernels(law: BasalLaw | None) -> StageKernels:
+def stage_kernels(law: BasalLaw | None) -> tuple[Any, Any, Any]:
     """The single layer's source-stage kernels with the basal law ``law`` (None:
     Coulomb's closed-form step, tan(phi_b)), compiled with the law's kernels as
-    constants."""
+    constants: the stage on the cells lo..hi ``(q, dt, t, P, diag, lo, hi)``, the same
+    on every cell ``(q, dt, t, P, diag)`` (the post-step hook's kernel) and MUSCL's
+    friction predictor ``(q, dt, P, lo, hi)``."""
     if law is None:
         return _stage(basal_friction, basal_velocity, coulomb=True)
     return _stage(law_friction, _law_step(law_velocity(law)))
@@ -73,14 +64,14 @@ def _law_step(velocity_after: Any) -> Any:
     return specialise(basal_velocity_law, helper=True, inline="always")
 
 
-def _stage(step_friction: Any, after_friction: Any, coulomb: bool = False) -> StageKernels:
+def _stage(step_friction: Any, after_friction: Any,
+           coulomb: bool = False) -> tuple[Any, Any, Any]:
     """The stage kernels with friction ``after_friction(b, h, dt, g, step_friction(dt,
     g, P))`` (see :func:`basal_friction`, :func:`basal_velocity`); ``coulomb``: named
     as the module's names they are bound to (a new interpreter imports them)."""
 
     def named(kernel: Any) -> str | None:
         return kernel.__name__ if coulomb else None
-
 
     def sources_single(q, dt, t, P, diag, lo, hi):
         """Implicit basal friction (and gravity along the bed) of the single layer on
@@ -129,7 +120,7 @@ def _stage(step_friction: Any, after_friction: Any, coulomb: bool = False) -> St
                 if u == 0.0:
                     q[1, i] = 0.0
 
-    return StageKernels(
+    return (
         sources, specialise(source_stage_single, STATE, f8, f8, PARAMS, VECTOR,
                             name=named(source_stage_single)),
         specialise(predictor_single, STATE, f8, PARAMS, i8, i8,

@@ -31,10 +31,10 @@ def kernels(law: BasalLaw | None = None) -> ModelKernels:
     """System (24) with closure (25) and the basal law ``law`` (None: the paper's
     Coulomb friction): the fluctuations of :mod:`.flux`, the source stages (31)-(34) of
     :mod:`.sources`."""
-    stage = stage_kernels(law)
+    sources, source_stage, predictor = stage_kernels(law)
     return ModelKernels(
         fields=4, face=face, fluctuations=fluctuations, cell_jump=cell_jump,
-        sources=stage.sources, source_stage=stage.source_stage, predictor=stage.predictor,
+        sources=sources, source_stage=source_stage, predictor=predictor,
         mol_sources=source_rate(law), numpy_advection=_numpy_advection,
         numpy_sources=functools.partial(source_rate_np, law=law), constants=_constants)
 

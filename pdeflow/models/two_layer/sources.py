@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import functools
 import math
-from typing import Any, NamedTuple
+from typing import Any
 
 from ...numerics import layout as L
 from ...numerics.compiled import PARAMS, STATE, VECTOR, cached, f8, i8, specialise
@@ -39,23 +39,14 @@ from .hyperbolicity import restoration_target
 from .laws import law_bed
 
 
-class StageKernels(NamedTuple):
-    """The source-stage kernels of one basal law."""
-
-    sources: Any
-    """``(q, dt, t, P, diag, lo, hi)``: stages (31)-(34) on the cells lo..hi (the
-    others must be dry and at rest, where the stage changes nothing)"""
-    source_stage: Any
-    """``(q, dt, t, P, diag)``: the same on every cell (the post-step hook's kernel)"""
-    predictor: Any
-    """``(q, dt, P, lo, hi)``: MUSCL's friction predictor"""
-
-
 @functools.cache
-def stage_kernels(law: BasalLaw | None) -> StageKernels:
+def stage_kernels(law: BasalLaw | None) -> tuple[Any, Any, Any]:
     """The two layers' source-stage kernels with the basal law ``law`` (None: the
     paper's Coulomb friction, tan(phi_B)), compiled with the law's kernels as
-    constants."""
+    constants: stages (31)-(34) on the cells lo..hi ``(q, dt, t, P, diag, lo, hi)`` (the
+    others must be dry and at rest, where the stage changes nothing), the same on every
+    cell ``(q, dt, t, P, diag)`` (the post-step hook's kernel) and MUSCL's friction
+    predictor ``(q, dt, P, lo, hi)``."""
     coulomb = law is None
     bed = (coulomb_params, bed_under_both, bed_under_lower) if coulomb else law_bed(law)
     fk = friction_kernels(*bed, coulomb=coulomb)
@@ -68,9 +59,9 @@ def stage_kernels(law: BasalLaw | None) -> StageKernels:
         F_extra/rho1 per cell [m^2/s^2]."""
         sources(q, dt, t, P, diag, 0, q.shape[1] - 1)
 
-    return StageKernels(sources, specialise(
+    return sources, specialise(
         source_stage_two_layer, STATE, f8, f8, PARAMS, VECTOR,
-        name="source_stage_two_layer" if coulomb else None), fk.predictor)
+        name="source_stage_two_layer" if coulomb else None), fk.predictor
 
 
 def _sources(fk: FrictionKernels, coulomb: bool) -> Any:
