@@ -214,6 +214,7 @@ def test_coulomb_block_and_law_parameters_are_validated():
     P = pdeflow.SingleLayerGranular(phi_b_deg=30.0).parameter_array()
     assert P[S.LAW + L.LAW_MU1] == P[S.TAN_B]
     assert not P[S.LAW + 1:S.LAW + L.N_LAW].any()  # no code: the kernels carry the law
+    assert len(law_block(P, S.LAW)) == L.N_LAW  # what the kernels read is the block
     with pytest.raises(ValueError, match=r"^friction_law must be one of"):
         pdeflow.SingleLayerGranular(friction_law="bingham")
     with pytest.raises(ValueError, match=r"^pouliquen_L must lie in \(0, inf\) m"):

@@ -82,9 +82,10 @@ class BasalLaw:
 
 @cached(inline="always")
 def law_block(P, base):
-    """The law's block of ``P`` at ``base`` as a tuple of floats: what the law's kernels
-    take. A tuple, not the array: an array passed on to a helper costs a reference-count
-    update per call, which was 6-30 times the friction law's own arithmetic (measured)."""
+    """The law's block of ``P`` at ``base`` as a tuple of its ``layout.N_LAW`` (six)
+    floats: what the law's kernels take. A tuple, not the array: an array passed on to
+    a helper costs a reference-count update per call, which was 6-30 times the friction
+    law's own arithmetic (measured)."""
     return (P[base], P[base + 1], P[base + 2], P[base + 3], P[base + 4], P[base + 5])
 
 
