@@ -339,8 +339,9 @@ above, not re-measured since the code moved behind `prepare`):
   `PDEFLOW_NUMBA_FALLBACK=1`, `numba_hooks` is not imported and none of its mechanisms
   apply: kernels are plain `numba.njit(cache=True)` with entry points, no helper
   process compiles, kernels are passed to the stepping loop as dispatchers, and
-  closures over kernels (the advection stages, the stepping loop) are compiled in every
-  process, since numba's own cache key for them changes from one process to the next.
+  closures over kernels (the advection stages, the stepping loop, the models' source
+  stages, built per basal law) are compiled in every process, since numba's own cache
+  key for them changes from one process to the next.
   The numbers computed are the same (`tests/test_numba_fallback.py`).
 * **The app** loads its kernels in a background thread (`app/kernels.py`) and says so:
   its first picture came 13 s after a start with an empty cache (docs/teaching.md).

@@ -99,9 +99,10 @@ class EquationSystem:
     """index in :attr:`layers` of the layer an erodible bed at rest belongs to (the
     initial shape ``column_on_bed`` adds its bed there); None: the model has no erodible
     layer and runs such cases on the rigid bed"""
-    law_kernels: Any = None
-    """the :attr:`kernels` with a rate-dependent basal friction law, for parameters
-    whose ``rate_dependent_law`` is true (None: the model has no such choice)"""
+    law_kernels: Callable[[Any], Any] | None = None
+    """``basal law -> its kernels``: the :attr:`kernels` compiled with the
+    rate-dependent basal law that parameters name as their ``basal_law`` (None: the
+    model has no such choice)"""
     diagnostics: Mapping[str, int] = field(default_factory=dict)
     """the model's own slots of the fv-split diagnostics array, name -> index (named in
     its layout, from :data:`pdeflow.numerics.layout.MODEL_SLOTS`): what its source stage
@@ -110,12 +111,12 @@ class EquationSystem:
     erosion series"""
 
     def kernels_for(self, parameters: Any) -> Any:
-        """The kernel bundle for ``parameters``: :attr:`law_kernels` if they choose a
-        rate-dependent basal law, else :attr:`kernels` (so that a Coulomb run compiles
-        none of the laws' code)."""
-        if self.law_kernels is not None and getattr(parameters, "rate_dependent_law",
-                                                    False):
-            return self.law_kernels
+        """The kernel bundle for ``parameters``: :attr:`law_kernels` of their
+        ``basal_law`` if they choose a rate-dependent one, else :attr:`kernels` (so that
+        a run compiles its own law's code only)."""
+        law = getattr(parameters, "basal_law", None)
+        if self.law_kernels is not None and law is not None:
+            return self.law_kernels(law)
         return self.kernels
 
     @property

@@ -10,12 +10,13 @@ import pytest
 from pde.backends import get_backend
 
 import pdeflow
+from pdeflow.models.friction_laws import LAWS as FRICTION_LAWS
 from pdeflow.models.friction_laws import h_stop
 from pdeflow.models.single_layer import layout as S
 from pdeflow.models.two_layer import layout as T
 from pdeflow.models.two_layer.laws import friction_two_layer_law
 from pdeflow.numerics import layout as L
-from pdeflow.numerics.rheology import basal_accel, law_block, law_speed
+from pdeflow.numerics.rheology import basal_accel, law_block
 from tests.helpers import grid, step
 
 LAWS = ["pouliquen", "mu_i", "voellmy"]
@@ -134,13 +135,15 @@ def test_backward_euler_step_is_the_root_and_set_valued(law):
     u + dt a(u) = |b| (a: the law's deceleration) to round-off; u grows with |b|; thin
     films (h down to 1e-12 m) give finite speeds."""
     P = law_parameters(law)
+    kernels = FRICTION_LAWS[law].kernels
+    law_speed, accel = kernels.speed, basal_accel(kernels)
     law = law_block(P, S.LAW)
     rng = np.random.default_rng(3)
     gz = P[S.G_Z]
     for _ in range(2000):
         h = 10.0 ** rng.uniform(-12, 0.5)
         dt = 10.0 ** rng.uniform(-5, -1)
-        a_static = dt * basal_accel(law, h, gz, h, 0.0)
+        a_static = dt * accel(law, h, gz, h, 0.0)
         b = a_static * rng.uniform(0.0, 3.0) + (rng.uniform(0, 5) if rng.random() < 0.3
                                                  else 0.0)
         s = law_speed(b, h, gz, h, dt, law)
@@ -149,7 +152,7 @@ def test_backward_euler_step_is_the_root_and_set_valued(law):
             assert s == 0.0
         else:
             assert s > 0.0 or b - a_static < 1e-300
-            residual = s + dt * basal_accel(law, h, gz, h, s) - b
+            residual = s + dt * accel(law, h, gz, h, s) - b
             assert abs(residual) <= 1e-12 * b
             assert law_speed(b * 1.01, h, gz, h, dt, law) >= s
 
@@ -160,6 +163,8 @@ def test_two_layer_root_balances_the_total_momentum(law):
     total momentum m1 (u1 - b1) + m2 (u2 - b2) + dt B(u2) = 0, and a stuck one is held
     by the static bound."""
     P = law_parameters(law, pdeflow.TwoLayerGranular)
+    kernels = FRICTION_LAWS[law].kernels
+    solve, accel = friction_two_layer_law(kernels), basal_accel(kernels)
     law = law_block(P, T.LAW)
     rng = np.random.default_rng(5)
     g, r = P[T.G_Z], P[T.R]
@@ -169,16 +174,15 @@ def test_two_layer_root_balances_the_total_momentum(law):
         b1, b2 = rng.normal(0, 2, 2)
         m1 = r * h1
         kdt = dt * 0.65 * r * g * h1 * P[T.TAN_INT]
-        u1, u2 = friction_two_layer_law(b1, b2, m1, h2, kdt, dt * 0.03, dt, g, h1 + h2,
-                                        law)
+        u1, u2 = solve(b1, b2, m1, h2, kdt, dt * 0.03, dt, g, h1 + h2, law)
         assert np.isfinite(u1) and np.isfinite(u2)
         w = m1 + h2
         if u2 == 0.0:
             push = h2 * b2 + m1 * (b1 - u1)
-            assert abs(push) <= dt * basal_accel(law, h1 + h2, g * w, 1.0, 0.0) * (
+            assert abs(push) <= dt * accel(law, h1 + h2, g * w, 1.0, 0.0) * (
                 1 + 1e-12)
         else:
-            bdt = dt * basal_accel(law, h1 + h2, g * w, 1.0, abs(u2)) * np.sign(u2)
+            bdt = dt * accel(law, h1 + h2, g * w, 1.0, abs(u2)) * np.sign(u2)
             balance = m1 * (u1 - b1) + h2 * (u2 - b2) + bdt
             assert abs(balance) <= 1e-10 * (m1 * abs(b1) + h2 * abs(b2) + abs(bdt))
 
@@ -208,8 +212,9 @@ def test_numba_and_numpy_rates_agree_for_every_law(law, two_layer):
 
 def test_coulomb_block_and_law_parameters_are_validated():
     P = pdeflow.SingleLayerGranular(phi_b_deg=30.0).parameter_array()
-    assert P[S.LAW + L.LAW_CODE] == L.FRICTION_COULOMB
     assert P[S.LAW + L.LAW_MU1] == P[S.TAN_B]
+    assert not P[S.LAW + 1:S.LAW + L.N_LAW].any()  # no code: the kernels carry the law
+    assert len(law_block(P, S.LAW)) == L.N_LAW  # what the kernels read is the block
     with pytest.raises(ValueError, match=r"^friction_law must be one of"):
         pdeflow.SingleLayerGranular(friction_law="bingham")
     with pytest.raises(ValueError, match=r"^pouliquen_L must lie in \(0, inf\) m"):
@@ -220,26 +225,36 @@ def test_coulomb_block_and_law_parameters_are_validated():
         pdeflow.SingleLayerGranular(voellmy_xi=-1.0)
 
 
-def test_coulomb_runs_compile_none_of_the_laws_code():
-    """A Coulomb run uses the model's bundle, whose stepping kernels call no law kernel;
-    any other law uses the law bundle (the same for every law: its code is read at run
-    time, so a sweep over laws compiles once)."""
-    from pdeflow.numerics import compile_parallel, rheology
+def _law_code(kernel) -> bool:
+    """True for a kernel of a basal law (:mod:`pdeflow.numerics.rheology`,
+    :mod:`pdeflow.models.two_layer.laws`)."""
+    return kernel.py_func.__module__ in ("pdeflow.numerics.rheology",
+                                         "pdeflow.models.two_layer.laws")
 
-    law_kernels = {id(k) for k in vars(rheology).values()
-                   if getattr(getattr(k, "py_func", None), "__module__", "") == rheology.__name__}
+
+def test_each_run_compiles_its_own_law_only():
+    """A Coulomb run uses the model's bundle, whose stepping kernels call no law kernel;
+    a run with a law uses that law's bundle (one per law), whose stage calls that law's
+    step and no other law's: the law reaches the kernels as compiled-in constants only
+    (the parameter vector holds no code of it)."""
+    from pdeflow.numerics import compile_parallel
+
+    def tree(bundle) -> list:
+        found: dict = {}
+        for k in (bundle.sources, bundle.predictor, bundle.mol_sources):
+            compile_parallel._call_tree(k, found)
+        return list(found.values())
+
     for cls in (pdeflow.SingleLayerGranular, pdeflow.TwoLayerGranular):
         coulomb = cls()
         assert coulomb.kernels is coulomb.system.kernels
-        found: dict = {}
-        for k in (coulomb.kernels.sources, coulomb.kernels.predictor):
-            compile_parallel._call_tree(k, found)
-        assert not law_kernels & set(found)
+        assert not any(map(_law_code, tree(coulomb.kernels)))
         bundles = {id(cls(friction_law=law).kernels) for law in LAWS}
-        assert bundles == {id(coulomb.system.law_kernels)}
-        found = {}
-        compile_parallel._call_tree(coulomb.system.law_kernels.sources, found)
-        assert law_kernels & {id(k) for k in found.values()}
+        assert len(bundles) == len(LAWS) and id(coulomb.kernels) not in bundles
+        for law in LAWS:
+            found = tree(cls(friction_law=law).kernels)
+            steps = {FRICTION_LAWS[name].kernels.speed for name in LAWS}
+            assert [k for k in found if k in steps] == [FRICTION_LAWS[law].kernels.speed]
 
 
 def test_rheology_report_generator_runs(tmp_path):
@@ -312,7 +327,7 @@ def test_case_key_reaches_the_run_and_its_stored_variant():
 
 def test_a_study_over_laws_warms_every_law_bundle(tmp_path):
     """A study file choosing among basal laws: the kernels its workers will need (the
-    Coulomb bundle and the law bundle) are among those its process prepares."""
+    Coulomb bundle and the chosen law's bundle) are among those its process prepares."""
     from pathlib import Path
 
     from pdeflow.study.evaluate import study_steppers
@@ -330,7 +345,7 @@ def test_a_study_over_laws_warms_every_law_bundle(tmp_path):
     kernels = {k for s in study_steppers(spec) for k in s.kernels}
     system = pdeflow.SingleLayerGranular.system
     assert system.kernels.sources in kernels
-    assert system.law_kernels.sources in kernels
+    assert system.law_kernels(FRICTION_LAWS["voellmy"].kernels).sources in kernels
 
 
 def _cached_rows():

@@ -107,7 +107,7 @@ LAW_REFINE = (0.0025, 0.00125)
 def static_angle(name: str, depth: float) -> float:
     """The bed law's static friction angle [deg] of the set ``name`` for a layer
     ``depth`` [m] deep: Pouliquen's mu_stop(h) = tan d1 + (tan d2 - tan d1)/(1 + h/L)
-    (the inverse of h_stop; pdeflow.numerics.rheology.static_mu), mu_i's tan d1, and
+    (the inverse of h_stop; pdeflow.numerics.rheology.POULIQUEN.static_mu), mu_i's tan d1, and
     Coulomb's phi_b_deg."""
     model, sets = SETS[name]
     p = load_case(CASE, sets).make_pde(model).parameters

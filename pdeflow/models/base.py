@@ -280,9 +280,8 @@ class GranularPDE(PDEBase):
         a run, its solver and its summary share it)."""
         last = self.__dict__.get("_metric")
         if last is None or last[0] is not grid:
-            metric = metric_of(grid)
-            self._check_geometry(metric.geometry)
-            self._metric = (grid, metric)
+            self.geometry(grid)  # the models are 1D: refuses a 2D grid
+            self._metric = (grid, metric_of(grid))
         return self._metric[1]
 
     def make_state(self, grid: CartesianGrid, **profiles: np.ndarray) -> FieldCollection:

@@ -117,21 +117,27 @@ def cached(func: Callable | None = None, *, inline: str = "never") -> Any:
 
 
 def specialise(func: Callable, *arg_types: Any, helper: bool = False,
-               pointer: bool = True) -> Any:
+               pointer: bool = True, inline: str = "never", name: str | None = None) -> Any:
     """A numba kernel of the closure ``func`` with the one signature ``arg_types``,
     disk-cached (see the module docstring); compiled by :func:`ready`. ``helper``: only
     other kernels call it (see :func:`cached`);
-    ``pointer``: it is also called through a function pointer (:func:`first_class`)."""
+    ``pointer``: it is also called through a function pointer (:func:`first_class`).
+    Without ``arg_types`` (a helper, e.g. ``inline="always"``) it declares no signature
+    and is compiled by the kernels that call it, as :func:`cached` helpers are.
+    ``name``: the module-level name the caller binds it to (one closure of its
+    factory), so that a new interpreter finds it by name
+    (:mod:`pdeflow.numerics.compile_parallel`)."""
     if config.DISABLE_JIT:
         return func
     # numba names compiled code after the function's qualified name and a per-process
     # counter: two closures of one factory compiled in two processes (a run and its
     # compile helper, or two runs) can get one name, and a process that loads both
     # from the disk cache may run one's code for the other (numba issue #10486). Here
-    # the name carries what the closure is made of.
-    func.__qualname__ += "_" + digest(func)[:12]
-    compiled = _jit(func, helper=helper, pointer=pointer)
-    _SIGNATURES[compiled] = tuple(arg_types)
+    # the name carries what the closure is made of, or is a module-level name.
+    func.__qualname__ = name or func.__qualname__ + "_" + digest(func)[:12]
+    compiled = _jit(func, helper=helper, pointer=pointer, inline=inline)
+    if arg_types:
+        _SIGNATURES[compiled] = tuple(arg_types)
     _SPECIALISED.append(compiled)
     return compiled
 

@@ -72,23 +72,19 @@ HYPERBOLICITY_MODES = {"none": HYPERBOLICITY_NONE, "exact": HYPERBOLICITY_EXACT,
                        "bound": HYPERBOLICITY_BOUND}
 
 # --- basal friction laws (pdeflow.numerics.rheology) -----------------------------------
-FRICTION_COULOMB = 0  #: constant Coulomb friction tan(phi_b) (the paper's)
-FRICTION_POULIQUEN = 1  #: Pouliquen & Forterre (2002): mu(h, Fr)
-FRICTION_MU_I = 2  #: depth-averaged mu(I) of Jop, Forterre & Pouliquen (2006), Bagnold profile
-FRICTION_VOELLMY = 3  #: Voellmy (1955): mu + g u^2 / (xi h)
-FRICTION_LAWS = {"coulomb": FRICTION_COULOMB, "pouliquen": FRICTION_POULIQUEN,
-                 "mu_i": FRICTION_MU_I, "voellmy": FRICTION_VOELLMY}
-# The law's block of a model's parameter vector: offsets from the model's LAW index.
-# Every rate-dependent law is written mu(h, s) = mu1 + dmu s / (s0(h) + s) (+ a Voellmy
-# drag) for a speed s > 0, with s0(h) = S0 h^(3/2); see pdeflow.numerics.rheology.
-LAW_CODE = 0  #: FRICTION_* [code]
-LAW_MU1 = 1  #: friction coefficient as s -> 0 on the flowing branch (mu1, mu_s, mu) [-]
-LAW_DMU = 2  #: mu2 - mu1 [-] (0 for Voellmy)
-LAW_S0 = 3  #: s0(h) / h^(3/2): speed at which the rate part is half [m^-1/2 s^-1]
-LAW_INV_L = 4  #: Pouliquen: 1/L [1/m]; 0 for the other laws
-LAW_BETA_G = 5  #: Pouliquen: beta sqrt(g_z), the Fr = beta plateau edge / sqrt(h) [m^1/2/s]
-LAW_DRAG = 6  #: Voellmy: g / xi [1/m]; 0 for the other laws
-N_LAW = 7
+# The law's block of a model's parameter vector: offsets from the model's LAW index. A
+# law is chosen when its kernels are compiled (pdeflow.numerics.rheology.BasalLaw), not
+# by a code in the vector; the block holds its constants. The shipped rate-dependent laws
+# are written mu(h, s) = mu1 + dmu s / (s0(h) + s) (+ a Voellmy drag) for a speed s > 0,
+# with s0(h) = S0 h^(3/2), and use the offsets below; another law may use the block as
+# it likes, but for LAW_DRAG, the quadratic drag every law's deceleration adds.
+LAW_MU1 = 0  #: friction coefficient as s -> 0 on the flowing branch (mu1, mu_s, mu) [-]
+LAW_DMU = 1  #: mu2 - mu1 [-] (0 for Voellmy)
+LAW_S0 = 2  #: s0(h) / h^(3/2): speed at which the rate part is half [m^-1/2 s^-1]
+LAW_INV_L = 3  #: Pouliquen: 1/L [1/m]; 0 for the other laws
+LAW_BETA_G = 4  #: Pouliquen: beta sqrt(g_z), the Fr = beta plateau edge / sqrt(h) [m^1/2/s]
+LAW_DRAG = 5  #: Voellmy: g / xi [1/m]; 0 for the other laws
+N_LAW = 6
 
 # --- geometry of the grid (pdeflow.numerics.geometry) -----------------------------------
 GEOMETRY_PLANAR = 0  #: a 1D Cartesian grid: the planar slope, per unit width

@@ -3,9 +3,13 @@ r"""Basal friction laws, and their set-valued backward-Euler friction step.
 A law gives the basal friction of a layer of depth h [m] sliding at speed s = |u| [m/s]
 as an acceleration per unit mass ``gw mu(h, s) + D s^2 / h_m`` (``gw`` = g_z times the
 layer's weight over its mass: g_z for one layer; D = g/xi only for Voellmy) and, at rest,
-the set [-gw mu_static(h), gw mu_static(h)]. Codes and the parameter block are in
-:mod:`pdeflow.numerics.layout` (``FRICTION_*``, ``LAW_*``); the model's dataclass fills
-them (:mod:`pdeflow.models.friction_laws`).
+the set [-gw mu_static(h), gw mu_static(h)]. A law is a :class:`BasalLaw`: its kernels
+over its constants ``law`` (the tuple :func:`law_block` reads from the law's block of
+the parameter vector, offsets ``layout.LAW_*``, which the model's dataclass fills,
+:mod:`pdeflow.models.friction_laws`). A model's source stage is compiled per law, with
+the law's kernels as constants (e.g. :func:`pdeflow.models.single_layer.sources.stage_kernels`),
+so that a run compiles its own law's code only; Coulomb's friction is not a law here
+but each model's closed-form step (:mod:`.implicit`).
 
 The laws, written for s > 0 as mu(h, s) = mu1 + dmu s / (s0(h) + s), s0 = S0 h^(3/2):
 
@@ -38,66 +42,98 @@ division by h appears except Voellmy's D/h_m, with h_m above the dry tolerance.
 
 from __future__ import annotations
 
+import functools
 import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
 
 from . import layout as L
-from .compiled import cached
+from .compiled import cached, specialise
 from .implicit import drag_root
+
+MU1, DMU, S0, INV_L, BETA_G, DRAG = (L.LAW_MU1, L.LAW_DMU, L.LAW_S0, L.LAW_INV_L,
+                                     L.LAW_BETA_G, L.LAW_DRAG)
+
+
+@dataclass(frozen=True, eq=False)
+class BasalLaw:
+    """A rate-dependent basal law as kernels of its constants ``law`` (a tuple of
+    ``layout.N_LAW`` floats, :func:`law_block`), compared and hashed by identity (the
+    stage factories build one stage per law). Its deceleration is ``gw mu(h, s) +
+    law[LAW_DRAG] s^2 / hm`` (:func:`basal_accel`)."""
+
+    name: str
+    """the name case files use (``friction_law``)"""
+    static_mu: Any
+    """``(law, h) -> mu_static(h)``: the upper end of the set at rest [-]"""
+    flowing_mu: Any
+    """``(law, h, s) -> mu(h, s)`` [-] for s > 0 (mu(h, 0+) = mu_static(h))"""
+    flowing_mu_slope: Any
+    """``(law, h, s) -> d mu / d s`` [s/m] for s > 0 (>= 0: friction graph monotone)"""
+    speed: Any
+    """``(a, h, gw, hm, dt, law) -> s``: the speed after the set-valued backward-Euler
+    step from speed ``a`` [m/s] (0: held at rest), see the module docstring"""
+    accel_np: Callable[..., np.ndarray]
+    """numpy twin of :func:`basal_accel` over arrays: ``(law, h, gw, hm, s)``"""
 
 
 @cached(inline="always")
 def law_block(P, base):
-    """The law's block of ``P`` at ``base`` as a tuple of floats (code, mu1, dmu, S0,
-    1/L, beta sqrt(g_z), D): what the helpers below take. A tuple, not the array: an
-    array passed on to a helper costs a reference-count update per call, which was
-    6-30 times the friction law's own arithmetic (measured)."""
-    return (P[base + L.LAW_CODE], P[base + L.LAW_MU1], P[base + L.LAW_DMU],
-            P[base + L.LAW_S0], P[base + L.LAW_INV_L], P[base + L.LAW_BETA_G],
-            P[base + L.LAW_DRAG])
+    """The law's block of ``P`` at ``base`` as a tuple of its ``layout.N_LAW`` (six)
+    floats: what the law's kernels take. A tuple, not the array: an array passed on to
+    a helper costs a reference-count update per call, which was 6-30 times the friction
+    law's own arithmetic (measured)."""
+    return (P[base], P[base + 1], P[base + 2], P[base + 3], P[base + 4], P[base + 5])
+
+
+def law_block_np(P: np.ndarray, base: int) -> tuple[float, ...]:
+    """:func:`law_block` in Python (for the numpy twins)."""
+    return tuple(float(v) for v in P[base:base + L.N_LAW])
+
+
+@functools.cache
+def basal_accel(law: BasalLaw) -> Any:
+    """The kernel ``(law, h, gw, hm, s)``: friction deceleration [m/s^2] of ``law`` at
+    speed ``s`` >= 0 [m/s] (s = 0: the static bound), gw mu(h, s) + D s^2 / hm, ``hm``
+    the layer's mass depth [m]."""
+    static_mu, flowing_mu = law.static_mu, law.flowing_mu
+
+    def basal_accel_law(c, h, gw, hm, s):
+        if s <= 0.0:
+            return gw * static_mu(c, h)
+        return gw * flowing_mu(c, h, s) + c[DRAG] * s * s / hm
+
+    return specialise(basal_accel_law, helper=True, inline="always")
+
+
+@functools.cache
+def law_velocity(law: BasalLaw) -> Any:
+    """The kernel ``(b, h, gw, hm, dt, law)``: :attr:`BasalLaw.speed` with the sign of
+    ``b``, the velocity after the friction step [m/s]."""
+    speed = law.speed
+
+    def law_velocity_law(b, h, gw, hm, dt, c):
+        s = speed(abs(b), h, gw, hm, dt, c)
+        return s if b > 0.0 else -s
+
+    return specialise(law_velocity_law, helper=True, inline="always")
 
 
 @cached(inline="always")
-def static_mu(law, h):
-    """Upper end of the friction coefficient's set at rest [-] for depth ``h`` [m]."""
-    mu = law[1]
-    if int(law[0]) == L.FRICTION_POULIQUEN:
-        mu += law[2] / (1.0 + h * law[4])
-    return mu
+def _rational_mu(law, h, s):
+    """mu1 + dmu s / (s0(h) + s), s0 = S0 h^(3/2) [-]."""
+    s0 = law[S0] * h * math.sqrt(h)
+    return law[MU1] + law[DMU] * s / (s0 + s)
 
 
 @cached(inline="always")
-def flowing_mu(law, h, s):
-    """Friction coefficient mu(h, s) [-] of a layer of depth ``h`` [m] at speed ``s`` > 0
-    [m/s] (without Voellmy's drag, see :func:`basal_accel`)."""
-    code = int(law[0])
-    mu1 = law[1]
-    if code == L.FRICTION_VOELLMY or code == L.FRICTION_COULOMB:
-        return mu1
-    if code == L.FRICTION_POULIQUEN and s < law[5] * math.sqrt(h):
-        return static_mu(law, h)  # the plateau Fr < beta: mu_stop(h)
-    s0 = law[3] * h * math.sqrt(h)
-    return mu1 + law[2] * s / (s0 + s)
-
-
-@cached(inline="always")
-def flowing_mu_slope(law, h, s):
-    """d mu(h, s) / d s [s/m] for s > 0 (0 on Pouliquen's plateau and for Voellmy)."""
-    code = int(law[0])
-    if code == L.FRICTION_VOELLMY or code == L.FRICTION_COULOMB:
-        return 0.0
-    if code == L.FRICTION_POULIQUEN and s < law[5] * math.sqrt(h):
-        return 0.0
-    s0 = law[3] * h * math.sqrt(h)
-    return law[2] * s0 / ((s0 + s) * (s0 + s))
-
-
-@cached(inline="always")
-def basal_accel(law, h, gw, hm, s):
-    """Friction deceleration [m/s^2] at speed ``s`` >= 0 [m/s] (s = 0: the static
-    bound): gw mu(h, s) + D s^2 / hm, ``hm`` the layer's mass depth [m]."""
-    if s <= 0.0:
-        return gw * static_mu(law, h)
-    return gw * flowing_mu(law, h, s) + law[6] * s * s / hm
+def _rational_slope(law, h, s):
+    """d/ds of :func:`_rational_mu` [s/m]."""
+    s0 = law[S0] * h * math.sqrt(h)
+    return law[DMU] * s0 / ((s0 + s) * (s0 + s))
 
 
 @cached(inline="always")
@@ -112,35 +148,114 @@ def _rational_root(y, c, s0):
 
 
 @cached(inline="always")
-def law_speed(a, h, gw, hm, dt, law):
-    """Speed |u| [m/s] after the set-valued backward-Euler friction step of a layer
-    whose velocity before friction has magnitude ``a`` [m/s]: depth ``h`` [m] seen by the
-    law, ``gw`` = g_z weight/mass [m/s^2], mass depth ``hm`` [m] (see module docstring)."""
-    ydt = dt * gw
-    code = int(law[0])
-    y = a - ydt * law[1]
-    if code == L.FRICTION_POULIQUEN:
-        # mu_stop(h) = mu1 + dmu / (1 + h/L) is the static bound and the plateau
-        # Fr < beta; both tests multiplied by 1 + h/L > 0 (no division on the way)
-        w = 1.0 + h * law[4]
-        drive = y * w - ydt * law[2]  # (a - dt gw mu_stop) (1 + h/L)
-        if drive <= 0.0:
-            return 0.0  # held at rest by static friction
-        root_h = math.sqrt(h)
-        if drive <= law[5] * root_h * w:
-            return drive / w
-        return _rational_root(y, ydt * law[2], law[3] * h * root_h)
-    if y <= 0.0:
-        return 0.0  # held at rest: the static bound of the other laws is mu1
-    if code == L.FRICTION_VOELLMY:
-        return drag_root(y, 1.0, dt * law[6] / hm)
-    if code == L.FRICTION_COULOMB:
-        return y
-    return _rational_root(y, ydt * law[2], law[3] * h * math.sqrt(h))
+def _mu1(law, h):
+    """mu1 [-]: the static bound of mu_i and Voellmy, and Voellmy's mu."""
+    return law[MU1]
 
 
 @cached(inline="always")
-def law_velocity(b, h, gw, hm, dt, law):
-    """:func:`law_speed` with the sign of ``b``: the velocity after friction [m/s]."""
-    s = law_speed(abs(b), h, gw, hm, dt, law)
-    return s if b > 0.0 else -s
+def _mu1_flowing(law, h, s):
+    """Voellmy's mu [-] (its rate part is the drag)."""
+    return law[MU1]
+
+
+@cached(inline="always")
+def _no_slope(law, h, s):
+    """0: a coefficient that does not depend on the speed."""
+    return 0.0
+
+
+@cached(inline="always")
+def _pouliquen_static(law, h):
+    """mu_stop(h) = mu1 + dmu / (1 + h/L) [-]."""
+    return law[MU1] + law[DMU] / (1.0 + h * law[INV_L])
+
+
+@cached(inline="always")
+def _pouliquen_mu(law, h, s):
+    """Pouliquen's mu(h, s) [-]: mu_stop(h) on the plateau Fr < beta."""
+    if s < law[BETA_G] * math.sqrt(h):
+        return _pouliquen_static(law, h)
+    return _rational_mu(law, h, s)
+
+
+@cached(inline="always")
+def _pouliquen_slope(law, h, s):
+    """d mu / d s of :func:`_pouliquen_mu` [s/m] (0 on the plateau)."""
+    if s < law[BETA_G] * math.sqrt(h):
+        return 0.0
+    return _rational_slope(law, h, s)
+
+
+@cached(inline="always")
+def _pouliquen_speed(a, h, gw, hm, dt, law):
+    """Pouliquen's friction step (see :attr:`BasalLaw.speed`)."""
+    ydt = dt * gw
+    y = a - ydt * law[MU1]
+    # mu_stop(h) = mu1 + dmu / (1 + h/L) is the static bound and the plateau Fr < beta;
+    # both tests multiplied by 1 + h/L > 0 (no division on the way)
+    w = 1.0 + h * law[INV_L]
+    drive = y * w - ydt * law[DMU]  # (a - dt gw mu_stop) (1 + h/L)
+    if drive <= 0.0:
+        return 0.0  # held at rest by static friction
+    root_h = math.sqrt(h)
+    if drive <= law[BETA_G] * root_h * w:
+        return drive / w
+    return _rational_root(y, ydt * law[DMU], law[S0] * h * root_h)
+
+
+@cached(inline="always")
+def _mu_i_speed(a, h, gw, hm, dt, law):
+    """mu(I)'s friction step (see :attr:`BasalLaw.speed`)."""
+    ydt = dt * gw
+    y = a - ydt * law[MU1]
+    if y <= 0.0:
+        return 0.0  # held at rest: the static bound is mu1
+    return _rational_root(y, ydt * law[DMU], law[S0] * h * math.sqrt(h))
+
+
+@cached(inline="always")
+def _voellmy_speed(a, h, gw, hm, dt, law):
+    """Voellmy's friction step (see :attr:`BasalLaw.speed`): a quadratic in s."""
+    y = a - dt * gw * law[MU1]
+    if y <= 0.0:
+        return 0.0  # held at rest: the static bound is mu
+    return drag_root(y, 1.0, dt * law[DRAG] / hm)
+
+
+def _accel_np(law: tuple, mu_static: Any, mu: Any, gw: Any, hm: Any,
+              s: np.ndarray) -> np.ndarray:
+    """gw mu + D s^2 / hm over arrays, mu_static where s = 0 [m/s^2]."""
+    mu = np.where(s > 0.0, mu, mu_static)
+    return gw * mu + law[DRAG] * s * s / np.maximum(hm, 1e-300)
+
+
+def _rational_np(law: tuple, hp: np.ndarray, s: np.ndarray) -> np.ndarray:
+    s0 = law[S0] * hp * np.sqrt(hp)
+    return law[MU1] + law[DMU] * s / np.maximum(s0 + s, 1e-300)
+
+
+def _pouliquen_np(law, h, gw, hm, s):
+    hp = np.maximum(h, 1e-300)
+    mu_static = law[MU1] + law[DMU] / (1.0 + hp * law[INV_L])
+    mu = np.where(s < law[BETA_G] * np.sqrt(hp), mu_static, _rational_np(law, hp, s))
+    return _accel_np(law, mu_static, mu, gw, hm, s)
+
+
+def _mu_i_np(law, h, gw, hm, s):
+    hp = np.maximum(h, 1e-300)
+    return _accel_np(law, law[MU1] + 0.0, _rational_np(law, hp, s), gw, hm, s)
+
+
+def _voellmy_np(law, h, gw, hm, s):
+    hp = np.maximum(h, 1e-300)
+    return _accel_np(law, law[MU1] + 0.0, np.full_like(hp, law[MU1]), gw, hm, s)
+
+
+POULIQUEN = BasalLaw("pouliquen", _pouliquen_static, _pouliquen_mu, _pouliquen_slope,
+                     _pouliquen_speed, _pouliquen_np)
+"""Pouliquen & Forterre (2002): mu(h, Fr) with the plateau Fr < beta"""
+MU_I = BasalLaw("mu_i", _mu1, _rational_mu, _rational_slope, _mu_i_speed, _mu_i_np)
+"""the depth-averaged mu(I) of Jop, Forterre & Pouliquen (2006), Bagnold profile"""
+VOELLMY = BasalLaw("voellmy", _mu1, _mu1_flowing, _no_slope, _voellmy_speed, _voellmy_np)
+"""Voellmy (1955): mu + g u^2 / (xi h)"""

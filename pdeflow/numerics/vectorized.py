@@ -72,23 +72,3 @@ def advection_rate(q: np.ndarray, dx: float, bc: tuple[int, int], fluctuations: 
     dmin, dplus, sL, sR = fluctuations(ext[:, :-1], ext[:, 1:], *args)
     smax = float(np.max(np.maximum(np.abs(sL), np.abs(sR))))
     return -(dplus[:, :-1] + dmin[:, 1:]) / dx, smax
-
-
-def basal_accel_np(P: np.ndarray, base: int, h: np.ndarray, gw: np.ndarray,
-                   hm: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """Friction deceleration [m/s^2] of the basal law at ``base`` over arrays (the numpy
-    twin of :func:`pdeflow.numerics.rheology.basal_accel`; depths > 0 where used)."""
-    code = int(P[base + L.LAW_CODE])
-    mu1, dmu = P[base + L.LAW_MU1], P[base + L.LAW_DMU]
-    hp = np.maximum(h, 1e-300)
-    mu_static = mu1 + (dmu / (1.0 + hp * P[base + L.LAW_INV_L])
-                       if code == L.FRICTION_POULIQUEN else 0.0)
-    if code in (L.FRICTION_COULOMB, L.FRICTION_VOELLMY):
-        mu = np.full_like(hp, mu1)
-    else:
-        s0 = P[base + L.LAW_S0] * hp * np.sqrt(hp)
-        mu = mu1 + dmu * s / np.maximum(s0 + s, 1e-300)
-        if code == L.FRICTION_POULIQUEN:
-            mu = np.where(s < P[base + L.LAW_BETA_G] * np.sqrt(hp), mu_static, mu)
-    mu = np.where(s > 0.0, mu, mu_static)
-    return gw * mu + P[base + L.LAW_DRAG] * s * s / np.maximum(hm, 1e-300)

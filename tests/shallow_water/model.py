@@ -3,13 +3,13 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from pdeflow import systems
 from pdeflow.models.base import GranularPDE, SharedParameters, stop_time
+from pdeflow.models.parameters import parameter_vector
 from pdeflow.models.single_layer import flux as saint_venant
 from pdeflow.models.single_layer.rates import fluctuations_np
 from pdeflow.numerics.model_kernels import ModelKernels
@@ -28,10 +28,7 @@ class ShallowWaterParameters(SharedParameters):
     kind = "shallow-water"
 
     def to_array(self) -> np.ndarray:
-        th = math.radians(self.theta_deg)
-        P = np.zeros(W.SIZE)
-        P[W.G_Z] = self.g * math.cos(th)
-        P[W.G_X] = self.g * math.sin(th)
+        P = parameter_vector(self, W.SIZE)
         P[W.DRY] = self.dry_tolerance
         return P
 

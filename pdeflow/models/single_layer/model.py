@@ -23,8 +23,9 @@ import numpy as np
 from ... import systems
 from ..base import GranularPDE, SharedParameters, check_range, stop_time
 from ..friction_laws import FrictionLawParameters
+from ..parameters import parameter_vector
 from . import layout as S
-from .kernels import KERNELS, LAW_KERNELS
+from .kernels import KERNELS, kernels
 
 
 @dataclass
@@ -44,10 +45,7 @@ class SingleLayerParameters(FrictionLawParameters, SharedParameters):
 
     def to_array(self) -> np.ndarray:
         """Kernel parameter vector (layout in :mod:`.layout`)."""
-        th = math.radians(self.theta_deg)
-        P = np.zeros(S.SIZE)
-        P[S.G_Z] = self.g * math.cos(th)
-        P[S.G_X] = self.g * math.sin(th)
+        P = parameter_vector(self, S.SIZE)
         P[S.TAN_B] = math.tan(math.radians(self.phi_b_deg))
         P[S.DRY] = self.dry_tolerance
         P[S.SLOW_U] = self.rest_speed
@@ -78,7 +76,7 @@ SYSTEM = systems.register(systems.EquationSystem(
     name="single_layer", label="single layer", adjective="single-layer",
     layers=(systems.Layer("h", "hu", "u", "single layer", "single"),),
     parameters_class=SingleLayerParameters, pde_class=SingleLayerGranular,
-    kernels=KERNELS, law_kernels=LAW_KERNELS, diagnostics=S.DIAGNOSTICS,
+    kernels=KERNELS, law_kernels=kernels, diagnostics=S.DIAGNOSTICS,
     densities=lambda p: (1.0,),
     layer_depths=lambda h, x, ini, p: (h,),
     summarize=summarize, bytes_per_cell=180, paper_runout_law=(2.25, 1.06),

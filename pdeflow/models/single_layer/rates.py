@@ -4,45 +4,54 @@ u / max(|u|, mol_eps) (see :mod:`pdeflow.models.two_layer.rates`)."""
 
 from __future__ import annotations
 
+import functools
+from typing import Any
+
 import numpy as np
 
-from ...numerics import layout as L
-from ...numerics.compiled import FIELDS, PARAMS, STATE, kernel
-from ...numerics.rheology import basal_accel, law_block
-from ...numerics.vectorized import at_rest, basal_accel_np, layer_fluctuations, velocity_np
+from ...numerics.compiled import FIELDS, PARAMS, STATE, specialise
+from ...numerics.rheology import BasalLaw, basal_accel, law_block, law_block_np
+from ...numerics.vectorized import at_rest, layer_fluctuations, velocity_np
 from . import layout as S
 
 
-@kernel(STATE, FIELDS, PARAMS)
-def source_rate_single(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> None:
-    """Add gravity along the bed and regularised basal friction (single layer)."""
-    coulomb = int(P[S.LAW + L.LAW_CODE]) == L.FRICTION_COULOMB
-    for i in range(q.shape[1]):
-        h = max(q[0, i], 0.0)
-        if h > P[S.DRY]:
-            u = q[1, i] / h
-            if coulomb:
-                rate[1, i] += P[S.G_X] * h - P[S.G_Z] * h * P[S.TAN_B] * u / max(
-                    abs(u), P[S.MOL_EPS])
-            else:
-                rate[1, i] += P[S.G_X] * h - h * basal_accel(
-                    law_block(P, S.LAW), h, P[S.G_Z], h, abs(u)) * u / max(
+@functools.cache
+def source_rate(law: BasalLaw | None) -> Any:
+    """The kernel ``(q, rate, P)`` that adds gravity along the bed and the regularised
+    basal friction of the law ``law`` (None: Coulomb's) to ``rate`` (single layer)."""
+    coulomb = law is None
+    # closes over what its law calls only (None for Coulomb), as the scheme's factories
+    accel, block = (None, None) if coulomb else (basal_accel(law), law_block)
+
+    def source_rate_single(q, rate, P):
+        for i in range(q.shape[1]):
+            h = max(q[0, i], 0.0)
+            if h > P[S.DRY]:
+                u = q[1, i] / h
+                if coulomb:
+                    rate[1, i] += P[S.G_X] * h - P[S.G_Z] * h * P[S.TAN_B] * u / max(
                         abs(u), P[S.MOL_EPS])
+                else:
+                    rate[1, i] += P[S.G_X] * h - h * accel(
+                        block(P, S.LAW), h, P[S.G_Z], h, abs(u)) * u / max(
+                            abs(u), P[S.MOL_EPS])
+
+    return specialise(source_rate_single, STATE, FIELDS, PARAMS)
 
 
-def source_rate_single_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
-    """Gravity along the bed and regularised Coulomb friction of the single layer (the
-    numpy twin of :func:`source_rate_single`)."""
+def source_rate_np(q: np.ndarray, P: np.ndarray, law: BasalLaw | None = None) -> np.ndarray:
+    """Gravity along the bed and regularised basal friction of the single layer with
+    the law ``law`` (None: Coulomb's): the numpy twin of :func:`source_rate`."""
     rate = np.zeros_like(q)
     h = np.maximum(q[0], 0.0)
     u = velocity_np(h, q[1], P[S.DRY])
     eps = P[S.MOL_EPS]
     wet = h > P[S.DRY]
-    if int(P[S.LAW + L.LAW_CODE]) == L.FRICTION_COULOMB:
+    if law is None:
         fric = P[S.G_Z] * h * P[S.TAN_B] * u / np.maximum(np.abs(u), eps)
     else:
-        fric = h * basal_accel_np(P, S.LAW, h, P[S.G_Z], h, np.abs(u)) * u / np.maximum(
-            np.abs(u), eps)
+        fric = h * law.accel_np(law_block_np(P, S.LAW), h, P[S.G_Z], h,
+                                np.abs(u)) * u / np.maximum(np.abs(u), eps)
     rate[1] = np.where(wet, P[S.G_X] * h - fric, 0.0)
     return rate
 

@@ -1,61 +1,36 @@
 """The single layer's source stage: gravity along the bed and implicit basal friction.
 
-The stage of the split scheme on the wet cells (:func:`sources_single`) and on every
-cell (:func:`source_stage_single`, the post-step hook's kernel), MUSCL's friction
-predictor, and the same three with a rate-dependent basal law
-(:mod:`pdeflow.numerics.rheology`; the Coulomb kernels' code is reused with the law's
-friction helpers, :func:`pdeflow.numerics.callees.with_callees`). Friction is applied
-implicitly and set-valued: a layer whose drive is below the static friction stops in
-that step.
+The stage of the split scheme on the wet cells (``sources``) and on every cell
+(``source_stage``, the post-step hook's kernel) and MUSCL's friction predictor, built
+per basal law by :func:`stage_kernels` (Coulomb's closed form, or a rate-dependent law
+of :mod:`pdeflow.numerics.rheology` whose kernels are compiled in as constants).
+Friction is applied implicitly and set-valued: a layer whose drive is below the static
+friction stops in that step.
 """
 
 from __future__ import annotations
 
-import numpy as np
+import functools
+from typing import Any
 
 from ...numerics import layout as L
-from ...numerics.callees import with_callees
-from ...numerics.compiled import PARAMS, STATE, VECTOR, cached, f8, i8, kernel
+from ...numerics.compiled import PARAMS, STATE, VECTOR, cached, f8, i8, specialise
 from ...numerics.implicit import coulomb_single
-from ...numerics.rheology import law_block, law_velocity
+from ...numerics.rheology import BasalLaw, law_block, law_velocity
 from ...numerics.state import velocity
 from . import layout as S
 
 
-@kernel(STATE, f8, f8, PARAMS, VECTOR)
-def source_stage_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
-                        diag: np.ndarray) -> None:
-    """Implicit Coulomb friction (and gravity along the bed) for the single layer."""
-    sources_single(q, dt, t, P, diag, 0, q.shape[1] - 1)
-
-
-@kernel(STATE, f8, f8, PARAMS, VECTOR, i8, i8)
-def sources_single(q: np.ndarray, dt: float, t: float, P: np.ndarray,
-                   diag: np.ndarray, lo: int, hi: int) -> None:
-    """:func:`source_stage_single` on the cells ``lo..hi`` only."""
-    g = P[S.G_Z]
-    gx = P[S.G_X]
-    dry = P[S.DRY]
-    friction = basal_friction(dt, g, P)
-    moving = False
-    fast = False
-    for i in range(lo, hi + 1):
-        h = q[0, i]
-        m = q[1, i]
-        if h == 0.0 and m == 0.0:
-            continue
-        h = max(h, 0.0)
-        u = velocity(h, m, dry)
-        if dt > 0.0 and h > dry:
-            u = basal_velocity(u + dt * gx, h, dt, g, friction)
-        m = h * u if h > dry else 0.0
-        if m != 0.0:
-            moving = True
-            if h > P[S.SLOW_H] and abs(u) >= P[S.SLOW_U]:
-                fast = True
-        q[0, i] = h
-        q[1, i] = m
-    _close_stage(diag, t, moving, fast)
+@functools.cache
+def stage_kernels(law: BasalLaw | None) -> tuple[Any, Any, Any]:
+    """The single layer's source-stage kernels with the basal law ``law`` (None:
+    Coulomb's closed-form step, tan(phi_b)), compiled with the law's kernels as
+    constants: the stage on the cells lo..hi ``(q, dt, t, P, diag, lo, hi)``, the same
+    on every cell ``(q, dt, t, P, diag)`` (the post-step hook's kernel) and MUSCL's
+    friction predictor ``(q, dt, P, lo, hi)``."""
+    if law is None:
+        return _stage(basal_friction, basal_velocity, coulomb=True)
+    return _stage(law_friction, _law_step(law_velocity(law)))
 
 
 @cached(inline="always")
@@ -73,6 +48,86 @@ def basal_velocity(b, h, dt, g, friction):
 
 
 @cached(inline="always")
+def law_friction(dt, g, P):
+    """What a basal law needs of a step: its block of ``P`` (read once per stage)."""
+    return law_block(P, S.LAW)
+
+
+@functools.cache
+def _law_step(velocity_after: Any) -> Any:
+    """:func:`basal_velocity` with a law: its velocity after friction (its depth is
+    the depth it sees and its mass depth; g_z its weight per mass)."""
+
+    def basal_velocity_law(b, h, dt, g, law):
+        return velocity_after(b, h, g, h, dt, law)
+
+    return specialise(basal_velocity_law, helper=True, inline="always")
+
+
+def _stage(step_friction: Any, after_friction: Any,
+           coulomb: bool = False) -> tuple[Any, Any, Any]:
+    """The stage kernels with friction ``after_friction(b, h, dt, g, step_friction(dt,
+    g, P))`` (see :func:`basal_friction`, :func:`basal_velocity`); ``coulomb``: named
+    as the module's names they are bound to (a new interpreter imports them)."""
+
+    def named(kernel: Any) -> str | None:
+        return kernel.__name__ if coulomb else None
+
+    def sources_single(q, dt, t, P, diag, lo, hi):
+        """Implicit basal friction (and gravity along the bed) of the single layer on
+        the cells ``lo..hi``."""
+        g = P[S.G_Z]
+        gx = P[S.G_X]
+        dry = P[S.DRY]
+        friction = step_friction(dt, g, P)
+        moving = False
+        fast = False
+        for i in range(lo, hi + 1):
+            h = q[0, i]
+            m = q[1, i]
+            if h == 0.0 and m == 0.0:
+                continue
+            h = max(h, 0.0)
+            u = velocity(h, m, dry)
+            if dt > 0.0 and h > dry:
+                u = after_friction(u + dt * gx, h, dt, g, friction)
+            m = h * u if h > dry else 0.0
+            if m != 0.0:
+                moving = True
+                if h > P[S.SLOW_H] and abs(u) >= P[S.SLOW_U]:
+                    fast = True
+            q[0, i] = h
+            q[1, i] = m
+        _close_stage(diag, t, moving, fast)
+
+    sources = specialise(sources_single, STATE, f8, f8, PARAMS, VECTOR, i8, i8,
+                         name=named(sources_single))
+
+    def source_stage_single(q, dt, t, P, diag):
+        """:func:`sources_single` on every cell."""
+        sources(q, dt, t, P, diag, 0, q.shape[1] - 1)
+
+    def predictor_single(q, dt, P, lo, hi):
+        """Zero the momentum of cells that the implicit friction would hold at rest, in
+        place, in the cells ``lo..hi`` (MUSCL's intermediate stage, as
+        :func:`pdeflow.models.two_layer.friction.friction_kernels`' predictor)."""
+        dry = P[S.DRY]
+        friction = step_friction(dt, P[S.G_Z], P)
+        for i in range(lo, hi + 1):
+            h = max(q[0, i], 0.0)
+            if h > dry:
+                u = after_friction(q[1, i] / h + dt * P[S.G_X], h, dt, P[S.G_Z], friction)
+                if u == 0.0:
+                    q[1, i] = 0.0
+
+    return (
+        sources, specialise(source_stage_single, STATE, f8, f8, PARAMS, VECTOR,
+                            name=named(source_stage_single)),
+        specialise(predictor_single, STATE, f8, PARAMS, i8, i8,
+                   name=named(predictor_single)))
+
+
+@cached(inline="always")
 def _close_stage(diag, t, moving, fast):
     """Book a source stage ending at ``t`` [s] in ``diag``: the times of the last motion
     (``moving``: the layer has momentum; ``fast``: faster than SLOW_U where deeper than
@@ -86,55 +141,5 @@ def _close_stage(diag, t, moving, fast):
     diag[L.D_STEPS] += 1.0
 
 
-@kernel(STATE, f8, PARAMS, i8, i8)
-def predictor_single(q: np.ndarray, dt: float, P: np.ndarray, lo: int, hi: int) -> None:
-    """Zero the momentum of cells that the implicit Coulomb friction would hold at
-    rest, in place, in the cells ``lo..hi`` (MUSCL's intermediate stage, as
-    :func:`pdeflow.models.two_layer.friction.predictor_two_layer`)."""
-    dry = P[S.DRY]
-    for i in range(lo, hi + 1):
-        h = max(q[0, i], 0.0)
-        if h > dry:
-            u = coulomb_single(q[1, i] / h + dt * P[S.G_X],
-                               dt * P[S.G_Z] * P[S.TAN_B])
-            if u == 0.0:
-                q[1, i] = 0.0
-
-
-@cached(inline="always")
-def basal_friction_law(dt, g, P):
-    """What the basal law needs of a step: its block of ``P`` (read once per stage)."""
-    return law_block(P, S.LAW)
-
-
-@cached(inline="always")
-def basal_velocity_law(b, h, dt, g, law):
-    """:func:`basal_velocity` with the basal law."""
-    return law_velocity(b, h, g, h, dt, law)
-
-
-sources_single_law = kernel(STATE, f8, f8, PARAMS, VECTOR, i8, i8)(with_callees(
-    __name__, sources_single, "sources_single_law",
-    basal_friction=basal_friction_law, basal_velocity=basal_velocity_law))
-
-
-@kernel(STATE, f8, f8, PARAMS, VECTOR)
-def source_stage_single_law(q: np.ndarray, dt: float, t: float, P: np.ndarray,
-                            diag: np.ndarray) -> None:
-    """:func:`sources_single_law` on every cell (the post-step hook's kernel)."""
-    sources_single_law(q, dt, t, P, diag, 0, q.shape[1] - 1)
-
-
-@kernel(STATE, f8, PARAMS, i8, i8)
-def predictor_single_law(q: np.ndarray, dt: float, P: np.ndarray, lo: int,
-                         hi: int) -> None:
-    """:func:`predictor_single` with the basal law: zero the
-    momentum of cells that the law's implicit friction would hold at rest."""
-    dry = P[S.DRY]
-    law = law_block(P, S.LAW)
-    for i in range(lo, hi + 1):
-        h = max(q[0, i], 0.0)
-        if h > dry:
-            u = law_velocity(q[1, i] / h + dt * P[S.G_X], h, P[S.G_Z], h, dt, law)
-            if u == 0.0:
-                q[1, i] = 0.0
+sources_single, source_stage_single, predictor_single = stage_kernels(None)
+"""the Coulomb stage's kernels (the paper's baseline)"""

@@ -29,8 +29,9 @@ from ...numerics import layout as L
 from ...numerics.geometry import Metric
 from ..base import GranularPDE, SharedParameters, check_range, stop_time
 from ..friction_laws import FrictionLawParameters
+from ..parameters import parameter_vector
 from . import layout as T
-from .kernels import KERNELS, LAW_KERNELS
+from .kernels import KERNELS, kernels
 
 HYPERBOLICITY_MODES = L.HYPERBOLICITY_MODES
 
@@ -95,10 +96,7 @@ class TwoLayerParameters(FrictionLawParameters, SharedParameters):
 
     def to_array(self) -> np.ndarray:
         """Kernel parameter vector (layout in :mod:`.layout`)."""
-        th = math.radians(self.theta_deg)
-        P = np.zeros(T.SIZE)
-        P[T.G_Z] = self.g * math.cos(th)
-        P[T.G_X] = self.g * math.sin(th)
+        P = parameter_vector(self, T.SIZE)
         P[T.R] = self.density_ratio
         P[T.TAN_INT] = math.tan(math.radians(self.phi_int_deg))
         P[T.TAN_B] = math.tan(math.radians(self.phi_b_deg))
@@ -178,7 +176,7 @@ SYSTEM = systems.register(systems.EquationSystem(
     layers=(systems.Layer("h1", "h1u1", "u1", "upper layer", "upper"),
             systems.Layer("h2", "h2u2", "u2", "lower layer", "lower")),
     parameters_class=TwoLayerParameters, pde_class=TwoLayerGranular, kernels=KERNELS,
-    law_kernels=LAW_KERNELS, diagnostics=T.DIAGNOSTICS,
+    law_kernels=kernels, diagnostics=T.DIAGNOSTICS,
     densities=lambda p: (p.density_ratio, 1.0), layer_depths=layer_depths,
     summarize=summarize, has_fextra=True, cell_diagnostic="fextra_over_rho1",
     bytes_per_cell=320,

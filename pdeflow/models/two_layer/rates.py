@@ -21,73 +21,76 @@ which is the same equation rewritten through (25), see :mod:`.exchange`):
 
 from __future__ import annotations
 
+import functools
 import math
+from typing import Any
 
 import numpy as np
 
 from ...numerics import layout as L
-from ...numerics.compiled import FIELDS, PARAMS, STATE, kernel
-from ...numerics.rheology import basal_accel, law_block
+from ...numerics.compiled import FIELDS, PARAMS, STATE, specialise
+from ...numerics.rheology import BasalLaw, basal_accel, law_block, law_block_np
 from ...numerics.state import velocity
-from ...numerics.vectorized import (
-    at_rest,
-    basal_accel_np,
-    hll_split,
-    layer_fluctuations,
-    velocity_np,
-)
+from ...numerics.vectorized import at_rest, hll_split, layer_fluctuations, velocity_np
 from . import layout as T
 from .exchange import closure_rate, relaxed_rate
 
 
-@kernel(STATE, FIELDS, PARAMS)
-def source_rate_two_layer(q: np.ndarray, rate: np.ndarray, P: np.ndarray) -> None:
-    """Add the regularised source rate of (26)-(27) to ``rate`` (two layers)."""
-    r = P[T.R]
-    g = P[T.G_Z]
-    gx = P[T.G_X]
-    dry = P[T.DRY]
-    eps = P[T.MOL_EPS]
-    du_reg = max(P[T.DU_REG], eps)
-    closure = int(P[T.CLOSURE])
-    coulomb = int(P[T.LAW + L.LAW_CODE]) == L.FRICTION_COULOMB
-    for i in range(q.shape[1]):
-        h1 = max(q[0, i], 0.0)
-        h2 = max(q[2, i], 0.0)
-        u1 = velocity(h1, q[1, i], dry)
-        u2 = velocity(h2, q[3, i], dry)
-        wet1 = h1 > dry
-        wet2 = h2 > dry
-        m = 0.0
-        t1 = 0.0
-        if wet1:
-            du = u1 - u2
-            m = closure_rate(h1, du, r, g, P[T.TAN_INT], P[T.K], P[T.C], du_reg)
-            if (m > 0.0 and not wet2) or closure == L.CLOSURE_NONE:
-                m = 0.0
-            elif closure == L.CLOSURE_RELAXED:
-                tau = P[T.TAU_STAR] * math.sqrt((h1 + h2) / g)
-                m = relaxed_rate(m, h1, h2, du, r, g, P[T.TAN_INT], P[T.K], P[T.C], tau)
-            t1 = (P[T.K] * r * g * h1 * P[T.TAN_INT] + P[T.C] * du * du) * du / max(
-                abs(du), eps)
-            rate[0, i] += m / r
-            rate[1, i] += gx * h1 + u1 * m / r - t1 / r
-        rate[2, i] -= m
-        if wet2:
-            if coulomb:
-                bf = g * (r * h1 + h2) * P[T.TAN_B] * u2 / max(abs(u2), eps)
-            else:  # the law's stress: h2 x deceleration per unit mass
-                bf = h2 * basal_accel(law_block(P, T.LAW), h1 + h2,
-                                      g * (r * h1 + h2) / h2, h2, abs(u2)) * u2 / max(
-                                          abs(u2), eps)
-            rate[3, i] += gx * h2 - u1 * m + t1 - bf
-        else:
-            rate[3, i] -= u1 * m
+@functools.cache
+def source_rate(law: BasalLaw | None) -> Any:
+    """The kernel ``(q, rate, P)`` that adds the regularised source rate of (26)-(27)
+    with the basal law ``law`` (None: the paper's Coulomb friction) to ``rate``."""
+    coulomb = law is None
+    # closes over what its law calls only (None for Coulomb), as the scheme's factories
+    accel, block = (None, None) if coulomb else (basal_accel(law), law_block)
+
+    def source_rate_two_layer(q, rate, P):
+        r = P[T.R]
+        g = P[T.G_Z]
+        gx = P[T.G_X]
+        dry = P[T.DRY]
+        eps = P[T.MOL_EPS]
+        du_reg = max(P[T.DU_REG], eps)
+        closure = int(P[T.CLOSURE])
+        for i in range(q.shape[1]):
+            h1 = max(q[0, i], 0.0)
+            h2 = max(q[2, i], 0.0)
+            u1 = velocity(h1, q[1, i], dry)
+            u2 = velocity(h2, q[3, i], dry)
+            wet1 = h1 > dry
+            wet2 = h2 > dry
+            m = 0.0
+            t1 = 0.0
+            if wet1:
+                du = u1 - u2
+                m = closure_rate(h1, du, r, g, P[T.TAN_INT], P[T.K], P[T.C], du_reg)
+                if (m > 0.0 and not wet2) or closure == L.CLOSURE_NONE:
+                    m = 0.0
+                elif closure == L.CLOSURE_RELAXED:
+                    tau = P[T.TAU_STAR] * math.sqrt((h1 + h2) / g)
+                    m = relaxed_rate(m, h1, h2, du, r, g, P[T.TAN_INT], P[T.K], P[T.C],
+                                     tau)
+                t1 = (P[T.K] * r * g * h1 * P[T.TAN_INT] + P[T.C] * du * du) * du / max(
+                    abs(du), eps)
+                rate[0, i] += m / r
+                rate[1, i] += gx * h1 + u1 * m / r - t1 / r
+            rate[2, i] -= m
+            if wet2:
+                if coulomb:
+                    bf = g * (r * h1 + h2) * P[T.TAN_B] * u2 / max(abs(u2), eps)
+                else:  # the law's stress: h2 x deceleration per unit mass
+                    bf = h2 * accel(block(P, T.LAW), h1 + h2, g * (r * h1 + h2) / h2,
+                                    h2, abs(u2)) * u2 / max(abs(u2), eps)
+                rate[3, i] += gx * h2 - u1 * m + t1 - bf
+            else:
+                rate[3, i] -= u1 * m
+
+    return specialise(source_rate_two_layer, STATE, FIELDS, PARAMS)
 
 
-def source_rate_two_layer_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
-    """Regularised source rate of (26)-(27) of the two layers (the numpy twin of
-    :func:`source_rate_two_layer`)."""
+def source_rate_np(q: np.ndarray, P: np.ndarray, law: BasalLaw | None = None) -> np.ndarray:
+    """Regularised source rate of (26)-(27) of the two layers with the basal law
+    ``law`` (None: Coulomb's): the numpy twin of :func:`source_rate`."""
     rate = np.zeros_like(q)
     r, g, gx, dry, eps = P[T.R], P[T.G_Z], P[T.G_X], P[T.DRY], P[T.MOL_EPS]
     h1 = np.maximum(q[0], 0.0)
@@ -115,12 +118,12 @@ def source_rate_two_layer_np(q: np.ndarray, P: np.ndarray) -> np.ndarray:
     rate[0] = m / r
     rate[1] = np.where(wet1, gx * h1 + u1 * m / r - t1 / r, 0.0)
     rate[2] = -m
-    if int(P[T.LAW + L.LAW_CODE]) == L.FRICTION_COULOMB:
+    if law is None:
         bf = g * (r * h1 + h2) * P[T.TAN_B] * u2 / np.maximum(np.abs(u2), eps)
     else:
         gw = g * (r * h1 + h2) / np.maximum(h2, 1e-300)
-        bf = h2 * basal_accel_np(P, T.LAW, h1 + h2, gw, h2, np.abs(u2)) * u2 / np.maximum(
-            np.abs(u2), eps)
+        bf = h2 * law.accel_np(law_block_np(P, T.LAW), h1 + h2, gw, h2,
+                               np.abs(u2)) * u2 / np.maximum(np.abs(u2), eps)
     rate[3] = np.where(wet2, gx * h2 - u1 * m + t1 - bf, -u1 * m)
     return rate
 
