@@ -400,7 +400,11 @@ class DamBreakPage:
         for m, r in run.results.items():
             s = r.summary
             stop = s.get("stop_time")
-            state = (f"at rest at {stop:.3g} s" if stop is not None
+            # the table's stop time as the table prints it, and the end of the run (the
+            # time of the last frame): the page's times, each said what it is (issue 38
+            # saw four end times on one page, unexplained)
+            state = (f"at rest at {stop:.4g} s (the stop time); the run ended at "
+                     f"t = {r.t_final:.2f} s" if stop is not None
                      else "still moving at t_end")
             rows.append(f"<li><b>{LABELS[m]}</b>: {state}</li>")
         return (f"<ul>{''.join(rows)}</ul>"
