@@ -393,6 +393,12 @@ def test_presentation_mode_has_larger_fonts_and_fewer_controls(browser, server):
             if name == "dam-break":
                 assert _title(page, "depths")["font_px"] > 1.3 * normal
                 assert not page.locator(".pdeflow-sidebar").first.is_visible()
+                # the three figures in the window's height, F_extra too (the results
+                # go under them in this mode)
+                for fig in FIGURES[name]:
+                    box = _box(page, fig)
+                    assert box["y"] >= 0 and box["y"] + box["height"] <= SIZES[0][1], \
+                        (fig, box)
             assert layout_problems(page, FIGURES[name]) == [], name
             assert not log.errors, log.errors
         finally:

@@ -38,7 +38,7 @@ from ..solvers.fv_split import SimulationBlowUp
 from ..summary_table import print_summary
 from ..trackers import FextraStorageTracker
 from .controls import ParameterControls, command_line, list_cases, served
-from .look import PageLayout, fit_height, legend_outside, style_figures
+from .look import PageLayout, legend_outside, style_figures
 from .plan_view import PlanView
 
 FRAMES_PER_T_END = 250
@@ -50,18 +50,18 @@ SEND_MS = 40
 (the frames' run would otherwise hold the message back until it is done)."""
 LABELS = {m: systems.get(m).label for m in (PAPER_MODEL, BASELINE_MODEL)}
 """The models as the pages name them."""
-FEXTRA_TITLE = "F_extra keeps the layers hyperbolic"
-"""The F_extra figure's title (it fits the figure's 400 px on a projector)."""
-FRONTS_LABEL = "final fronts (dotted)"
-"""The legend entry of both models' final fronts (each in its layer's colour)."""
+FEXTRA_TITLE = "F_extra keeps the layers hyperbolic"  # fits 400 px
+FRONTS_LABEL = "final fronts (dotted)"  # both models', each in its layer's colour
 FIGURES_MIN_PX = 400
-"""The narrowest the three figures get before the results wrap under them [px]: their
-legends stand above the plots, so on a projector's 1024 px the results stand beside
-them also with the side bar shown (1024 - 240 - 380)."""
-FIGURE_HEIGHTS = {"depths": 220, "velocities": 165, "fextra": 195}
-"""Heights of the three profile figures [px] (presentation mode: more), each with its
-legend above the plot, the first with the time, the last with its title and the x axis:
-on a projector's 768 px the three fit under the header and the player, no scrolling."""
+"""The narrowest the figures get before the results wrap under them [px]: legends
+above the plots, the results stand beside them on 1024 px with the side bar shown."""
+FIGURE_HEIGHTS = {"depths": (220, 205), "velocities": (165, 172), "fextra": (195, 220)}
+"""Heights of the three figures [px], normal and presentation mode (larger upright y
+labels): on a projector's 768 px they fit under the player, in either mode."""
+DEPTH_LEGEND_COLUMNS = (2, 4)
+"""Entries per row of the depth legend, normal and presentation mode (full width)."""
+
+
 @dataclass
 class DamBreakRun:
     """One run of every model of a case: summary runs and animation frames."""
@@ -192,7 +192,8 @@ class DamBreakPage:
         self.controls = ParameterControls(cases, default if default in cases
                                           else next(iter(cases)), self.rerun)
         self.run: DamBreakRun | None = None
-        self.status = pn.pane.HTML("", css_classes=["pdeflow-status"],
+        # shown only with a message: empty, its margins took height from the figures
+        self.status = pn.pane.HTML("", css_classes=["pdeflow-status"], visible=False,
                                    sizing_mode="stretch_width")
         self.warnings = pn.pane.HTML("", css_classes=["pdeflow-warnings"],
                                      sizing_mode="stretch_width", visible=False,
@@ -226,7 +227,7 @@ class DamBreakPage:
         self.src_one = ColumnDataSource({k: zero for k in ("x", "h", "u")})
         # short: upright, the label must fit the figure's height on a projector
         fh = figure(title="", y_axis_label="depth ⊥ bed [m]",
-                    y_range=Range1d(0, 1), height=FIGURE_HEIGHTS["depths"], **opts)
+                    y_range=Range1d(0, 1), height=FIGURE_HEIGHTS["depths"][0], **opts)
         fh.varea("x", "zero", "h2", source=self.src_two, color=COLOURS["lower"],
                  alpha=0.6, legend_label="lower layer h2")
         fh.varea("x", "h2", "top", source=self.src_two, color=COLOURS["upper"],
@@ -234,7 +235,7 @@ class DamBreakPage:
         fh.line("x", "h", source=self.src_one, color=COLOURS["single"], line_width=2,
                 legend_label="single layer h")
         fu = figure(y_axis_label="velocity [m/s]", y_range=Range1d(0, 1),
-                    height=FIGURE_HEIGHTS["velocities"], **opts)
+                    height=FIGURE_HEIGHTS["velocities"][0], **opts)
         fu.line("x", "u1", source=self.src_two, color=COLOURS["upper"], line_width=2,
                 legend_label="u1 (upper)")
         fu.line("x", "u2", source=self.src_two, color=COLOURS["lower"], line_width=2,
@@ -243,7 +244,7 @@ class DamBreakPage:
                 legend_label="u single layer")
         ff = figure(x_axis_label="x [m]", y_axis_label="F_extra/ρ1 [m²/s²]",
                     title=FEXTRA_TITLE, y_range=Range1d(0, 1),
-                    height=FIGURE_HEIGHTS["fextra"], **opts)
+                    height=FIGURE_HEIGHTS["fextra"][0], **opts)
         # one line, named by the y axis and the title: no legend row over the plot
         ff.line("x", "f", source=self.src_two, color=COLOURS["fextra"], line_width=2)
         self.fronts = {m: Span(location=0, dimension="height", line_dash="dotted",
@@ -259,7 +260,7 @@ class DamBreakPage:
             stand_ins.append(fh.line([np.nan], [np.nan], line_dash="dotted", line_width=2,
                                      line_color=s.line_color))
         fh.legend.items.append(LegendItem(label=FRONTS_LABEL, renderers=stand_ins))
-        for f, ncols in ((fh, 2), (fu, 3)):
+        for f, ncols in ((fh, DEPTH_LEGEND_COLUMNS[0]), (fu, 3)):
             f.legend.click_policy = "hide"
             legend_outside(f, "above", ncols)  # never over the data, nor beside it
         for f, name in ((fh, "depths"), (fu, "velocities"), (ff, "fextra")):
@@ -277,7 +278,7 @@ class DamBreakPage:
             case = c.load()
             run = simulate(case, c.case_path, overrides, frames=False)
         except (CaseError, SimulationBlowUp, ValueError) as err:
-            self.status.object = f"<b>cannot run this:</b> {escape(str(err))}"
+            self._say(f"<b>cannot run this:</b> {escape(str(err))}")
             return
         with pn.io.hold():
             self.pause()
@@ -296,6 +297,11 @@ class DamBreakPage:
         self.player.direction = 0
         self.player.param.trigger("direction")
 
+    def _say(self, html: str) -> None:
+        """The status line above the figures (an error), or none."""
+        self.status.object = html
+        self.status.visible = bool(html)
+
     def set_present(self, present: bool) -> None:
         """Presentation mode: larger fonts and lines, the expert choices hidden."""
         self.present = present
@@ -303,7 +309,8 @@ class DamBreakPage:
         self.plan.set_present(present)
         for f, name in ((self.fig_h, "depths"), (self.fig_u, "velocities"),
                         (self.fig_f, "fextra")):
-            f.height = fit_height(FIGURE_HEIGHTS[name], present)
+            f.height = FIGURE_HEIGHTS[name][present]
+        self.fig_h.legend[0].ncols = DEPTH_LEGEND_COLUMNS[present]
         self.controls.set_present(present)
 
     def _animate(self, run: DamBreakRun) -> None:
@@ -312,7 +319,7 @@ class DamBreakPage:
         try:
             add_frames(run)
         except SimulationBlowUp as err:  # the frames' run differs a little
-            self.status.object = f"<b>no animation:</b> {escape(str(err))}"
+            self._say(f"<b>no animation:</b> {escape(str(err))}")
             return
         with pn.io.hold():
             self._show_frames(run)
@@ -337,7 +344,7 @@ class DamBreakPage:
         # change of the player would redraw it in the browser twice per move)
         self.show_frame(len(run.times) - 1)
         self.summary.text = self._summary_html(run)
-        self.status.object = ""
+        self._say("")
         self.warnings.object = warnings_html(run.warnings)
         self.warnings.visible = bool(run.warnings)
 
@@ -400,9 +407,7 @@ class DamBreakPage:
         for m, r in run.results.items():
             s = r.summary
             stop = s.get("stop_time")
-            # the table's stop time as the table prints it, and the end of the run (the
-            # time of the last frame): the page's times, each said what it is (issue 38
-            # saw four end times on one page, unexplained)
+            # each time said what it is (issue 38: four end times on one page)
             state = (f"at rest at {stop:.4g} s (the stop time); the run ended at "
                      f"t = {r.t_final:.2f} s" if stop is not None
                      else "still moving at t_end")
