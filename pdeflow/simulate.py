@@ -284,16 +284,18 @@ _LENGTH_KEYS = ("front_position", "runout", "front_mass_quantile", "runout_mass_
                 "max_fextra_x", "bed_max_erosion_x", "bed_max_erosion_depth")
 
 
-def summary_unit(key: str) -> str | None:
+def summary_unit(key: str, geometry: str | None = None) -> str | None:
     """The unit of the summary number ``key`` ('-' for counts and ratios; None for a key
     that is no number, e.g. 'model' or 'warnings'); volumes are per unit width on a
-    planar grid (m^2) and m^3 on an axisymmetric one."""
+    planar grid (m^2) and m^3 on an axisymmetric one ('m^2 or m^3' if ``geometry``, the
+    case's grid.geometry, is not given). The one table of the units of summary keys:
+    the printed table, ``pdeflow converge`` and study reports read it."""
     if key in ("t_final", "wall_time_s", "flow_duration") or key.endswith("_time"):
         return "s"
     if key in _LENGTH_KEYS:
         return "m"
     if "_volume" in key:
-        return "m^2 or m^3"
+        return {"planar": "m^2", "axisymmetric": "m^3"}.get(geometry or "", "m^2 or m^3")
     units = {"max_fextra_over_rho1": "m^2/s^2", "front_velocity_max": "m/s"}
     if key in units:
         return units[key]

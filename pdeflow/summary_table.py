@@ -8,6 +8,7 @@ import sys
 from typing import Any
 
 from .checks import mass_through_ends
+from .simulate import summary_unit
 
 
 def _fmt(v: Any, unit: str = "") -> str:
@@ -18,28 +19,36 @@ def _fmt(v: Any, unit: str = "") -> str:
     return f"{v}{unit}"
 
 
+ROWS = (("stop time", "stop_time"), ("lower stop", "lower_stop_time"),
+        ("upper stop", "upper_stop_time"), ("front", "front_position"),
+        ("run-out", "runout"), ("front {q} mass", "front_mass_quantile"),
+        ("run-out {q} mass", "runout_mass_quantile"),
+        ("max F_extra/rho1", "max_fextra_over_rho1"), ("flow duration", "flow_duration"),
+        ("front speed max", "front_velocity_max"), ("bed eroded", "bed_eroded_volume"),
+        ("bed eroded max", "bed_eroded_volume_max"),
+        ("bed deposited", "bed_deposited_volume"),
+        ("erosion depth", "bed_max_erosion_depth"), ("  at x", "bed_max_erosion_x"),
+        ("  at t", "bed_max_erosion_time"), ("bed moving max", "bed_moving_volume_max"),
+        ("mass error", "mass_relative_error"), ("mass outflow", "mass_outflow"),
+        ("steps", "steps"), ("wall time", "wall_time_s"))
+"""(label, summary key) of the table's rows, in order; '{q}' is the mass fraction."""
+
+
+def cell_unit(key: str, geometry: str | None) -> str:
+    """The unit a cell of ``key`` carries, as the table writes it (' m2/s2'; '' for
+    counts and ratios): :func:`pdeflow.simulate.summary_unit`, the one table of units."""
+    unit = summary_unit(key, geometry)
+    return "" if unit in (None, "-") else " " + unit.replace("^", "")
+
+
 def print_summary(summary: dict[str, Any], out: Any = None) -> None:
     """A short human-readable table of the per-model results."""
     out = out or sys.stdout
-    rows = [("stop time", "stop_time", " s"), ("lower stop", "lower_stop_time", " s"),
-            ("upper stop", "upper_stop_time", " s"), ("front", "front_position", " m"),
-            ("run-out", "runout", " m"),
-            ("front {q} mass", "front_mass_quantile", " m"),
-            ("run-out {q} mass", "runout_mass_quantile", " m"),
-            ("max F_extra/rho1", "max_fextra_over_rho1", " m2/s2"),
-            ("flow duration", "flow_duration", " s"),
-            ("front speed max", "front_velocity_max", " m/s"),
-            ("bed eroded", "bed_eroded_volume", " m2"),
-            ("bed eroded max", "bed_eroded_volume_max", " m2"),
-            ("bed deposited", "bed_deposited_volume", " m2"),
-            ("erosion depth", "bed_max_erosion_depth", " m"),
-            ("  at x", "bed_max_erosion_x", " m"), ("  at t", "bed_max_erosion_time", " s"),
-            ("bed moving max", "bed_moving_volume_max", " m2"),
-            ("mass error", "mass_relative_error", ""),
-            ("mass outflow", "mass_outflow", ""), ("steps", "steps", ""),
-            ("wall time", "wall_time_s", " s")]
     models = summary["models"]
-    if any(s.get("geometry") == "axisymmetric" for s in models.values()):
+    axisymmetric = any(s.get("geometry") == "axisymmetric" for s in models.values())
+    geometry = "axisymmetric" if axisymmetric else "planar"
+    rows = [(label, k, cell_unit(k, geometry)) for label, k in ROWS]
+    if axisymmetric:
         # the front and the run-out are radii: R_f and R_f - R0
         rows = [("front radius" if k == "front_position" else
                  "radius {q} mass" if k == "front_mass_quantile" else label, k, u)

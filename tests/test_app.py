@@ -494,17 +494,24 @@ def test_presentation_mode_enlarges_and_hides_and_switches_back():
 
 
 def test_legends_are_beside_the_data_and_every_line_is_named():
-    from bokeh.models import Legend
+    """Every legend outside the plot area; every line named by a legend, or, alone in
+    its figure (F_extra), by the y axis. The dam break's legends stand above the plots,
+    which keep the figure's width (issue 38: at 1024 px they crowded the plots)."""
+    from bokeh.models import GlyphRenderer, Legend
 
     shared = SharedRun()
     dam, runout = DamBreakPage(CASES, shared), RunoutPage(CASES, start=False)
     for f in _all_figures(dam, runout, HyperbolicityPage(shared)):
-        assert f.legend, f.css_classes
+        lines = [r for r in f.renderers if isinstance(r, GlyphRenderer)]
+        assert f.legend or len(lines) == 1 and f.yaxis[0].axis_label, f.css_classes
         assert not [m for m in f.center if isinstance(m, Legend)], f.css_classes
     labels = [i.label.value for i in runout.fig.legend[0].items]
     assert "a of the slider (the current point)" in labels
-    labels = [i.label.value for i in dam.fig_h.legend[0].items]
-    assert "final front, two layers" in labels and "final front, single layer" in labels
+    for f in (dam.fig_h, dam.fig_u):
+        assert f.legend[0] in f.above, f.css_classes
+    fronts = next(i for i in dam.fig_h.legend[0].items if "fronts" in i.label.value)
+    colours = {r.glyph.line_color for r in fronts.renderers}
+    assert colours == {s.line_color for s in dam.fronts.values()}  # both models
 
 
 def test_app_present_option():
@@ -604,3 +611,22 @@ def test_runout_page_shows_the_mass_quantile_run_out_and_its_fit():
         assert f"r_mass = {format_r(res['points_mass'][ratios.index(5.0)][1])}" in \
             page.current.object
     assert "99% of the mass" in page.fits.object
+
+
+def test_every_time_on_the_page_says_what_it_is():
+    """Issue 38 saw four end times on one page (1.347 s, 'at rest at 1.35 s', 't = 1.36
+    s', 't = 1.38 s (final state)'). The stop time reads as the table prints it, and
+    the end of each model's run is the time of one of its frames, said as such."""
+    page = DamBreakPage(CASES)
+    for m, res in page.run.results.items():
+        stop = res.summary["stop_time"]
+        assert f"{stop:.4g} s" in page.run.table()  # the table's stop time ...
+        said = f"at rest at {stop:.4g} s (the stop time); the run ended at t = " \
+               f"{res.t_final:.2f} s"
+        assert said in page.summary.text, (m, page.summary.text)  # ... is the page's
+        # the run's end is a frame's time (the last, final state, is the later model's;
+        # the frames' times are rounded to 1e-9 s)
+        assert np.isclose(page.run.times, res.t_final, rtol=0, atol=1e-9).any(), m
+    page.player.value = len(page.run.times) - 1
+    t_end = max(r.t_final for r in page.run.results.values())
+    assert f"t = {t_end:.2f} s (final state)" in page.fig_h.title.text

@@ -219,3 +219,19 @@ def test_bed_stresses_follow_the_closure_and_the_bed_holds_below_phi_b():
     assert np.allclose(s["M"], rate, rtol=1e-12, atol=0)
     assert np.array_equal(s["erodes"], rate > 0)
     assert np.all(s["drive_no_pressure"] < s["t_b_max"])
+
+
+@pytest.mark.parametrize("geometry,volume", [("planar", "m2"), ("axisymmetric", "m3")])
+def test_the_table_gives_volumes_in_the_grids_unit(geometry, volume):
+    """The bed's volumes are per unit width on a planar grid (m^2) and m^3 on an
+    axisymmetric one (cell volumes pi (r+^2 - r-^2)); the table printed m2 for both
+    (issue 38). Its units are :func:`pdeflow.simulate.summary_unit`'s, written without
+    '^'."""
+    summary = {"geometry": geometry, "bed_eroded_volume": 0.25, "bed_max_erosion_x": 0.5,
+               "max_fextra_over_rho1": 2.0, "steps": 7}
+    out = io.StringIO()
+    print_summary({"case": "x", "models": {"two_layer": summary}}, out)
+    rows = {line[:18].strip(): line[18:].strip() for line in out.getvalue().splitlines()}
+    assert rows["bed eroded"] == f"0.25 {volume}"
+    assert rows["at x"] == "0.5 m" and rows["max F_extra/rho1"] == "2 m2/s2"
+    assert rows["steps"] == "7"

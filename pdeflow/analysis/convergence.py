@@ -35,7 +35,7 @@ import numpy as np
 from .. import systems
 from ..cases import PAPER_MODEL, Case, CaseError, load_case
 from ..numerics.warmup import prepare
-from ..simulate import case_steppers
+from ..simulate import case_steppers, summary_unit
 from ..study.core import Executor, Study, serial
 from .points import Point, refined
 
@@ -184,10 +184,6 @@ def _fmt(v: Any) -> str:
     return str(v)
 
 
-#: units of the quantities, for table headers
-UNITS = {"dx": "m", "wall_time_s": "s", "runout": "m", "runout_mass_quantile": "m",
-         "max_fextra_over_rho1": "m^2/s^2",
-         "max_fextra_x": "m", "max_fextra_time": "s"}
 #: the columns ``pdeflow converge`` prints by default (``--all``: every quantity)
 SHORT_VIEW = ("dx", "cells", "stop_time", "lower_stop_time", "upper_stop_time", "runout",
               "runout_mass_quantile", "max_fextra_over_rho1", "wall_time_s")
@@ -195,14 +191,19 @@ SWEEP_VIEW = ("dx", "prefactor", "exponent", "exponent_mass", "all_at_rest", "wa
 
 
 def header(key: str) -> str:
-    """A column header with its unit: 'runout [m]', 'stop_time [s]', 'V1(0.1) [m^2]'."""
-    unit = UNITS.get(key)
-    if unit is None and (key == "stop_time" or key.endswith(("_stop_time", "_slow_time"))):
-        unit = "s"
-    if unit is None and key.startswith("V1("):
+    """A column header with its unit: 'runout [m]', 'stop_time [s]', 'V1(0.1) [m^2]'.
+
+    A run's numbers take their unit from :func:`pdeflow.simulate.summary_unit`; the
+    grid's dx and the upper-layer volumes V1(t) (sum of h1 dx, m^2 per unit width) are
+    this table's own; counts ('-') show none."""
+    if key == "dx":
+        unit: str | None = "m"
+    elif key.startswith("V1("):
         unit = "m^2"
+    else:
+        unit = summary_unit(key)
     name = "wall_time" if key == "wall_time_s" else key
-    return f"{name} [{unit}]" if unit else name
+    return f"{name} [{unit}]" if unit not in (None, "-") else name
 
 
 def table(result: dict[str, Any], keys: Sequence[str] | None = None) -> str:

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 import panel as pn
 import param
-from bokeh.models import ColumnDataSource, Div, Range1d, Span
+from bokeh.models import ColumnDataSource, Div, LegendItem, Range1d, Span
 from bokeh.plotting import figure
 
 from .. import systems
@@ -38,7 +38,7 @@ from ..solvers.fv_split import SimulationBlowUp
 from ..summary_table import print_summary
 from ..trackers import FextraStorageTracker
 from .controls import ParameterControls, command_line, list_cases, served
-from .look import PageLayout, fit_height, legend_outside, style_figures
+from .look import PageLayout, legend_outside, style_figures
 from .plan_view import PlanView
 
 FRAMES_PER_T_END = 250
@@ -50,9 +50,18 @@ SEND_MS = 40
 (the frames' run would otherwise hold the message back until it is done)."""
 LABELS = {m: systems.get(m).label for m in (PAPER_MODEL, BASELINE_MODEL)}
 """The models as the pages name them."""
-FIGURE_HEIGHT = 195
-"""Height of each of the three profile figures [px] (presentation mode: more): on a
-projector's 768 px the three fit under the header and the player, no scrolling."""
+FEXTRA_TITLE = "F_extra keeps the layers hyperbolic"  # fits 400 px
+FRONTS_LABEL = "final fronts (dotted)"  # both models', each in its layer's colour
+FIGURES_MIN_PX = 400
+"""The narrowest the figures get before the results wrap under them [px]: legends
+above the plots, the results stand beside them on 1024 px with the side bar shown."""
+FIGURE_HEIGHTS = {"depths": (220, 205), "velocities": (165, 172), "fextra": (195, 220)}
+"""Heights of the three figures [px], normal and presentation mode (larger upright y
+labels): on a projector's 768 px they fit under the player, in either mode."""
+DEPTH_LEGEND_COLUMNS = (2, 4)
+"""Entries per row of the depth legend, normal and presentation mode (full width)."""
+
+
 @dataclass
 class DamBreakRun:
     """One run of every model of a case: summary runs and animation frames."""
@@ -183,7 +192,8 @@ class DamBreakPage:
         self.controls = ParameterControls(cases, default if default in cases
                                           else next(iter(cases)), self.rerun)
         self.run: DamBreakRun | None = None
-        self.status = pn.pane.HTML("", css_classes=["pdeflow-status"],
+        # shown only with a message: empty, its margins took height from the figures
+        self.status = pn.pane.HTML("", css_classes=["pdeflow-status"], visible=False,
                                    sizing_mode="stretch_width")
         self.warnings = pn.pane.HTML("", css_classes=["pdeflow-warnings"],
                                      sizing_mode="stretch_width", visible=False,
@@ -208,7 +218,7 @@ class DamBreakPage:
     # --- figures --------------------------------------------------------------------------
     def _figures(self) -> None:
         xr = Range1d(0, 1)  # shared by the panels; set to the domain by each run
-        opts = {"height": FIGURE_HEIGHT, "sizing_mode": "stretch_width",
+        opts = {"sizing_mode": "stretch_width",
                 "toolbar_location": "right", "tools": "pan,wheel_zoom,box_zoom,reset,save",
                 "x_range": xr}
         zero = np.zeros(2)
@@ -217,14 +227,15 @@ class DamBreakPage:
         self.src_one = ColumnDataSource({k: zero for k in ("x", "h", "u")})
         # short: upright, the label must fit the figure's height on a projector
         fh = figure(title="", y_axis_label="depth ⊥ bed [m]",
-                    y_range=Range1d(0, 1), **opts)
+                    y_range=Range1d(0, 1), height=FIGURE_HEIGHTS["depths"][0], **opts)
         fh.varea("x", "zero", "h2", source=self.src_two, color=COLOURS["lower"],
                  alpha=0.6, legend_label="lower layer h2")
         fh.varea("x", "h2", "top", source=self.src_two, color=COLOURS["upper"],
                  alpha=0.5, legend_label="upper layer h1")
         fh.line("x", "h", source=self.src_one, color=COLOURS["single"], line_width=2,
                 legend_label="single layer h")
-        fu = figure(y_axis_label="velocity [m/s]", y_range=Range1d(0, 1), **opts)
+        fu = figure(y_axis_label="velocity [m/s]", y_range=Range1d(0, 1),
+                    height=FIGURE_HEIGHTS["velocities"][0], **opts)
         fu.line("x", "u1", source=self.src_two, color=COLOURS["upper"], line_width=2,
                 legend_label="u1 (upper)")
         fu.line("x", "u2", source=self.src_two, color=COLOURS["lower"], line_width=2,
@@ -232,23 +243,26 @@ class DamBreakPage:
         fu.line("x", "u", source=self.src_one, color=COLOURS["single"], line_width=2,
                 legend_label="u single layer")
         ff = figure(x_axis_label="x [m]", y_axis_label="F_extra/ρ1 [m²/s²]",
-                    title="momentum exchange keeping the two layers hyperbolic",
-                    y_range=Range1d(0, 1), **opts)
-        ff.line("x", "f", source=self.src_two, color=COLOURS["fextra"], line_width=2,
-                legend_label="F_extra/ρ1")
+                    title=FEXTRA_TITLE, y_range=Range1d(0, 1),
+                    height=FIGURE_HEIGHTS["fextra"][0], **opts)
+        # one line, named by the y axis and the title: no legend row over the plot
+        ff.line("x", "f", source=self.src_two, color=COLOURS["fextra"], line_width=2)
         self.fronts = {m: Span(location=0, dimension="height", line_dash="dotted",
                                line_width=2, visible=False,
                                line_color=COLOURS["upper" if m == PAPER_MODEL
                                                   else "single"])
                        for m in (PAPER_MODEL, BASELINE_MODEL)}
-        for m, s in self.fronts.items():
+        # a Span has no legend entry: empty lines in its styles stand for it, one entry
+        # for both fronts (coloured as their layers), so that the legend takes 2 rows
+        stand_ins = []
+        for s in self.fronts.values():
             fh.add_layout(s)
-            # a Span has no legend entry: an empty line in its style stands for it
-            fh.line([np.nan], [np.nan], line_dash="dotted", line_width=2,
-                    line_color=s.line_color, legend_label=f"final front, {LABELS[m]}")
-        for f in (fh, fu, ff):
+            stand_ins.append(fh.line([np.nan], [np.nan], line_dash="dotted", line_width=2,
+                                     line_color=s.line_color))
+        fh.legend.items.append(LegendItem(label=FRONTS_LABEL, renderers=stand_ins))
+        for f, ncols in ((fh, DEPTH_LEGEND_COLUMNS[0]), (fu, 3)):
             f.legend.click_policy = "hide"
-            legend_outside(f)  # never over the data
+            legend_outside(f, "above", ncols)  # never over the data, nor beside it
         for f, name in ((fh, "depths"), (fu, "velocities"), (ff, "fextra")):
             f.css_classes = [f"pdeflow-{name}"]  # for the browser tests
         self.fig_h, self.fig_u, self.fig_f = fh, fu, ff
@@ -264,7 +278,7 @@ class DamBreakPage:
             case = c.load()
             run = simulate(case, c.case_path, overrides, frames=False)
         except (CaseError, SimulationBlowUp, ValueError) as err:
-            self.status.object = f"<b>cannot run this:</b> {escape(str(err))}"
+            self._say(f"<b>cannot run this:</b> {escape(str(err))}")
             return
         with pn.io.hold():
             self.pause()
@@ -283,13 +297,20 @@ class DamBreakPage:
         self.player.direction = 0
         self.player.param.trigger("direction")
 
+    def _say(self, html: str) -> None:
+        """The status line above the figures (an error), or none."""
+        self.status.object = html
+        self.status.visible = bool(html)
+
     def set_present(self, present: bool) -> None:
         """Presentation mode: larger fonts and lines, the expert choices hidden."""
         self.present = present
         style_figures((self.fig_h, self.fig_u, self.fig_f), present)
         self.plan.set_present(present)
-        for f in (self.fig_h, self.fig_u, self.fig_f):
-            f.height = fit_height(FIGURE_HEIGHT, present)
+        for f, name in ((self.fig_h, "depths"), (self.fig_u, "velocities"),
+                        (self.fig_f, "fextra")):
+            f.height = FIGURE_HEIGHTS[name][present]
+        self.fig_h.legend[0].ncols = DEPTH_LEGEND_COLUMNS[present]
         self.controls.set_present(present)
 
     def _animate(self, run: DamBreakRun) -> None:
@@ -298,7 +319,7 @@ class DamBreakPage:
         try:
             add_frames(run)
         except SimulationBlowUp as err:  # the frames' run differs a little
-            self.status.object = f"<b>no animation:</b> {escape(str(err))}"
+            self._say(f"<b>no animation:</b> {escape(str(err))}")
             return
         with pn.io.hold():
             self._show_frames(run)
@@ -323,7 +344,7 @@ class DamBreakPage:
         # change of the player would redraw it in the browser twice per move)
         self.show_frame(len(run.times) - 1)
         self.summary.text = self._summary_html(run)
-        self.status.object = ""
+        self._say("")
         self.warnings.object = warnings_html(run.warnings)
         self.warnings.visible = bool(run.warnings)
 
@@ -386,7 +407,9 @@ class DamBreakPage:
         for m, r in run.results.items():
             s = r.summary
             stop = s.get("stop_time")
-            state = (f"at rest at {stop:.3g} s" if stop is not None
+            # each time said what it is (issue 38: four end times on one page)
+            state = (f"at rest at {stop:.4g} s (the stop time); the run ended at "
+                     f"t = {r.t_final:.2f} s" if stop is not None
                      else "still moving at t_end")
             rows.append(f"<li><b>{LABELS[m]}</b>: {state}</li>")
         return (f"<ul>{''.join(rows)}</ul>"
@@ -407,7 +430,7 @@ class DamBreakPage:
         results = pn.Column("### results", self.plan.pane,
                             pn.pane.Bokeh(self.summary), sizing_mode="stretch_width")
         self.layout = PageLayout(self.controls.panel("dam break"), plots, results,
-                                 top=self.player)
+                                 top=self.player, figures_min_px=FIGURES_MIN_PX)
         if self.present:
             self.layout.show_sidebar(False)
         return self.layout.row

@@ -30,8 +30,9 @@ one scrolls to the last sliders."""
 RESULTS_PX = 380
 """Width of a page's results column [px] (beside the figures, or under them)."""
 FIGURES_MIN_PX = 580
-"""The narrowest the figures get before the results wrap under them [px]: on a
-projector's 1024 px the results stand beside the figures once the side bar is hidden."""
+"""The narrowest the figures get before the results wrap under them [px], by default:
+on a projector's 1024 px the results stand beside the figures once the side bar is
+hidden (a page whose legends stand above its plots gives a smaller width)."""
 FIGURES_MIN_PRESENT_PX = 700
 """The same in presentation mode [px]: larger fonts need wider figures, and the results
 go under them."""
@@ -126,13 +127,20 @@ def label_log_axis(axis: Any, low: float, high: float) -> None:
     axis.formatter = NumeralTickFormatter(format="0[.][0000]")
 
 
-def legend_outside(fig: Any, place: str = "right") -> None:
-    """Move the figure's legend out of the plot area (``place``: 'right', 'below'), where
-    it cannot cover the data."""
+def legend_outside(fig: Any, place: str = "right", ncols: int | None = None) -> None:
+    """Move the figure's legend out of the plot area (``place``: 'right', 'below',
+    'above'), where it cannot cover the data; above or below, its entries stand in rows
+    of ``ncols`` (default: all in one row), so that the plot keeps the figure's width (a
+    legend at the right took 200 px of it)."""
     for legend in list(fig.legend):
         if legend in fig.center:
             fig.center.remove(legend)
             fig.add_layout(legend, place)
+        if place in ("above", "below"):
+            legend.orientation = "horizontal"
+            legend.ncols = ncols or len(legend.items)
+            legend.margin, legend.padding, legend.spacing = 0, 2, 12
+            legend.border_line_alpha = 0
 
 
 class PageLayout:
@@ -144,11 +152,15 @@ class PageLayout:
         results: the numbers; beside the figures if both fit, else under them.
         top: beside the side bar's button, above the figures and results (the
             animation's player: one row for both, the figures start higher).
+        figures_min_px: the narrowest the figures get before the results wrap under
+            them [px] (outside presentation mode).
     """
 
     def __init__(self, sidebar: pn.viewable.Viewable, figures: pn.viewable.Viewable,
                  results: pn.viewable.Viewable | None = None,
-                 top: pn.viewable.Viewable | None = None):
+                 top: pn.viewable.Viewable | None = None,
+                 figures_min_px: int = FIGURES_MIN_PX):
+        self.figures_min_px = figures_min_px
         self.sidebar = pn.Column(sidebar, width=SIDEBAR_PX, css_classes=["pdeflow-sidebar"],
                                  styles={"max-height": f"calc(100vh - {SIDEBAR_TOP_PX}px)",
                                          "overflow-y": "auto", "overflow-x": "hidden"})
@@ -171,8 +183,8 @@ class PageLayout:
                           sizing_mode="stretch_width")
 
     def set_present(self, present: bool) -> None:
-        """The figures' narrowest width for the mode (:data:`FIGURES_MIN_PX`)."""
-        least = FIGURES_MIN_PRESENT_PX if present else FIGURES_MIN_PX
+        """The figures' narrowest width for the mode."""
+        least = FIGURES_MIN_PRESENT_PX if present else self.figures_min_px
         self.figures.styles = {"flex": f"1 1 {least}px", "min-width": "0"}
 
     def show_sidebar(self, shown: bool) -> None:

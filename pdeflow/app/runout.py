@@ -44,6 +44,9 @@ A_RANGE = (1.0, 35.0)
 """a axis of the figure"""
 R_RANGE = (0.5, 150.0)
 """r axis of the figure"""
+FIGURE_HEIGHT_PX = 545
+"""Height of the figure with its legend [px], in either mode: on a projector's 768 px
+it ends in the window, under the header, the tabs and the a slider."""
 
 
 def format_r(r: float | None) -> str:
@@ -160,10 +163,10 @@ class RunoutPage:
 
     # --- figure ---------------------------------------------------------------------------
     def _figure(self) -> None:
-        f = figure(x_axis_type="log", y_axis_type="log", height=620,
+        f = figure(x_axis_type="log", y_axis_type="log", height=FIGURE_HEIGHT_PX,
                    sizing_mode="stretch_width", x_range=Range1d(*A_RANGE),
                    y_range=Range1d(*R_RANGE), x_axis_label="aspect ratio a = H0/L0",
-                   y_axis_label="normalised run-out r = (R - L0)/L0",
+                   y_axis_label="run-out r = (R - L0)/L0",  # upright: fits 545 px
                    tools="pan,wheel_zoom,box_zoom,reset,save")
         label_log_axis(f.xaxis[0], *A_RANGE)  # 1, 2, 3, 5, 10, 20, 30
         label_log_axis(f.yaxis[0], *R_RANGE)
@@ -276,7 +279,7 @@ class RunoutPage:
         """Presentation mode: larger fonts and lines, the expert choices hidden."""
         self.present = present
         style_figure(self.fig, present)
-        self.fig.height = 700 if present else 620  # the legend below takes its share
+        self.fig.height = FIGURE_HEIGHT_PX  # the legend's larger rows take from the plot
         self.controls.set_present(present)
 
     def panel(self) -> pn.Row:
