@@ -10,6 +10,7 @@ Needs Debian's Chromium and Playwright, like the browser tests.
 
 from __future__ import annotations
 
+import argparse
 import os
 import statistics
 import sys
@@ -49,12 +50,21 @@ def warm_start_to_first_picture(repeats: int = 5,
             "load_avg_at_start": load, "load_avg_at_end": os.getloadavg()[0]}
 
 
-if __name__ == "__main__":
-    import sys
-
-    out = warm_start_to_first_picture(trees=tuple(Path(a) for a in sys.argv[1:]) or (ROOT,))
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("trees", nargs="*", type=Path, default=[ROOT],
+                    help="checkouts to compare, their starts interleaved (default: this one)")
+    ap.add_argument("--repeats", type=int, default=5, help="warm starts per tree")
+    a = ap.parse_args(argv)
+    if a.repeats < 1:
+        ap.error(f"--repeats must be >= 1, got {a.repeats}")
+    out = warm_start_to_first_picture(a.repeats, tuple(a.trees))
     for tree, median, walls in zip(out["trees"], out["median_s"], out["walls_s"],
                                    strict=True):
         print(f"{tree}: warm start to the first dam-break picture {median:.1f} s median "
               f"({', '.join(f'{w:.1f}' for w in walls)}; load "
               f"{out['load_avg_at_start']:.1f} -> {out['load_avg_at_end']:.1f})")
+
+
+if __name__ == "__main__":
+    main()

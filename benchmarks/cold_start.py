@@ -87,26 +87,22 @@ class _Compiles(event.Listener):
 event.register("numba:compile", _Compiles())
 import pdeflow.plotting as _plotting
 # compiling on two cores: this process's own compilations, then waiting for the helper
-try:
-    import pdeflow.numerics.warmup as _warmup
-    _warmup._compile = _timed("compile", _warmup._compile)
-    import pdeflow.numerics.compile_parallel as _parallel
-    _ready_each = _parallel.ready_each
+import pdeflow.numerics.warmup as _warmup
+_warmup._compile = _timed("compile", _warmup._compile)
+import pdeflow.numerics.compile_parallel as _parallel
+_ready_each = _parallel.ready_each
 
-    def _booked_ready_each(kernels):
-        # CPU time of each process's share (this process's first call, the helper's
-        # only one): how evenly the two cores were loaded
-        c0 = time.process_time()
-        try:
-            return _ready_each(kernels)
-        finally:
-            with open(os.environ["PDEFLOW_COLD_SHARES"], "a") as log:
-                log.write(json.dumps([os.getpid(), time.process_time() - c0]) + "\n")
+def _booked_ready_each(kernels):
+    # CPU time of each process's share (this process's first call, the helper's
+    # only one): how evenly the two cores were loaded
+    c0 = time.process_time()
+    try:
+        return _ready_each(kernels)
+    finally:
+        with open(os.environ["PDEFLOW_COLD_SHARES"], "a") as log:
+            log.write(json.dumps([os.getpid(), time.process_time() - c0]) + "\n")
 
-    _parallel.ready_each = _warmup.ready_each = _booked_ready_each
-except ImportError:  # a checkout (--tree) from before pdeflow.numerics.warmup
-    import pdeflow.solvers.fv_split as _fv_split
-    _fv_split.ready_all = _timed("compile", _fv_split.ready_all)
+_parallel.ready_each = _warmup.ready_each = _booked_ready_each
 try:
     import pdeflow.case_figures as _case_figures
     _figure_modules = [_plotting, _case_figures]

@@ -52,7 +52,7 @@ import json, time
 import numpy as np
 import pdeflow
 from pdeflow.numerics import layout as L
-from pdeflow.numerics.bundles import SINGLE_LAYER
+from pdeflow.models.single_layer.kernels import KERNELS as SINGLE_LAYER
 from pdeflow.numerics.splitting import scheme_stepper
 st = scheme_stepper(SINGLE_LAYER, L.FLUX_HLL, 1, L.LIMITER_MINMOD, False,
                     L.GEOMETRY_PLANAR).ready()

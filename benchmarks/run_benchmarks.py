@@ -89,6 +89,7 @@ def measure_wp(quick: bool, repeats: int, results: Path = RESULTS) -> dict[str, 
     """Work-precision studies, the mol-rk stiffness probe and the hyperbolicity modes."""
     from pdeflow.analysis import workprecision as wp
     from pdeflow.analysis.hyperbolicity_modes import hyperbolicity_study
+    from pdeflow.analysis.workprecision_outputs import plot
     from pdeflow.cases import load_case
 
     out: dict[str, Any] = {"conditions": conditions(), "cases": {}}
@@ -102,7 +103,7 @@ def measure_wp(quick: bool, repeats: int, results: Path = RESULTS) -> dict[str, 
         res = wp.compare(load_case(ROOT / case, cfg.get("set", [])), variants, grids,
                          cfg.get("reference", "auto"), None,
                          t=cfg["t"], repeats=repeats, label=label, log=sys.stderr)
-        fig = wp.plot(res, figures / f"workprecision_{res.case}.png")
+        fig = plot(res, figures / f"workprecision_{res.case}.png")
         out["cases"][res.case] = {"source": " --set ".join([case, *cfg.get("set", [])]),
                                   "t": res.t, "rows": res.rows,
                                   "figure": str(fig.relative_to(ROOT) if fig.is_relative_to(ROOT)

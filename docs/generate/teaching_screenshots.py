@@ -16,6 +16,7 @@ shared machine the times grow with the load. Needs Debian's Chromium
 
 from __future__ import annotations
 
+import argparse
 import os
 import statistics
 import sys
@@ -139,8 +140,11 @@ def other_pages(browser: Any, url: str) -> None:
     page.close()
 
 
-def main() -> int:
-    warm = "--warm" in sys.argv[1:]  # the kernels of the usual cache: no cold start
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--warm", action="store_true",
+                    help="use the usual numba cache (no cold start, no compiling screenshot)")
+    warm = ap.parse_args(argv).warm
     FIGURES.mkdir(exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp, chromium() as browser:
         env = {} if warm else {"NUMBA_CACHE_DIR": str(Path(tmp) / "numba")}
