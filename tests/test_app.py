@@ -369,11 +369,14 @@ def test_command_lines_are_readable_and_mean_the_overrides():
 
 def test_friction_law_choice_sets_every_model_and_enables_its_sliders():
     """The law choice becomes ``<model>.friction_law`` of each model of the case, and
-    only the chosen law's parameter sliders are enabled (issue 23)."""
+    only the chosen law's parameter sliders are enabled (issue 23); the laws offered are
+    the registered ones (no list of its own in the app)."""
     from pdeflow.app.controls import ParameterControls
+    from pdeflow.models.friction_laws import LAWS
 
     calls = []
     controls = ParameterControls({"5.1": CASE_51}, "5.1", lambda: calls.append(1))
+    assert list(controls.law.options) == list(LAWS)
     assert controls.law.value == "coulomb" and controls.sliders["voellmy_xi"].disabled
     controls.law.value = "voellmy"
     assert calls and not controls.sliders["voellmy_xi"].disabled

@@ -21,13 +21,15 @@ import panel as pn
 from .. import systems
 from ..analysis.workprecision import DEFAULT_VARIANTS
 from ..cases import Case, CaseError, load_case
+from ..models.friction_laws import LAWS, FrictionLawParameters
 from ..variant import Variant
 from .slider import Slider  # the pages import it from here
 
 GEOMETRIES = ("planar", "axisymmetric")
 """grid.geometry choices: a slope of unit width, or a column collapsing radially"""
-LAWS = ("coulomb", "pouliquen", "mu_i", "voellmy")
-"""The basal friction laws offered (``<model>.friction_law`` of every model of the case)."""
+DEFAULT_LAW = FrictionLawParameters.friction_law
+"""The law selected before a case names one (the models' default, Coulomb's); the
+laws offered are those registered, :data:`pdeflow.models.friction_laws.LAWS`."""
 CLOSURES = ("paper", "relaxed")
 """The exchange closures offered (a case with another one adds it to the choice)."""
 SCHEMES = tuple(v for v in DEFAULT_VARIANTS if not Variant.parse(v).is_mol)
@@ -168,7 +170,7 @@ def _law_models(case: Case) -> list[str]:
 def case_law(case: Case) -> str:
     """The basal friction law of the case's first model that has one (else Coulomb)."""
     models = _law_models(case)
-    return str(case_value(case, f"{models[0]}.friction_law")) if models else LAWS[0]
+    return str(case_value(case, f"{models[0]}.friction_law")) if models else DEFAULT_LAW
 
 
 def case_scheme(case: Case) -> str:
@@ -244,7 +246,7 @@ class ParameterControls:
             label="geometry", options=list(GEOMETRIES), value="planar",
             css_classes=["pdeflow-geometry"])
         self.law = pn.widgets.Select(label="basal friction law", options=list(LAWS),
-                                     value=LAWS[0], css_classes=["pdeflow-law"],
+                                     value=DEFAULT_LAW, css_classes=["pdeflow-law"],
                                      sizing_mode="stretch_width")
         self.scheme = pn.widgets.Select(label="scheme (flux/reconstruction[/limiter]"
                                         "[+splitting])", options=list(SCHEMES),

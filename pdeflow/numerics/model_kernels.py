@@ -2,9 +2,9 @@
 
 The stepping loop (:mod:`.splitting`), the advection stage and the method-of-lines rate
 (:mod:`.advection`) are written once for every model; a :class:`ModelKernels` hands them
-one model's pieces. An equation system (:mod:`pdeflow.models.system`) owns one; the two
-of the paper's models are in :mod:`.bundles`. Nothing in :mod:`pdeflow.numerics`
-branches on which model it runs.
+one model's pieces. An equation system (:class:`pdeflow.systems.EquationSystem`) owns
+one; each model builds its own in its package (``pdeflow.models.<name>.kernels``, one per
+basal law). Nothing in :mod:`pdeflow.numerics` branches on which model it runs.
 """
 
 from __future__ import annotations
