@@ -42,7 +42,7 @@ from numba import njit
 
 from . import layout as L
 from .compiled import FIELDS, METRIC, STATE, WORK, cached, f8, i8, kernel, specialise
-from .model_kernels import ModelKernels
+from .model_kernels import ModelKernels, check_flux
 from .state import velocity
 
 
@@ -248,6 +248,7 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
     bc_hi, g, r, dry) -> smax``: MUSCL's face values along the axis in cells
     ``r_lo..r_hi``, the axis' faces next to ``lo..hi`` (:func:`_faces_function`), the
     MUSCL cell jump along the axis."""
+    check_flux(model, flux)
     rows = model.axis_rows(axis)
     width = model.layer_rows
     faces = njit(inline="always")(_faces_function(model.face, model.fluctuations(flux),

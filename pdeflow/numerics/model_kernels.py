@@ -15,6 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from . import layout as L
+
 
 @dataclass(frozen=True, eq=False)
 class ModelKernels:
@@ -61,6 +63,20 @@ class ModelKernels:
     """per axis, the row of ``q`` each entry of a fluctuation (a :attr:`face` tuple) goes
     back into (default: one axis, in the order of ``q``)"""
 
+    fluxes: tuple[int, ...] = (L.FLUX_HLL, L.FLUX_RUSANOV, L.FLUX_IFCP)
+    """the flux codes :attr:`fluctuations` answers (a flux added by
+    :func:`~pdeflow.numerics.scheme.register_flux` runs only on models that list it:
+    :func:`check_flux`)"""
+
     def axis_rows(self, axis: int) -> tuple[int, ...]:
         """:attr:`rows` of ``axis`` (the identity if none are given)."""
         return self.rows[axis] if self.rows else tuple(range(self.fields))
+
+
+def check_flux(model: ModelKernels, flux: int) -> None:
+    """Raise ValueError naming the fluxes ``model`` has fluctuations for unless ``flux``
+    (layout.FLUX_*) is one of them: a model does not fall back on another flux."""
+    if flux not in model.fluxes:
+        names = {code: name for name, code in L.FLUXES.items()}
+        raise ValueError(f"flux must be one of {[names[c] for c in model.fluxes]} for "
+                         f"this model, got {names.get(flux, flux)!r}")

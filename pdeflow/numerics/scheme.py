@@ -11,12 +11,16 @@ not part of it: it comes from the grid (:func:`pdeflow.numerics.geometry.metric_
 
 from __future__ import annotations
 
+import re
+from collections.abc import Collection, KeysView
 from dataclasses import dataclass
 
 from . import layout as L
 
-FLUXES: tuple[str, ...] = tuple(L.FLUXES)
-"""interface fluxes: 'hll' (the paper's), 'rusanov', 'ifcp'"""
+FLUXES: KeysView[str] = L.FLUXES.keys()
+"""interface fluxes: 'hll' (the paper's), 'rusanov', 'ifcp', then any registered by
+:func:`register_flux` (a live view of ``layout.FLUXES``, the one table of their names)"""
+_SHIPPED_FLUXES = frozenset(L.FLUXES)
 RECONSTRUCTIONS: tuple[str, ...] = tuple(L.RECONSTRUCTIONS)
 """'first-order' (the paper's) or 'muscl' (second order in space)"""
 LIMITERS: tuple[str, ...] = tuple(L.LIMITERS)
@@ -34,7 +38,26 @@ class SchemeError(ValueError):
     """A scheme choice that is not one of the allowed ones."""
 
 
-def check_choice(what: str, value: object, allowed: tuple[str, ...],
+def register_flux(name: str) -> int:
+    """Add the interface flux ``name`` (lower-case letters, as variant names spell
+    fluxes) and return its code, the next free one: what a model's
+    ``fluctuations(code)`` answers (docs/architecture.md, "Adding a flux")."""
+    if not re.fullmatch(r"[a-z]+", str(name)):
+        raise SchemeError(f"flux name must be lower-case letters a-z, got {name!r}")
+    if name in L.FLUXES:
+        raise SchemeError(f"a flux named {name!r} is registered already")
+    L.FLUXES[name] = max(L.FLUXES.values()) + 1
+    return L.FLUXES[name]
+
+
+def unregister_flux(name: str) -> None:
+    """Remove the flux ``name`` added by :func:`register_flux` (a test's); the shipped
+    fluxes stay."""
+    if name not in _SHIPPED_FLUXES:
+        L.FLUXES.pop(name, None)
+
+
+def check_choice(what: str, value: object, allowed: Collection[str],
                  where: str = "") -> None:
     """Raise :class:`SchemeError` ``"{where}{what} must be one of [...], got ..."``
     unless ``value`` is one of ``allowed``."""
