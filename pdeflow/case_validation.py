@@ -10,7 +10,7 @@ from . import systems
 from .case_schema import FRAMES, SCHEMA, SERIES, CaseError
 from .initial_shapes import SHAPES, check_initial
 from .models.base import check_range
-from .numerics.layout import GEOMETRIES
+from .numerics.layout import BOUNDARIES, GEOMETRIES
 from .variant import MAX_CFL, VariantError
 
 
@@ -57,8 +57,9 @@ def validate(case: Any) -> None:
     for side in ("left", "right"):
         bc = case.data.get("boundaries", {}).get(side, "wall" if side == "left"
                                                   else "open")
-        if bc not in ("wall", "open"):
-            raise _err(case, f"boundaries.{side} must be 'wall' or 'open', got {bc!r}")
+        if bc not in BOUNDARIES:
+            raise _err(case, f"boundaries.{side} must be one of {list(BOUNDARIES)}, got "
+                             f"{bc!r}")
     if "initial" not in case.data or "shape" not in case.data["initial"]:
         raise _err(case, "[initial] with a 'shape' is required")
     try:

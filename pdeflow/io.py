@@ -29,17 +29,6 @@ class OutputError(ValueError):
     """An output path that cannot be written as given (names the option and the path)."""
 
 
-def check_output(path: str | Path | None, option: str) -> None:
-    """Raise :class:`OutputError` unless the directory that ``path`` goes into exists
-    (as ``cp`` does: a mistyped path must not create directories anywhere)."""
-    if path is None:
-        return
-    parent = Path(path).expanduser().parent
-    if not parent.is_dir():
-        raise OutputError(f"{option} {path}: directory {parent} does not exist (create it "
-                          "first)")
-
-
 _PENDING: dict[int, PendingFile | PendingDir] = {}
 """the temporaries not yet committed or discarded, by id"""
 

@@ -441,10 +441,11 @@ WARNING_STYLE = {"background": "#fff3cd", "border": "2px solid #d62728",
 """The warnings box: above the figures, where nobody overlooks it."""
 
 
-def warnings_html(lines: list[str]) -> str:
-    """The lines ``pdeflow: warning: ...`` of a run as the page's warning box."""
+def warnings_html(lines: list[str], about: str = "numbers") -> str:
+    """The lines ``pdeflow: warning: ...`` of a run (or a set's) as the page's warning
+    box, which says what they are ``about``."""
     if not lines:
         return ""
     items = "".join(f"<li>{escape(line)}</li>" for line in lines)
     return (f"<p style='margin:0.4em 0'><b>The command line warns about these "
-            f"numbers:</b></p><ul style='margin:0.2em 0 0.5em'>{items}</ul>")
+            f"{about}:</b></p><ul style='margin:0.2em 0 0.5em'>{items}</ul>")

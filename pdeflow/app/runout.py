@@ -33,7 +33,7 @@ from ..cases import BASELINE_MODEL, PAPER_MODEL, CaseError
 from ..checks import run_warnings
 from ..solvers.fv_split import SimulationBlowUp
 from .controls import KNOBS, ParameterControls, Slider, is_column, list_cases, served
-from .dam_break import COLOURS, LABELS, WARNING_STYLE
+from .dam_break import COLOURS, LABELS, WARNING_STYLE, warnings_html
 from .look import PageLayout, label_log_axis, style_figure
 
 MODEL_STYLE = {PAPER_MODEL: (COLOURS["upper"], "square", LABELS[PAPER_MODEL]),
@@ -224,7 +224,7 @@ class RunoutPage:
             self.a_line.location = a_now
             self.current.object = self._current_html(a_now)
             self.fits.object = self._fits_html()
-            self.warnings.object = self._warnings_html()
+            self.warnings.object = warnings_html(self.warning_lines(), "points")
             self.warnings.visible = any(self.point_warnings.values())
 
     def _current_html(self, a: float) -> str:
@@ -266,14 +266,6 @@ class RunoutPage:
         """The command line's warnings about the set's runs, each prefixed by its a."""
         return [f"a = {a:g}: {line}" for a, lines in sorted(self.point_warnings.items())
                 for line in lines]
-
-    def _warnings_html(self) -> str:
-        lines = self.warning_lines()
-        if not lines:
-            return ""
-        items = "".join(f"<li>{escape(line)}</li>" for line in lines)
-        return (f"<p style='margin:0.4em 0'><b>The command line warns about these "
-                f"points:</b></p><ul style='margin:0.2em 0 0.5em'>{items}</ul>")
 
     def set_present(self, present: bool) -> None:
         """Presentation mode: larger fonts and lines, the expert choices hidden."""
