@@ -9,12 +9,12 @@ from typing import Any
 
 from ..cases import PAPER_MODEL, Case
 from ..simulate import Run
-from ..variant import Variant
+from ..variant import HYPERBOLICITY, Variant
 from .points import case_on_grid, resolve_case
 
 
 def hyperbolicity_study(case_path: str | Path | Case,
-                        modes: Sequence[str] = ("exact", "bound", "none"),
+                        modes: Sequence[str] = HYPERBOLICITY,
                         grids: Sequence[float | int] | None = None, repeats: int = 3,
                         log: Any = None) -> list[dict[str, Any]]:
     """Cost and effect of the hyperbolicity modes on the two-layer model of a case.

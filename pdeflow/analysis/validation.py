@@ -28,12 +28,12 @@ from ..cases import BASELINE_MODEL, Case, CaseError
 from ..checks import RunWarning
 from ..models import SingleLayerGranular, TwoLayerGranular
 from ..study.core import Study
-from ..variant import FLUXES, Scheme, Variant
+from ..variant import FLUXES, RECONSTRUCTIONS, Scheme, Variant
 from .exact import exact_solution_for
 from .points import Point, on_grid
 
 VARIANTS: tuple[Variant, ...] = tuple(
-    Variant(Scheme(f, r)) for r in ("first-order", "muscl")
+    Variant(Scheme(f, r)) for r in RECONSTRUCTIONS
     for f in tuple(FLUXES))
 """Every flux with the first-order and the MUSCL (minmod) reconstruction."""
 
