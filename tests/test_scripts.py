@@ -55,9 +55,11 @@ def _module(name: str, here: Path) -> ModuleType | None:
     if top == "pdeflow":
         return importlib.import_module(name)
     if (here / f"{top}.py").exists():
-        if str(here) not in sys.path:
-            sys.path.insert(0, str(here))
-        return importlib.import_module(name)
+        sys.path.insert(0, str(here))  # a sibling, as the script imports it
+        try:
+            return importlib.import_module(name)
+        finally:
+            sys.path.remove(str(here))
     return None
 
 
