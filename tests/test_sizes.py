@@ -66,19 +66,20 @@ def _made_by(name: str, scope: ast.AST) -> str | None:
     return None
 
 
-def kernel_names(trees: list[ast.AST]) -> tuple[set[str], set[str]]:
-    """Names of the functions compiled directly and of the factories whose result is
-    compiled, over all ``trees``."""
+def kernel_names(tree: ast.AST) -> tuple[set[str], set[str]]:
+    """Names of the functions ``tree`` compiles directly (not a parameter handed on,
+    as ``_jit(func)`` does) and of the factories whose result it compiles."""
     direct, factories = set(), set()
-    for tree in trees:
-        for arg, scope in _compiled_arguments(tree):
-            if isinstance(arg, ast.Call):
-                factories.add(_callee(arg))
-            elif isinstance(arg, ast.Name):
+    for arg, scope in _compiled_arguments(tree):
+        if isinstance(arg, ast.Call):
+            factories.add(_callee(arg))
+        elif isinstance(arg, ast.Name):
+            made = _made_by(arg.id, scope)
+            if made:
+                factories.add(made)
+            elif not (isinstance(scope, Function) and arg.id in {
+                    a.arg for a in ast.walk(scope.args) if isinstance(a, ast.arg)}):
                 direct.add(arg.id)
-                made = _made_by(arg.id, scope)
-                if made:
-                    factories.add(made)
     return direct, factories
 
 
@@ -95,11 +96,14 @@ def is_kernel(func: Function, parent: ast.AST | None, direct: set[str],
 def long_functions(trees: dict[str, ast.AST], limit: int = MAX_FUNCTION_LINES
                    ) -> list[str]:
     """``module: function (lines)`` for each function over ``limit`` lines that is
-    not a kernel, nested kernels' lines left out."""
-    direct, factories = kernel_names(list(trees.values()))
+    not a kernel, nested kernels' lines left out (a function is compiled by its own
+    module; a factory may be called by another)."""
+    names = {where: kernel_names(tree) for where, tree in trees.items()}
+    factories = set().union(*(f for _, f in names.values()))
     found = []
 
     def visit(node: ast.AST, where: str) -> None:
+        direct = names[where][0]
         for child in ast.iter_child_nodes(node):
             if not isinstance(child, Function):
                 visit(child, where)

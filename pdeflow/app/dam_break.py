@@ -442,8 +442,7 @@ WARNING_STYLE = {"background": "#fff3cd", "border": "2px solid #d62728",
 
 
 def warnings_html(lines: list[str], about: str = "numbers") -> str:
-    """The lines ``pdeflow: warning: ...`` of a run (or a set's) as the page's warning
-    box, which says what they are ``about``."""
+    """Warning lines (``pdeflow: warning: ...``) as a page's box, saying their ``about``."""
     if not lines:
         return ""
     items = "".join(f"<li>{escape(line)}</li>" for line in lines)
