@@ -186,6 +186,10 @@ def test_a_cone_below_the_friction_angle_stays_at_rest(theta, scheme):
     assert info["solver"]["steps"] > 1000
     assert np.array_equal(out.data[0], h)
     assert not np.any(out.data[1:])
+    # stopped at rest (the default), fv-split ends the run itself in its first step
+    out, info = eq.solve(state, 100.0, solver="fv-split", tracker=None, ret_info=True)
+    assert info["solver"]["steps"] == 1 and info["solver"]["rest_time"] < 0.1
+    assert np.array_equal(out.data[0], h) and not np.any(out.data[1:])
 
 
 @pytest.mark.parametrize("law", ["coulomb", "voellmy"])
@@ -249,7 +253,8 @@ def test_method_of_lines_rate_and_a_py_pde_solver():
 def test_bad_2d_input_gets_a_one_line_error():
     """A 1D profile on a 2D grid, an array of the wrong shape, a cross-slope velocity on
     a 1D grid, boundaries per axis on a 1D grid, a model without 2D kernels on a 2D
-    grid: each a one-line ValueError naming the parameter, before any work."""
+    grid, a negative depth in a 2D state (named by its cell (i, j) and position): each a
+    one-line ValueError naming the parameter, before any work."""
     from pde import CartesianGrid
 
     from pdeflow.models import SingleLayerGranular, TwoLayerGranular
@@ -269,6 +274,11 @@ def test_bad_2d_input_gets_a_one_line_error():
         (lambda: TwoLayerGranular().make_state(grid, h1=np.ones((8, 4))),
          r"^grid must be a 1D CartesianGrid or a PolarSymGrid"),
     ]
+    bad = eq.make_state(grid, h=np.ones((8, 4)))
+    bad.data[0, 2, 1] = -0.5
+    cases.append((lambda: eq.solve(bad, 0.1, solver="fv-split", tracker=None),
+                   r"^h must be >= 0 m, got -0.5 in cell \(2, 1\) \(x=0.3125 m, "
+                   r"y=0.1875 m\) and 0 more$"))
     for make, message in cases:
         with pytest.raises(ValueError, match=message) as err:
             make()
