@@ -252,12 +252,14 @@ def test_method_of_lines_rate_and_a_py_pde_solver():
 
 def test_bad_2d_input_gets_a_one_line_error():
     """A 1D profile on a 2D grid, an array of the wrong shape, a cross-slope velocity on
-    a 1D grid, boundaries per axis on a 1D grid, a model without 2D kernels on a 2D
-    grid, a negative depth in a 2D state (named by its cell (i, j) and position): each a
-    one-line ValueError naming the parameter, before any work."""
+    a 1D grid, boundaries per axis on a 1D grid, a model without 2D kernels (the tests'
+    1D shallow water) on a 2D grid, a negative depth in a 2D state (named by its cell
+    (i, j) and position): each a one-line ValueError naming the parameter, before any
+    work."""
     from pde import CartesianGrid
 
-    from pdeflow.models import SingleLayerGranular, TwoLayerGranular
+    from pdeflow.models import SingleLayerGranular
+    from tests.shallow_water.model import ShallowWater
 
     grid = CartesianGrid([[0, 1.0], [0, 0.5]], [8, 4])
     eq = SingleLayerGranular()
@@ -271,7 +273,7 @@ def test_bad_2d_input_gets_a_one_line_error():
             CartesianGrid([[0, 1.0]], 8), h=np.ones(8)), r"^bc gives a pair per axis"),
         (lambda: SingleLayerGranular(bc=(("wall", "shut"), ("wall", "wall"))),
          r"^bc must be a pair of 'wall' or 'open'"),
-        (lambda: TwoLayerGranular().make_state(grid, h1=np.ones((8, 4))),
+        (lambda: ShallowWater().make_state(grid, h=np.ones((8, 4))),
          r"^grid must be a 1D CartesianGrid or a PolarSymGrid"),
     ]
     bad = eq.make_state(grid, h=np.ones((8, 4)))
