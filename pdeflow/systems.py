@@ -37,6 +37,11 @@ class Layer:
     """what figures and tables call it, e.g. 'upper layer'"""
     style: str
     """colour key of the figures (pdeflow.plotting.COLOURS), e.g. 'upper'"""
+    discharge_y: str | None = None
+    """field name of the cross-slope discharge h v [m^2/s] on a 2D grid, e.g. 'hv'
+    (None: the model is 1D)"""
+    velocity_y: str | None = None
+    """name of the cross-slope velocity [m/s] on a 2D grid, e.g. 'v'"""
 
 
 @dataclass(frozen=True)
@@ -103,6 +108,10 @@ class EquationSystem:
     """``basal law -> its kernels``: the :attr:`kernels` compiled with the
     rate-dependent basal law that parameters name as their ``basal_law`` (None: the
     model has no such choice)"""
+    kernels_2d: Callable[[Any], Any] | None = None
+    """``basal law (None: Coulomb's) -> its kernels on a 2D grid`` (state: each layer's
+    depth, discharge along x and :attr:`Layer.discharge_y`); None: the model is 1D and
+    refuses a 2D grid"""
     diagnostics: Mapping[str, int] = field(default_factory=dict)
     """the model's own slots of the fv-split diagnostics array, name -> index (named in
     its layout, from :data:`pdeflow.numerics.layout.MODEL_SLOTS`): what its source stage
@@ -110,11 +119,17 @@ class EquationSystem:
     ``deposited`` (exchanged depth summed over cells [m]), if booked, also feed the
     erosion series"""
 
-    def kernels_for(self, parameters: Any) -> Any:
-        """The kernel bundle for ``parameters``: :attr:`law_kernels` of their
-        ``basal_law`` if they choose a rate-dependent one, else :attr:`kernels` (so that
-        a run compiles its own law's code only)."""
+    def kernels_for(self, parameters: Any, axes: int = 1) -> Any:
+        """The kernel bundle for ``parameters`` on a grid of ``axes`` axes:
+        :attr:`law_kernels` of their ``basal_law`` if they choose a rate-dependent one,
+        else :attr:`kernels` (so that a run compiles its own law's code only); on a 2D
+        grid :attr:`kernels_2d` of the law."""
         law = getattr(parameters, "basal_law", None)
+        if axes == 2:
+            if self.kernels_2d is None:
+                raise ValueError(f"the {self.adjective} model has no 2D kernels: it runs "
+                                 "on a 1D CartesianGrid or a PolarSymGrid")
+            return self.kernels_2d(law)
         if self.law_kernels is not None and law is not None:
             return self.law_kernels(law)
         return self.kernels
@@ -128,6 +143,22 @@ class EquationSystem:
     def profile_names(self) -> tuple[str, ...]:
         """Names of the depth and velocity profiles (``make_state``, ``--final`` files)."""
         return tuple(n for layer in self.layers for n in (layer.depth, layer.velocity))
+
+    def field_names_on(self, axes: int) -> tuple[str, ...]:
+        """:attr:`field_names` on a grid of ``axes`` axes (2: each layer's depth,
+        discharge along x and across)."""
+        if axes == 1:
+            return self.field_names
+        return tuple(n for layer in self.layers
+                     for n in (layer.depth, layer.discharge, layer.discharge_y))
+
+    def profile_names_on(self, axes: int) -> tuple[str, ...]:
+        """:attr:`profile_names` on a grid of ``axes`` axes (2: each layer's depth and
+        velocities along x and across)."""
+        if axes == 1:
+            return self.profile_names
+        return tuple(n for layer in self.layers
+                     for n in (layer.depth, layer.velocity, layer.velocity_y))
 
     @property
     def summary_keys(self) -> tuple[str, ...]:

@@ -18,6 +18,8 @@ Each fenced ``bash`` block of a page is taken line by line (tests/doc_commands.p
 * ``pip install ".[extra]"``: the extra exists in pyproject.toml (nothing installed);
   ``python -m pytest PATH``: the path exists.
 * Anything else needs ``<!-- test: skip REASON -->``.
+* A ``python`` block under ``<!-- test: run -->`` runs as ``python -c`` in the scratch
+  directory (other ``python`` blocks are not run).
 
 A ``text`` block under ``<!-- test: output CMD -->`` is CMD's printed output: each of its
 lines must appear, in order, in what CMD prints now, every number equal within the digits
@@ -189,6 +191,9 @@ def check_block(block: Block, cwd: Path, slow: bool = False) -> int:
             if _runs_here(cmd, block, slow):
                 run_command(cmd, block, cwd)
                 ran += 1
+    if block.lang == "python" and block.has("run") and slow == block.has("slow"):
+        run_command(["python", "-c", block.text], block, cwd)  # in the scratch directory
+        ran += 1
     for command in block.get("output"):
         cmd = commands(command)[0]
         if slow != block.has("slow"):
@@ -228,7 +233,7 @@ def test_page_slow_commands(page: Path, tmp_path: Path) -> None:
 
 def test_convention_is_documented_and_parsed() -> None:
     """The directives are the documented ones, and every page's shell blocks parse."""
-    known = {"set", "before", "output", "vary", "whole", "slow", "parse", "skip"}
+    known = {"set", "before", "output", "vary", "whole", "slow", "parse", "skip", "run"}
     text = (ROOT / "docs" / "architecture.md").read_text()
     assert "## Commands in the docs are tested" in text
     for page in PAGES:

@@ -27,6 +27,7 @@ from pdeflow.numerics.splitting import STATUS_END, scheme_stepper
 from tests.shallow_water import layout as W
 from tests.shallow_water import two_d
 from tests.shallow_water.model import KERNELS as ONE_D
+from tests.shallow_water.model import ShallowWater
 
 N = 40  #: cells along the flow
 DX = 0.125  #: cell width along both axes [m] (a power of 2: both grids get it exactly)
@@ -140,9 +141,8 @@ def test_radial_dam_break_in_a_box(scheme):
 def test_the_2d_metric_and_what_still_refuses_a_2d_grid():
     """A 2D CartesianGrid's metric: axes as (stride in the flattened cell index, cells,
     width), the cell area dx dy (the mass integral), each side's boundary codes packed
-    one bit per axis; the shipped 1D models still refuse the grid with a one-line error
-    naming the grids they take (their 2D physics is issue 36's)."""
-    import pdeflow
+    one bit per axis; a model without 2D kernels (the 1D shallow water of the tests)
+    refuses the grid with a one-line error naming the grids it takes."""
 
     grid = CartesianGrid([[0, 2.0], [0, 0.5]], [8, 4])
     metric = metric_of(grid)
@@ -154,4 +154,4 @@ def test_the_2d_metric_and_what_still_refuses_a_2d_grid():
     assert L.sides((L.BC_OPEN,)) == L.BC_OPEN
     assert L.sides((L.BC_WALL, L.BC_OPEN)) == 2 and L.sides((L.BC_OPEN, L.BC_WALL)) == 1
     with pytest.raises(ValueError, match="1D CartesianGrid or a PolarSymGrid"):
-        pdeflow.SingleLayerGranular().metric(grid)
+        ShallowWater().metric(grid)

@@ -20,13 +20,14 @@ from dataclasses import asdict, dataclass, fields
 from typing import Any
 
 import numpy as np
-from pde import CartesianGrid, FieldCollection, ScalarField
+from pde import CartesianGrid, FieldCollection
 from pde.pdes.base import PDEBase
 
 from ..numerics import layout as L
 from ..numerics.geometry import Metric, geometry_of, metric_of
 from ..numerics.scheme import Scheme
 from ..numerics.state import DRY_TOLERANCE
+from .cells import boundaries, cell_name, flat_hook, flat_rate, layer_fields
 
 BC_NAMES = L.BOUNDARIES
 
@@ -191,8 +192,21 @@ class GranularPDE(PDEBase):
     @property
     def kernels(self) -> Any:
         """The model's :class:`~pdeflow.numerics.model_kernels.ModelKernels` for its
-        parameters (:meth:`~pdeflow.systems.EquationSystem.kernels_for`)."""
+        parameters (:meth:`~pdeflow.systems.EquationSystem.kernels_for`) on a 1D grid."""
         return self.system.kernels_for(self.parameters)
+
+    def kernels_of(self, metric: Metric) -> Any:
+        """:attr:`kernels` on the grid of ``metric`` (2D kernels on a 2D grid)."""
+        return self.system.kernels_for(self.parameters, len(metric.axes))
+
+    def boundary_codes(self, axes: int) -> tuple[int, int]:
+        """The low and the high sides' boundary codes the kernels take on a grid of
+        ``axes`` axes (:func:`~pdeflow.numerics.layout.sides`; 1D: :attr:`bc_codes`)."""
+        if axes == 1:
+            return self.bc_codes
+        pairs = self.bc_axes * axes if len(self.bc_axes) == 1 else self.bc_axes
+        return (L.sides(tuple(BC_NAMES[p[0]] for p in pairs)),
+                L.sides(tuple(BC_NAMES[p[1]] for p in pairs)))
 
     def __init__(self, parameters: SharedParameters | dict | None = None, *,
                  bc: Sequence[str] = ("wall", "open"), scheme: Scheme | str | None = None,
@@ -203,7 +217,9 @@ class GranularPDE(PDEBase):
         Args:
             parameters: the model's parameters (a :attr:`parameters_class` or a dict of
                 its fields).
-            bc: boundary at (left, right): 'wall' (reflective) or 'open' (transmissive).
+            bc: boundary at (left, right): 'wall' (reflective) or 'open' (transmissive)
+                (on a 2D grid: of both axes), or on a 2D grid one such pair per axis,
+                ((x low, x high), (y low, y high)).
             scheme: how fv-split discretises it (a
                 :class:`~pdeflow.numerics.scheme.Scheme` or its name, e.g.
                 'hll/muscl/mc+strang'); default: the paper's, 'hll/first-order'.
@@ -216,11 +232,10 @@ class GranularPDE(PDEBase):
             **kwargs: individual parameters overriding ``parameters``.
         """
         super().__init__()
-        if isinstance(bc, str) or len(bc) != 2 or any(b not in BC_NAMES for b in bc):
-            raise ValueError(
-                f"bc must be a pair of 'wall' or 'open' (left, right), got {bc!r}")
-        self.bc = tuple(bc)
-        self.bc_codes = (BC_NAMES[bc[0]], BC_NAMES[bc[1]])
+        self.bc_axes = boundaries(bc)
+        """(low, high) boundary names per axis (one pair: every axis)"""
+        self.bc = tuple(bc) if len(self.bc_axes) == 1 else self.bc_axes
+        self.bc_codes = (BC_NAMES[self.bc_axes[0][0]], BC_NAMES[self.bc_axes[0][1]])
         self.scheme: Scheme = _scheme_of(scheme, flux=flux, reconstruction=reconstruction,
                                          limiter=limiter, splitting=splitting)
         if isinstance(parameters, self.parameters_class):
@@ -262,13 +277,18 @@ class GranularPDE(PDEBase):
         return float(grid.discretization[0])
 
     def geometry(self, grid: Any) -> str:
-        """The geometry of ``grid`` (:func:`~pdeflow.numerics.geometry.geometry_of`),
-        checked against the boundaries (:meth:`_check_geometry`); cheap, no arrays."""
-        return self._check_geometry(geometry_of(grid))
+        """The geometry of ``grid`` (:func:`~pdeflow.numerics.geometry.geometry_of`; a
+        2D ``CartesianGrid`` for a model with 2D kernels), checked against the
+        boundaries (:meth:`_check_geometry`); cheap, no arrays."""
+        two_d = getattr(self.system, "kernels_2d", None) is not None
+        return self._check_geometry(geometry_of(grid, two_d=two_d))
 
     def _check_geometry(self, geometry: str) -> str:
         """``geometry``, or ValueError: on an axisymmetric grid the left boundary is the
-        axis and must be 'wall'."""
+        axis and must be 'wall'; boundaries per axis need a 2D grid."""
+        if len(self.bc_axes) == 2 and geometry != "planar-2d":
+            raise ValueError(f"bc gives a pair per axis, {self.bc!r}: a {geometry} grid "
+                             "takes one pair (left, right)")
         if geometry == "axisymmetric" and self.bc[0] != "wall":
             raise ValueError(f"on an axisymmetric grid the left boundary is the axis: "
                              f"bc[0] must be 'wall', got {self.bc[0]!r}")
@@ -280,54 +300,37 @@ class GranularPDE(PDEBase):
         a run, its solver and its summary share it)."""
         last = self.__dict__.get("_metric")
         if last is None or last[0] is not grid:
-            self.geometry(grid)  # the models are 1D: refuses a 2D grid
+            self.geometry(grid)  # a 1D model refuses a 2D grid
             self._metric = (grid, metric_of(grid))
         return self._metric[1]
 
     def make_state(self, grid: CartesianGrid, **profiles: np.ndarray) -> FieldCollection:
         """State from depth and velocity profiles (names: the system's
-        :attr:`~pdeflow.systems.EquationSystem.profile_names`, e.g. h1, u1, h2, u2)."""
-        self.check_grid(grid)
-        n = grid.shape[0]
-        known = list(self.system.profile_names)
-        unknown = sorted(set(profiles) - set(known))
-        if unknown:
-            raise ValueError(f"unknown profile(s) {unknown} for {self.__class__.__name__}; "
-                             f"allowed: {known}")
-        fields = []
-        for layer in self.system.layers:
-            h = np.asarray(profiles.get(layer.depth, np.zeros(n)), dtype=float)
-            u = np.asarray(profiles.get(layer.velocity, np.zeros(n)), dtype=float)
-            for name, arr in ((layer.depth, h), (layer.velocity, u)):
-                if arr.shape != (n,):
-                    raise ValueError(f"{name} must have shape ({n},), got {arr.shape}")
-                if not np.all(np.isfinite(arr)):
-                    raise ValueError(f"{name} must be finite (no NaN or inf)")
-            if np.any(h < 0):
-                raise ValueError(f"{layer.depth} must be >= 0 m, got min {h.min():g}")
-            fields.append(ScalarField(grid, h, label=layer.depth))
-            fields.append(ScalarField(grid, h * u, label=layer.discharge))
-        return FieldCollection(fields)
+        :meth:`~pdeflow.systems.EquationSystem.profile_names_on` the grid, e.g. h1, u1,
+        h2, u2; on a 2D grid h, u, v: arrays of the grid's shape [m, m/s])."""
+        axes = 2 if self.geometry(grid) == "planar-2d" else 1
+        return layer_fields(self.system, grid, axes, type(self).__name__, profiles)
 
     def check_state(self, state: FieldCollection) -> Metric:
         """Validate a state for this model and return its grid's :meth:`metric`."""
         metric = self.metric(state.grid)
-        if state.data.shape[0] != len(self.field_names):
-            raise ValueError(f"state must have {len(self.field_names)} fields "
-                             f"{self.field_names}, got {state.data.shape[0]}")
-        x = state.grid.axes_coords[0]
-        for k, name in enumerate(self.field_names):
-            bad = np.nonzero(~np.isfinite(state.data[k]))[0]
+        names = self.system.field_names_on(len(metric.axes))
+        if state.data.shape[0] != len(names):
+            raise ValueError(f"state must have {len(names)} fields "
+                             f"{names}, got {state.data.shape[0]}")
+        q = state.data.reshape(len(names), -1)  # cells flattened (1D: the data itself)
+        for k, name in enumerate(names):
+            bad = np.nonzero(~np.isfinite(q[k]))[0]
             if bad.size:
                 raise ValueError(f"{name} must be finite (no NaN or inf), got "
-                                 f"{state.data[k, bad[0]]} in cell {bad[0]} "
-                                 f"(x={x[bad[0]]:g} m) and {bad.size - 1} more")
-        for k in range(0, len(self.field_names), 2):
-            bad = np.nonzero(state.data[k] < 0)[0]
+                                 f"{q[k, bad[0]]} in {cell_name(state.grid, bad[0])} "
+                                 f"and {bad.size - 1} more")
+        for k in range(0, len(names), len(names) // len(self.system.layers)):
+            bad = np.nonzero(q[k] < 0)[0]
             if bad.size:
-                raise ValueError(f"{self.field_names[k]} must be >= 0 m, got "
-                                 f"{state.data[k, bad[0]]:g} in cell {bad[0]} "
-                                 f"(x={x[bad[0]]:g} m) and {bad.size - 1} more")
+                raise ValueError(f"{names[k]} must be >= 0 m, got "
+                                 f"{q[k, bad[0]]:g} in {cell_name(state.grid, bad[0])} "
+                                 f"and {bad.size - 1} more")
         return metric
 
     # --- rates ----------------------------------------------------------------------------
@@ -366,10 +369,14 @@ class GranularPDE(PDEBase):
         metric = self.metric(state.grid)
         dx, M = metric.dx, metric.array()
         P = self.parameter_array()
-        bcl, bcr = self.bc_codes
-        g, r, dry = self.kernels.constants(P)
-        advect = ready(rate_kernel(self.kernels, *self.scheme.codes, metric.code))
-        sources = ready(self.kernels.mol_sources)
+        kernels = self.kernels_of(metric)
+        bcl, bcr = self.boundary_codes(len(metric.axes))
+        g, r, dry = kernels.constants(P)
+        advect = ready(rate_kernel(kernels, *self.scheme.codes, metric.code))
+        sources = ready(kernels.mol_sources)
+        if len(metric.axes) > 1:
+            return flat_rate(advect, sources, state.data.shape, dx, M, bcl, bcr, g, r,
+                             dry, P)
         shape = (2, *state.data.shape)  # closure arrays are read-only in numba
 
         @njit
@@ -402,11 +409,14 @@ class GranularPDE(PDEBase):
         """
         from ..numerics.compiled import ready
 
-        self.check_state(state)
+        metric = self.check_state(state)
         P = self.parameter_array()
-        kernel = self.source_kernel()
+        kernel = self.kernels_of(metric).source_stage
         name = getattr(backend, "name", str(backend))
         kernel = kernel.py_func if name == "numpy" else ready(kernel)
+        if len(metric.axes) > 1:
+            return (flat_hook(kernel, state.data.shape, P),
+                    self.new_diagnostics(state.grid.num_cells))
 
         def post_step_hook(state_data, t, post_step_data):
             dt = post_step_data[0]

@@ -6,8 +6,9 @@ A cell's average q_i changes by the fluxes through its faces weighted by their a
 
 On the planar slope (a 1D ``CartesianGrid``, per unit width) A = 1 and V = dx, and the
 update is the one of a uniform grid. On a 2D ``CartesianGrid`` the faces of each axis
-have area 1 and the cells dx dy: every face of axis a weighs 1/dx_a (the face loop only,
-:mod:`pdeflow.numerics.advection`; the models are 1D). On py-pde's ``PolarSymGrid``
+have area 1 and the cells dx dy: every face of axis a weighs 1/dx_a
+(:mod:`pdeflow.numerics.advection`; a model with 2D kernels runs on it). On py-pde's
+``PolarSymGrid``
 (radial flow of an axisymmetric collapse on [0, R]) A_{i+1/2} = 2 pi r_{i+1/2} and
 V_i = pi (r_{i+1/2}^2 - r_{i-1/2}^2); the axis r = 0 is a face of area 0.
 :class:`Metric` holds these as the array the advection kernels read (rows
@@ -120,7 +121,7 @@ def geometry_of(grid: Any, two_d: bool = False) -> str:
 
 def metric_of(grid: Any) -> Metric:
     """The metric of a grid that :func:`geometry_of` accepts, a 2D ``CartesianGrid``
-    included (for the face loop: the models are 1D)."""
+    included (a model without 2D kernels refuses it before: ``GranularPDE.geometry``)."""
     geometry = geometry_of(grid, two_d=True)
     if geometry == "planar-2d":
         shape = tuple(int(n) for n in grid.shape)

@@ -44,6 +44,38 @@ __all__ = ["FVSplitSolver", "SimulationBlowUp", "diagnose_blowup", "split_steppe
            "stepper_codes"]
 
 
+def on_cells(step: Any, shape: tuple[int, int]) -> Any:
+    """``step(state, data, t_start, t_end)`` as a stepper of py-pde's states: ``data`` is
+    the kernels' ``q[field, cell]``, a 1D grid's ``state.data`` itself; on a grid of
+    several axes a flattened copy of py-pde's ``data[field, n0, n1]`` (a view without
+    the ghost cells, not contiguous), written back after every call."""
+    flat = np.empty(shape)
+
+    def stepper(state: Any, t_start: float, t_end: float) -> float:
+        if state.data.shape == shape:
+            return step(state, state.data, t_start, t_end)
+        flat[...] = state.data.reshape(shape)
+        try:
+            return step(state, flat, t_start, t_end)
+        finally:
+            state.data[...] = flat.reshape(state.data.shape)
+
+    return stepper
+
+
+def _blowup_2d(state: Any, data: np.ndarray, entry: np.ndarray, t_start: float,
+               t: float, steps: int) -> None:
+    """Raise :class:`SimulationBlowUp` for a failed step on a grid of several axes:
+    the state at the start of this stepper call (``entry``, time ``t_start`` [s]) is
+    restored; the blow-up diagnosis of a cell (:func:`diagnose_blowup`) is 1D only."""
+    data[...] = entry
+    msg = (f"fv-split blew up in step {steps + 1} at t={t:.6g} s on a 2D grid (the "
+           f"diagnosis of the failed cell is 1D only). Nothing of the steps since "
+           f"t={t_start:.6g} s was kept: that state is the solver's state.")
+    raise SimulationBlowUp(msg, report={"t": t, "t_kept": t_start},
+                           state=state.data.copy())
+
+
 class _RestProfilerFilter(logging.Filter):
     """Drop py-pde's "more time on trackers than on the simulation" warning after a run
     that fv-split ended at rest: the controller does not book the time of a stepper
@@ -68,7 +100,7 @@ def stepper_codes(pde: GranularPDE, metric: Metric,
     PDE's) with the model's kernels on the grid of ``metric``, as
     :func:`pdeflow.numerics.splitting.scheme_stepper` takes them."""
     scheme = pde.scheme if scheme is None else scheme
-    return (pde.kernels, *scheme.codes, scheme.strang, metric.code)
+    return (pde.kernels_of(metric), *scheme.codes, scheme.strang, metric.code)
 
 
 def split_stepper(pde: GranularPDE, metric: Metric,
@@ -148,11 +180,12 @@ class FVSplitSolver(SolverBase):
                          variant=self.scheme.spatial, splitting=self.scheme.splitting,
                          wall_time=0.0)
         P = pde.parameter_array()
-        bcl, bcr = pde.bc_codes
-        rate = np.empty_like(state.data)
-        backup = np.empty_like(state.data)
-        work = np.empty((3, *state.data.shape))
-        prev = np.empty_like(state.data)
+        bcl, bcr = pde.boundary_codes(len(metric.axes))
+        shape = (state.data.shape[0], state.grid.num_cells)  # the kernels' q[field, cell]
+        rate = np.empty(shape)
+        backup = np.empty(shape)
+        work = np.empty((3, *shape))
+        prev = np.empty(shape)
         scheme = stepper_codes(pde, metric, self.scheme)
         cfl = self.cfl
         stop = self.stop_at_rest
@@ -178,14 +211,14 @@ class FVSplitSolver(SolverBase):
 
         ahead: list[StepAhead] = []  # the state past the last output time, if any
 
-        def step(state: Any, t_start: float, t_end: float) -> float:
+        def step(state: Any, data: np.ndarray, t_start: float, t_end: float) -> float:
             t_pause = float(t_end)
             t_run = t_pause if self.t_end is None else max(self.t_end, t_pause)
-            done, t_start = self._resume(ahead, state, float(t_start), t_pause)
+            done, t_start = self._resume(ahead, data, float(t_start), t_pause)
             if done:
                 return t_start
-            entry = state.data.copy()
-            t, steps, status = advance(state.data, float(t_start), t_pause, t_run)
+            entry = data.copy()
+            t, steps, status = advance(data, float(t_start), t_pause, t_run)
             self.info["steps"] += int(steps)
             # not "dt": py-pde's controller would then fire every tracker due within half
             # a step *after* the time it stopped at, early (a snapshot at 0.0957 s
@@ -193,20 +226,21 @@ class FVSplitSolver(SolverBase):
             # the steps land on the output times (interpolated), no tolerance is needed
             self.info["last_dt"] = float(diag[L.D_DT]) or None
             if status == STATUS_FAIL:
+                if state.grid.num_axes > 1:
+                    _blowup_2d(state, data, entry, t_start, t, int(self.info["steps"]))
                 self._blowup(state, entry, t_start, t, t_run, replay)
             if t_pause < t < t_run and self.outputs == "interpolate":
                 # the step went past the output time: output the state at that time,
                 # continue from the step's end at the next call
                 dt = float(diag[L.D_DT]) * (2.0 if self.scheme.strang else 1.0)
-                ahead.append(pending_output(state.data, prev, t, dt,
-                                            status == STATUS_REST))
-                ahead[0].interpolate(state.data, t_pause)
+                ahead.append(pending_output(data, prev, t, dt, status == STATUS_REST))
+                ahead[0].interpolate(data, t_pause)
                 return t_pause
             if status == STATUS_REST:
                 self._at_rest(t)
             return float(t)
 
-        return self._timed(step)
+        return self._timed(on_cells(step, shape))
 
     def _hook(self, state: Any) -> tuple[Any, np.ndarray]:
         """(post-step hook or None, diagnostics array) of the backend: the compiled loop
@@ -219,7 +253,7 @@ class FVSplitSolver(SolverBase):
         else:
             self._select_backend(state)
         if self.backend_name == "numba":
-            hook, diag = None, self.pde.new_diagnostics(state.grid.shape[0])
+            hook, diag = None, self.pde.new_diagnostics(state.grid.num_cells)
         else:
             hook, diag = self.pde.make_post_step_hook(state, backend=self.backend)
         self.diagnostics = diag
@@ -239,19 +273,20 @@ class FVSplitSolver(SolverBase):
 
         return stepper
 
-    def _resume(self, ahead: list[StepAhead], state: Any, t_start: float,
+    def _resume(self, ahead: list[StepAhead], data: np.ndarray, t_start: float,
                 t_pause: float) -> tuple[bool, float]:
         """After an interpolated output (``ahead`` holds the step past it): ``(True,
         t)`` if the call to ``t_pause`` [s] is answered from it (another output time
         within the same step, or its end), else ``(False, t)`` with the step's end
-        restored as the state at ``t``; ``(False, t_start)`` if nothing is ahead."""
+        restored as the state ``data`` (cells flattened) at ``t``; ``(False, t_start)``
+        if nothing is ahead."""
         if not ahead:
             return False, t_start
         if t_pause < ahead[0].t:  # another output time within the same step
-            ahead[0].interpolate(state.data, t_pause)
+            ahead[0].interpolate(data, t_pause)
             return True, t_pause
         step = ahead.pop()
-        state.data[...] = step.q
+        data[...] = step.q
         if step.at_rest:
             self._at_rest(step.t)
         return step.t >= t_pause, step.t

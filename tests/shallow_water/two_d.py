@@ -1,12 +1,12 @@
 """Frictionless shallow water in 2D, (h, hu, hv): the kernels a model gives the scheme's
 face loop on a 2D grid (tests/test_two_d_loop.py).
 
-The model supplies its state at a face in the face's normal frame (:func:`face`: depth,
-normal momentum, tangential momentum), the rows the fluctuations go back into
-(:data:`ROWS`, one tuple per axis) and its fluctuations in that frame: the Saint-Venant
-ones of the single layer for (h, normal momentum), and the tangential momentum carried
-by the mass flux through the face, upwinded (the contact wave of HLLC's star states
-reduced to its transport). The scheme names no field. A state with no tangential
+The model supplies its state at a face in the face's normal frame (depth, normal
+momentum, tangential momentum), the rows the fluctuations go back into (one tuple per
+axis) and its fluctuations in that frame: the single layer's 2D ones
+(:mod:`pdeflow.models.single_layer.two_d`: the Saint-Venant ones for (h, normal
+momentum), and the tangential momentum carried by the mass flux through the face,
+upwinded). The scheme names no field. A state with no tangential
 momentum gives the 1D fluctuations and zero tangential ones, so a 2D run uniform across
 a direction gives the 1D run's numbers. This is the face loop's check, not issue 36's
 2D physics: gravity acts along x only (g_x), there is no friction.
@@ -14,83 +14,25 @@ a direction gives the 1D run's numbers. This is the face loop's check, not issue
 
 from __future__ import annotations
 
-import functools
 from typing import Any
 
 import numpy as np
 
-from pdeflow.models.single_layer import flux as saint_venant
+from pdeflow.models.single_layer.two_d import ROWS, cell_jump, face, fluctuations
 from pdeflow.numerics import layout as L
 from pdeflow.numerics.compiled import (
     FIELDS,
     PARAMS,
     STATE,
     VECTOR,
-    cached,
     f8,
     i8,
     kernel,
-    specialise,
-    types,
 )
 from pdeflow.numerics.model_kernels import ModelKernels
 from pdeflow.numerics.state import velocity
 
 from . import layout as W
-
-ROWS = ((0, 1, 2), (0, 2, 1))
-"""per axis: the rows of q that (depth, normal momentum, tangential momentum) go into"""
-
-
-@cached(inline="always")
-def face(q, i, axis, sign):
-    """State ``(h, normal momentum times sign, tangential momentum)`` of cell (or face
-    value) ``i`` at a face normal to ``axis`` (0: x, 1: y) [m, m^2/s, m^2/s]."""
-    if axis == 0:
-        return q[0, i], sign * q[1, i], q[2, i]
-    return q[0, i], sign * q[2, i], q[1, i]
-
-
-@functools.cache
-def fluctuations(flux: int) -> Any:
-    """``fluct(left, right, g, r, dry) -> (D^-, D^+, smax)`` in a face's normal frame,
-    (h, normal, tangential) tuples, for one flux (layout.FLUX_*)."""
-    normal = saint_venant.fluctuations(flux)
-
-    def fluct_sw2(left, right, g, r, dry):
-        hL, mL, tL = left
-        hR, mR, tR = right
-        dm, dp, smax = normal((hL, mL), (hR, mR), g, r, dry)
-        # the tangential velocity rides on the mass flux through the face, from upwind
-        fL = velocity(hL, mL, dry) * hL
-        fR = velocity(hR, mR, dry) * hR
-        vL = velocity(hL, tL, dry)
-        vR = velocity(hR, tR, dry)
-        mass = fL + dm[0]
-        t_minus = mass * (vL if mass > 0.0 else vR) - fL * vL
-        t_total = fR * vR - fL * vL
-        return (dm[0], dm[1], t_minus), (dp[0], dp[1], t_total - t_minus), smax
-
-    tuple3 = types.UniTuple(types.float64, 3)
-    return specialise(fluct_sw2, tuple3, tuple3, f8, f8, f8, helper=True)
-
-
-@cached
-def cell_jump(qm, qp, rate, lo, hi, inv_dx, g, r, dry, axis):
-    """MUSCL: subtract the flux difference along ``axis`` across the reconstruction
-    inside cells lo..hi (the single layer's for h and the normal momentum)."""
-    n = 1 + axis
-    t = 2 - axis
-    for i in range(lo, hi + 1):
-        hl, hr = qm[0, i], qp[0, i]
-        ul = velocity(hl, qm[n, i], dry)
-        ur = velocity(hr, qp[n, i], dry)
-        rate[0, i] -= (ur * hr - ul * hl) * inv_dx
-        rate[n, i] -= (ur * ur * hr + 0.5 * g * hr * hr
-                       - ul * ul * hl - 0.5 * g * hl * hl) * inv_dx
-        vl = velocity(hl, qm[t, i], dry)
-        vr = velocity(hr, qp[t, i], dry)
-        rate[t, i] -= (ur * hr * vr - ul * hl * vl) * inv_dx
 
 
 @kernel(STATE, f8, f8, PARAMS, VECTOR, i8, i8)

@@ -25,7 +25,7 @@ from ..base import GranularPDE, SharedParameters, check_range, stop_time
 from ..friction_laws import FrictionLawParameters
 from ..parameters import parameter_vector
 from . import layout as S
-from .kernels import KERNELS, kernels
+from .kernels import KERNELS, kernels, kernels_2d
 
 
 @dataclass
@@ -58,7 +58,9 @@ class SingleLayerParameters(FrictionLawParameters, SharedParameters):
 class SingleLayerGranular(GranularPDE):
     """Single-layer Coulomb granular flow (the paper's baseline) as a py-pde PDE.
 
-    State: ``FieldCollection`` of h [m] and hu [m^2/s] on a 1D ``CartesianGrid``.
+    State: ``FieldCollection`` of h [m] and hu [m^2/s] on a 1D ``CartesianGrid`` (or a
+    ``PolarSymGrid``), or of h, hu and hv [m^2/s] on a 2D ``CartesianGrid`` (x down the
+    slope, y across).
     """
 
     parameters_class = SingleLayerParameters
@@ -74,9 +76,9 @@ def summarize(diag, tf: float, at_rest: bool, x: np.ndarray, d: np.ndarray,
 
 SYSTEM = systems.register(systems.EquationSystem(
     name="single_layer", label="single layer", adjective="single-layer",
-    layers=(systems.Layer("h", "hu", "u", "single layer", "single"),),
+    layers=(systems.Layer("h", "hu", "u", "single layer", "single", "hv", "v"),),
     parameters_class=SingleLayerParameters, pde_class=SingleLayerGranular,
-    kernels=KERNELS, law_kernels=kernels, diagnostics=S.DIAGNOSTICS,
+    kernels=KERNELS, law_kernels=kernels, kernels_2d=kernels_2d, diagnostics=S.DIAGNOSTICS,
     densities=lambda p: (1.0,),
     layer_depths=lambda h, x, ini, p: (h,),
     summarize=summarize, bytes_per_cell=180, paper_runout_law=(2.25, 1.06),

@@ -28,9 +28,17 @@ def stage_kernels(law: BasalLaw | None) -> tuple[Any, Any, Any]:
     constants: the stage on the cells lo..hi ``(q, dt, t, P, diag, lo, hi)``, the same
     on every cell ``(q, dt, t, P, diag)`` (the post-step hook's kernel) and MUSCL's
     friction predictor ``(q, dt, P, lo, hi)``."""
+    return _stage(*friction_step(law))
+
+
+def friction_step(law: BasalLaw | None) -> tuple[Any, Any, bool]:
+    """``(step_friction, after_friction, coulomb)``: the single layer's implicit basal
+    friction with the law ``law`` (None: Coulomb's), as the stages take it (see
+    :func:`_stage`); the 2D stage (:mod:`.sources_2d`) applies ``after_friction`` to the
+    speed."""
     if law is None:
-        return _stage(basal_friction, basal_velocity, coulomb=True)
-    return _stage(law_friction, _law_step(law_velocity(law)))
+        return basal_friction, basal_velocity, True
+    return law_friction, _law_step(law_velocity(law)), False
 
 
 @cached(inline="always")
