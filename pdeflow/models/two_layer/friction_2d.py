@@ -167,12 +167,21 @@ def friction_two_layer_2d(b1x, b1y, b2x, b2y, m1, m2, Kdt, Cdt, Bdt):
     return u2x + s * nx, u2y + s * ny, u2x, u2y
 
 
+@cached(inline="always")
+def coulomb_bed_2d(b1x, b1y, b2x, b2y, m1, h1, h2, kdt, cdt, dt, g, r, fp):
+    """Stage (32) of two wet layers with Coulomb friction at the bed, vectors:
+    (u1x, u1y, u2x, u2y) [m/s] (as :func:`.friction.bed_under_both`)."""
+    bdt = dt * g * (r * h1 + h2) * fp[FP_TAN_B]
+    return friction_two_layer_2d(b1x, b1y, b2x, b2y, m1, h2, kdt, cdt, bdt)
+
+
 @functools.cache
-def implicit_friction_2d(fk: FrictionKernels) -> Any:
+def implicit_friction_2d(fk: FrictionKernels, bed: Any = coulomb_bed_2d) -> Any:
     """``(b1x, b1y, b2x, b2y, h1, h2, dt, fp, fx, fy, k, c) -> (u1x, u1y, u2x, u2y)``:
     stage (32) of one cell with vector velocities [m/s] and the extra exchange
     (fx, fy) = F_extra/rho2 [m^2/s^2]; the 1D kernel of ``fk`` where every vector lies
-    along one axis; arguments as :func:`.friction.implicit_friction`'s."""
+    along one axis, else ``bed`` (stage (32) of two wet layers with the basal law, as
+    :func:`coulomb_bed_2d`); arguments as :func:`.friction.implicit_friction`'s."""
     one_d = fk.implicit_friction
 
     def implicit_friction_two_d(b1x, b1y, b2x, b2y, h1, h2, dt, fp, fx, fy, k, c):
@@ -194,8 +203,7 @@ def implicit_friction_2d(fk: FrictionKernels) -> Any:
             b1y -= dt * fy / m1
             b2x += dt * fx / h2
             b2y += dt * fy / h2
-            bdt = dt * g * (r * h1 + h2) * fp[FP_TAN_B]
-            return friction_two_layer_2d(b1x, b1y, b2x, b2y, m1, h2, kdt, dt * c, bdt)
+            return bed(b1x, b1y, b2x, b2y, m1, h1, h2, kdt, dt * c, dt, g, r, fp)
         if wet1:
             u1x, u1y = _along(b1x, b1y, drag_root(
                 m1 * math.sqrt(b1x * b1x + b1y * b1y) - kdt, m1, dt * c))
@@ -226,16 +234,17 @@ def _settled(v, ex, ey, aim):
 
 
 @functools.cache
-def restore_2d(fk: FrictionKernels) -> Any:
+def restore_2d(fk: FrictionKernels, bed: Any = coulomb_bed_2d) -> Any:
     """``(b1x, b1y, b2x, b2y, h1, h2, v1x, v1y, v2x, v2y, dt, fp, k, c, edge) ->
     (f, v1x, v1y, v2x, v2y, bisected)``: the smallest F_extra/rho2 = f [m^2/s^2] along
     the post-friction shear du = v1 - v2 after which stage (32) gives |du| within w
     below ``edge`` [m/s] (F_c1: hyperbolic in every direction, docs/two_d.md), and the
-    velocities it leads to. Where every vector lies along one axis, the 1D closed form
-    of ``fk`` (:func:`.friction.restore_to_edge`); elsewhere bisection on f along the
-    shear (repeated along the new shear if it turned normal to the old one first)."""
+    velocities it leads to (``bed`` as :func:`implicit_friction_2d`'s). Where every
+    vector lies along one axis, the 1D closed form of ``fk``
+    (:func:`.friction.restore_to_edge`); elsewhere bisection on f along the shear
+    (repeated along the new shear if it turned normal to the old one first)."""
     one_d = fk.restore_to_edge
-    friction = implicit_friction_2d(fk)
+    friction = implicit_friction_2d(fk, bed)
 
     def restore_two_d(b1x, b1y, b2x, b2y, h1, h2, v1x, v1y, v2x, v2y, dt, fp, k, c,
                       edge):

@@ -53,16 +53,13 @@ def kernels_2d(law: BasalLaw | None = None, directions: str = "all") -> ModelKer
     h1v1, h2, h2u2, h2v2): the face states, fluctuations and MUSCL cell jump of
     :mod:`.two_d`, the source stages of :mod:`.sources_2d` (hyperbolicity restored in
     ``directions`` 'all' or, as in 1D, along the 'flow') and the method-of-lines rate
-    of :mod:`.rates_2d`; ``law`` None: the paper's Coulomb friction at the bed (the
-    rate-dependent laws are not written in 2D yet: ValueError)."""
-    if law is not None:
-        raise ValueError(f"the two-layer 2D kernels take Coulomb friction at the bed "
-                         f"only (law None), got {law!r}")
-    sources, source_stage, predictor = stage_kernels_2d(directions)
+    of :mod:`.rates_2d`, with the basal law ``law`` (None: the paper's Coulomb
+    friction at the bed)."""
+    sources, source_stage, predictor = stage_kernels_2d(law, directions)
     return ModelKernels(
         fields=6, face=two_d.face, fluctuations=two_d.fluctuations,
         cell_jump=two_d.cell_jump, sources=sources, source_stage=source_stage,
-        predictor=predictor, mol_sources=source_rate_2d, numpy_advection=_no_numpy_twin,
+        predictor=predictor, mol_sources=source_rate_2d(law), numpy_advection=_no_numpy_twin,
         numpy_sources=_no_numpy_twin, constants=_constants,
         layer_rows=two_d.LAYER_ROWS, rows=two_d.ROWS)
 

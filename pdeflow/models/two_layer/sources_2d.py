@@ -7,7 +7,8 @@ The 1D stage (:mod:`.sources`) with vectors:
   the 1D stage has |du| (:func:`.exchange.exchange_step` reads du only through du^2
   and |du|); the exchanged mass carries the velocity vector of the layer it leaves;
 * implicit momentum sources (32): gravity along x, the interface stress opposing du
-  and the basal friction opposing u2, both set-valued (:mod:`.friction_2d`);
+  and the basal friction opposing u2, both set-valued (:mod:`.friction_2d`; a
+  rate-dependent basal law: :mod:`.laws_2d`);
 * hyperbolicity (33)-(34): F_extra along du. With ``directions`` "all" (the default)
   it brings |du| to F_c1 whenever |du| > F_c1, above the band as inside it: only then
   is the state hyperbolic in every direction (docs/two_d.md); "flow" applies the 1D
@@ -26,12 +27,15 @@ from typing import Any
 
 from ...numerics import layout as L
 from ...numerics.compiled import PARAMS, STATE, VECTOR, f8, i8, specialise
+from ...numerics.rheology import BasalLaw
 from ...numerics.state import velocity
 from . import layout as T
 from .exchange import exchange_step
-from .friction import COULOMB
-from .friction_2d import implicit_friction_2d, restore_2d
+from .friction import COULOMB, friction_kernels
+from .friction_2d import coulomb_bed_2d, implicit_friction_2d, restore_2d
 from .hyperbolicity import restoration_target, restoration_target_all
+from .laws import law_bed
+from .laws_2d import law_bed_2d
 from .sources import _close_stage
 
 DIRECTIONS = ("all", "flow")
@@ -39,22 +43,25 @@ DIRECTIONS = ("all", "flow")
 
 
 @functools.cache
-def stage_kernels_2d(directions: str = "all") -> tuple[Any, Any, Any]:
-    """The 2D source-stage kernels with Coulomb friction at the bed: the stage on the
-    cells lo..hi ``(q, dt, t, P, diag, lo, hi)``, on every cell ``(q, dt, t, P,
-    diag)`` and MUSCL's predictor ``(q, dt, P, lo, hi)``; ``directions`` one of
-    :data:`DIRECTIONS`."""
+def stage_kernels_2d(law: BasalLaw | None = None,
+                     directions: str = "all") -> tuple[Any, Any, Any]:
+    """The 2D source-stage kernels with the basal law ``law`` (None: the paper's
+    Coulomb friction), compiled with its kernels as constants (as the 1D
+    :func:`.sources.stage_kernels`): the stage on the cells lo..hi ``(q, dt, t, P,
+    diag, lo, hi)``, on every cell ``(q, dt, t, P, diag)`` and MUSCL's predictor
+    ``(q, dt, P, lo, hi)``; ``directions`` one of :data:`DIRECTIONS`."""
     if directions not in DIRECTIONS:
         raise ValueError(f"directions must be one of {list(DIRECTIONS)}, got "
                          f"{directions!r}")
-    fk = COULOMB
-    sources = _sources_2d(fk, directions == "all")
+    fk = COULOMB if law is None else friction_kernels(*law_bed(law))
+    bed = coulomb_bed_2d if law is None else law_bed_2d(law)
+    sources = _sources_2d(fk, bed, directions == "all")
 
     def source_stage_two_layer_2d(q, dt, t, P, diag):
         sources(q, dt, t, P, diag, 0, q.shape[1] - 1)
 
     return (sources, specialise(source_stage_two_layer_2d, STATE, f8, f8, PARAMS, VECTOR),
-            _predictor_2d(fk))
+            _predictor_2d(fk, bed))
 
 
 def _exchange_2d(h1, h2, u1x, u1y, u2x, u2y, dt, P):
@@ -99,11 +106,12 @@ def _exchange_2d(h1, h2, u1x, u1y, u2x, u2y, dt, P):
     return h1, h2, u1x, u1y, u2x, u2y, dh1, phi
 
 
-def _sources_2d(fk: Any, every_direction: bool) -> Any:
-    """The 2D stage on a range of cells with the friction kernels ``fk``."""
+def _sources_2d(fk: Any, bed: Any, every_direction: bool) -> Any:
+    """The 2D stage on a range of cells with the friction kernels ``fk`` and the 2D bed
+    ``bed`` of the basal law (:func:`.friction_2d.implicit_friction_2d`)."""
     friction_params = fk.friction_params
-    friction = implicit_friction_2d(fk)
-    restore = restore_2d(fk)
+    friction = implicit_friction_2d(fk, bed)
+    restore = restore_2d(fk, bed)
     exchange = specialise(_exchange_2d, helper=True)
     target = restoration_target_all if every_direction else restoration_target
 
@@ -191,11 +199,11 @@ def _sources_2d(fk: Any, every_direction: bool) -> Any:
     return specialise(sources_two_layer_2d, STATE, f8, f8, PARAMS, VECTOR, i8, i8)
 
 
-def _predictor_2d(fk: Any) -> Any:
+def _predictor_2d(fk: Any, bed: Any) -> Any:
     """MUSCL's predictor in 2D: zero the momentum of the layers that stage (32) would
     hold at rest (as :func:`.friction.predictor_two_layer`)."""
     friction_params = fk.friction_params
-    friction = implicit_friction_2d(fk)
+    friction = implicit_friction_2d(fk, bed)
 
     def predictor_two_layer_2d(q, dt, P, lo, hi):
         dry = P[T.DRY]
