@@ -24,7 +24,13 @@ from pdeflow.models.two_layer.laws_2d import law_bed_2d
 from pdeflow.numerics import layout as L
 from pdeflow.numerics.geometry import metric_of
 from pdeflow.numerics.splitting import STATUS_END, scheme_stepper
-from tests.test_two_d_hyperbolicity import G, directions, hyperbolic_in, random_states
+from tests.test_two_d_hyperbolicity import (
+    G,
+    directions,
+    hyperbolic_in,
+    jacobian_2d,
+    random_states,
+)
 
 N = 56  #: cells along the flow: the 5.1 domain (7 m) at dx = 0.125 m
 DX = 0.125  #: cell width along both axes [m] (a power of 2: both grids get it exactly)
@@ -215,8 +221,9 @@ def test_mass_positivity_and_the_x_y_mirror_in_a_walled_box():
 
 def unrestored_wet_cells(q: np.ndarray, r: float, g: float) -> list[str]:
     """The cells of a 2D state where both layers are wet (above 1e-3 m) and |du| exceeds
-    F_c1 (1 + 1e-12) or some of the 64 directions of tests/test_two_d_hyperbolicity.py
-    is not hyperbolic (the closed-form discriminant): descriptions, empty if none."""
+    F_c1 (1 + 1e-12), or some of the 64 directions of tests/test_two_d_hyperbolicity.py
+    is not hyperbolic (the closed-form discriminant, then the eigenvalues of its 2D
+    Jacobian A_n): descriptions, empty if none."""
     bad = []
     for i in np.nonzero((q[0] > 1e-3) & (q[3] > 1e-3))[0]:
         h1, h2 = q[0, i], q[3, i]
@@ -230,6 +237,14 @@ def unrestored_wet_cells(q: np.ndarray, r: float, g: float) -> list[str]:
             bad.append(f"cell {i}: |du| = {du} > F_c1 = {edges[0]}")
         elif not all(hyperbolic_in(h1, u1, h2, u2, r, n) for n in directions()):
             bad.append(f"cell {i}: a direction is not hyperbolic")
+        else:
+            # the 6x6 A_n of the 2D fluxes: real spectra to the eigenvalue solver's
+            # accuracy near the double root at the band edge, 1e-6 sqrt(g H) (as the
+            # spectrum test of tests/test_two_d_hyperbolicity.py)
+            imag = max(np.abs(np.linalg.eigvals(jacobian_2d(h1, u1, h2, u2, n, r, g)).imag
+                              ).max() for n in directions())
+            if imag > 1e-6 * np.sqrt(g * (h1 + h2)):
+                bad.append(f"cell {i}: A_n has eigenvalues with imaginary part {imag}")
     return bad
 
 
