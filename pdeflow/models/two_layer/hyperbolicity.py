@@ -170,6 +170,37 @@ def restoration_target(h1: float, h2: float, du: float, g: float, r: float,
     return True, _edge_below(a, c2, A, D)
 
 
+EDGE_SAMPLES = 256
+"""samples of A between F_L and |du| that look for the band below a hyperbolic |du|"""
+
+
+@cached
+def restoration_target_all(h1: float, h2: float, du: float, g: float, r: float,
+                           mode: int) -> tuple[bool, float]:
+    """:func:`restoration_target` for every direction of a 2D state (docs/two_d.md):
+    (True, F_c1) whenever |du| > F_c1, above the band as inside it (F_L in ``bound``
+    mode), else (False, 0). Above the band the quartic is sampled at
+    :data:`EDGE_SAMPLES` points of A between F_L and |du| for a point inside the band,
+    from which :func:`_edge_below` refines F_c1 (a band narrower than the spacing is
+    missed: the state then counts as hyperbolic)."""
+    bad, edge = restoration_target(h1, h2, du, g, r, mode)
+    if bad or mode == L.HYPERBOLICITY_BOUND or du * du <= (1.0 - r) * g * (h1 + h2):
+        return bad, edge
+    fl = lower_bound_fl(h1, h2, g, r)
+    if abs(du) <= fl:
+        return False, 0.0
+    a = _quartic_in_a(h1, h2, r)
+    c2 = g * (h1 + h2)
+    lo = 0.25 * fl * fl / c2
+    hi = 0.25 * du * du / c2
+    for j in range(1, EDGE_SAMPLES + 1):
+        x = lo + (hi - lo) * j / (EDGE_SAMPLES + 1)
+        D = _quartic_at(a, x)
+        if D < 0.0:
+            return True, _edge_below(a, c2, x, D)
+    return False, 0.0
+
+
 @cached
 def band_lower_edge(h1: float, h2: float, g: float, r: float, du_bad: float) -> float:
     """Lower edge F_c1 [m/s] of the non-hyperbolic band, given a non-hyperbolic |du|.
