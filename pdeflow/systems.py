@@ -36,7 +36,7 @@ class Layer:
     label: str
     """what figures and tables call it, e.g. 'upper layer'"""
     style: str
-    """colour key of the figures (pdeflow.plotting.COLOURS), e.g. 'upper'"""
+    """how figures draw it, a key of pdeflow.plotting.LAYER_STYLES, e.g. 'upper'"""
     discharge_y: str | None = None
     """field name of the cross-slope discharge h v [m^2/s] on a 2D grid, e.g. 'hv'
     (None: the model is 1D)"""
@@ -108,10 +108,11 @@ class EquationSystem:
     """``basal law -> its kernels``: the :attr:`kernels` compiled with the
     rate-dependent basal law that parameters name as their ``basal_law`` (None: the
     model has no such choice)"""
-    kernels_2d: Callable[[Any], Any] | None = None
-    """``basal law (None: Coulomb's) -> its kernels on a 2D grid`` (state: each layer's
-    depth, discharge along x and :attr:`Layer.discharge_y`); None: the model is 1D and
-    refuses a 2D grid"""
+    kernels_2d: Callable[[Any, Any], Any] | None = None
+    """``(basal law (None: Coulomb's), parameters) -> the kernels on a 2D grid`` (state:
+    each layer's depth, discharge along x and :attr:`Layer.discharge_y`; the parameters
+    name the model's compile-time 2D choices); None: the model is 1D and refuses a 2D
+    grid"""
     diagnostics: Mapping[str, int] = field(default_factory=dict)
     """the model's own slots of the fv-split diagnostics array, name -> index (named in
     its layout, from :data:`pdeflow.numerics.layout.MODEL_SLOTS`): what its source stage
@@ -129,7 +130,7 @@ class EquationSystem:
             if self.kernels_2d is None:
                 raise ValueError(f"the {self.adjective} model has no 2D kernels: it runs "
                                  "on a 1D CartesianGrid or a PolarSymGrid")
-            return self.kernels_2d(law)
+            return self.kernels_2d(law, parameters)
         if self.law_kernels is not None and law is not None:
             return self.law_kernels(law)
         return self.kernels

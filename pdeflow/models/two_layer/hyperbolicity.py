@@ -30,8 +30,8 @@ Because the depths are frozen in that stage, hyperbolicity depends on du alone: 
 target is the lower band edge F_c1 (:func:`band_lower_edge`, a root of the
 discriminant found by safeguarded Halley iteration; F_L itself in ``bound`` mode), and
 the implicit friction step, solved in closed form, is inverted for the F_extra that
-lands |du| on it (:func:`pdeflow.numerics.splitting._restore_hyperbolicity`). The paper
-iterates until lambda_3 - lambda_2 <= w (34); near the boundary that gap grows like
+lands |du| on it (:func:`pdeflow.models.two_layer.friction._restore_hyperbolicity`).
+The paper iterates until lambda_3 - lambda_2 <= w (34); near the boundary that gap grows like
 the square root of the distance in du, so pdeflow reads w as a tolerance in du: the
 restored |du| lies within w below F_c1 (the direct solve lands within round-off of
 it; the bisection kept as a fallback stops when its bracket in du is below w).

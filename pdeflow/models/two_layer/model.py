@@ -31,7 +31,8 @@ from ..base import GranularPDE, SharedParameters, check_range, stop_time
 from ..friction_laws import FrictionLawParameters
 from ..parameters import parameter_vector
 from . import layout as T
-from .kernels import KERNELS, kernels
+from .kernels import KERNELS, kernels, kernels_2d
+from .sources_2d import DIRECTIONS
 
 HYPERBOLICITY_MODES = L.HYPERBOLICITY_MODES
 
@@ -72,6 +73,11 @@ class TwoLayerParameters(FrictionLawParameters, SharedParameters):
     """relaxation time of the 'relaxed' closure in units of sqrt(H/g) [-]"""
     hyperbolicity: str = "exact"
     """restoration of hyperbolicity: 'exact' (paper), 'bound' (F_L), 'none'"""
+    hyperbolicity_directions: str = "all"
+    """on a 2D grid, the directions the restoration makes hyperbolic: 'all' (default:
+    |du| brought to F_c1, so that every direction is, docs/two_d.md) or 'flow' (the
+    paper's 1D rule along du only, which leaves |du| >= F_c2 alone: the 1D numbers for a
+    flow uniform across); no effect on a 1D grid"""
 
     def validate_model(self) -> None:
         check_range("density_ratio", self.density_ratio, 0, 1, low_open=True,
@@ -92,6 +98,9 @@ class TwoLayerParameters(FrictionLawParameters, SharedParameters):
         if self.hyperbolicity not in HYPERBOLICITY_MODES:
             raise ValueError(f"hyperbolicity must be one of {list(HYPERBOLICITY_MODES)}, "
                              f"got {self.hyperbolicity!r}")
+        if self.hyperbolicity_directions not in DIRECTIONS:
+            raise ValueError("hyperbolicity_directions must be one of "
+                             f"{list(DIRECTIONS)}, got {self.hyperbolicity_directions!r}")
         self.validate_law()
 
     def to_array(self) -> np.ndarray:
@@ -120,7 +129,9 @@ class TwoLayerGranular(GranularPDE):
     """Two-layer depth-averaged granular flow (paper eqs. 24-27) as a py-pde PDE.
 
     State: ``FieldCollection`` of h1 [m], h1u1 [m^2/s], h2 [m], h2u2 [m^2/s] on a 1D
-    ``CartesianGrid`` whose cells are the finite volumes. Integrate with
+    ``CartesianGrid`` (or a ``PolarSymGrid``), or of h1, h1u1, h1v1, h2, h2u2, h2v2 on a
+    2D ``CartesianGrid`` (x down the slope, y across); its cells are the finite volumes.
+    Integrate with
     ``solver="fv-split"`` (the paper's scheme) or any py-pde solver (method of lines).
     """
 
@@ -173,10 +184,11 @@ def summarize(diag, tf: float, at_rest: bool, x: np.ndarray, d: np.ndarray,
 Q = systems.Quantity
 SYSTEM = systems.register(systems.EquationSystem(
     name="two_layer", label="two layers", adjective="two-layer",
-    layers=(systems.Layer("h1", "h1u1", "u1", "upper layer", "upper"),
-            systems.Layer("h2", "h2u2", "u2", "lower layer", "lower")),
+    layers=(systems.Layer("h1", "h1u1", "u1", "upper layer", "upper", "h1v1", "v1"),
+            systems.Layer("h2", "h2u2", "u2", "lower layer", "lower", "h2v2", "v2")),
     parameters_class=TwoLayerParameters, pde_class=TwoLayerGranular, kernels=KERNELS,
     law_kernels=kernels, diagnostics=T.DIAGNOSTICS,
+    kernels_2d=lambda law, p: kernels_2d(law, p.hyperbolicity_directions),
     densities=lambda p: (p.density_ratio, 1.0), layer_depths=layer_depths,
     summarize=summarize, has_fextra=True, cell_diagnostic="fextra_over_rho1",
     bytes_per_cell=320,

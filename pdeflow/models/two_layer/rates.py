@@ -148,7 +148,7 @@ def _at_uncovered_steps_np(left, right, ul, ur, sL, sR, a0, a1, dH, g, dry, fluc
     share_l = hll_split(sL, sR, 0.0 * pressure, pressure)[0]  # the flux's share of it
     share_r = pressure - share_l
     # both wet: the thinner side gets at most the share its own depth carries, the
-    # thicker side the rest (as pvm.upper_layer_at_uncovered_step)
+    # thicker side the rest (as .flux.upper_layer_at_uncovered_step)
     both = (h1l > dry) & (h1r > dry)
     with np.errstate(divide="ignore", invalid="ignore"):
         h1bar = 0.5 * (h1l + h1r)
