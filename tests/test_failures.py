@@ -113,11 +113,12 @@ def test_muscl_above_cfl_one_half_is_rejected():
 # --- grids and states -------------------------------------------------------------------
 
 @pytest.mark.parametrize("bad_grid, words", [
-    (CartesianGrid([[0, 1], [0, 1]], [4, 4]), "1D CartesianGrid"),
+    (CartesianGrid([[0, 1]] * 3, [4, 4, 4]), "1D or 2D CartesianGrid"),
+    (CartesianGrid([[0, 1], [0, 1]], [4, 4], periodic=[False, True]), "must not be periodic"),
     (PolarSymGrid((0.5, 1.0), 8), "must start at the axis"),
     (CartesianGrid([[0, 1]], 8, periodic=True), "must not be periodic"),
 ])
-def test_grid_that_is_not_1d_cartesian_is_rejected(bad_grid, words):
+def test_grid_the_models_do_not_run_on_is_rejected(bad_grid, words):
     eq = pdeflow.TwoLayerGranular()
     with pytest.raises(ValueError, match=words):
         eq.make_state(bad_grid, h2=np.ones(bad_grid.shape))
