@@ -131,8 +131,8 @@ class TwoLayerGranular(GranularPDE):
     State: ``FieldCollection`` of h1 [m], h1u1 [m^2/s], h2 [m], h2u2 [m^2/s] on a 1D
     ``CartesianGrid`` (or a ``PolarSymGrid``), or of h1, h1u1, h1v1, h2, h2u2, h2v2 on a
     2D ``CartesianGrid`` (x down the slope, y across); its cells are the finite volumes.
-    Integrate with
-    ``solver="fv-split"`` (the paper's scheme) or any py-pde solver (method of lines).
+    Integrate with ``solver="fv-split"`` (the paper's scheme) or any py-pde solver
+    (method of lines).
     """
 
     parameters_class = TwoLayerParameters
