@@ -138,28 +138,24 @@ class EquationSystem:
     @property
     def field_names(self) -> tuple[str, ...]:
         """Labels of the state's fields, in order: depth, discharge of each layer."""
-        return tuple(n for layer in self.layers for n in (layer.depth, layer.discharge))
+        return self.field_names_on(1)
 
     @property
     def profile_names(self) -> tuple[str, ...]:
         """Names of the depth and velocity profiles (``make_state``, ``--final`` files)."""
-        return tuple(n for layer in self.layers for n in (layer.depth, layer.velocity))
+        return self.profile_names_on(1)
 
     def field_names_on(self, axes: int) -> tuple[str, ...]:
         """:attr:`field_names` on a grid of ``axes`` axes (2: each layer's depth,
-        discharge along x and across)."""
-        if axes == 1:
-            return self.field_names
+        discharge along x and :attr:`Layer.discharge_y`)."""
         return tuple(n for layer in self.layers
-                     for n in (layer.depth, layer.discharge, layer.discharge_y))
+                     for n in (layer.depth, layer.discharge, layer.discharge_y)[:1 + axes])
 
     def profile_names_on(self, axes: int) -> tuple[str, ...]:
-        """:attr:`profile_names` on a grid of ``axes`` axes (2: each layer's depth and
-        velocities along x and across)."""
-        if axes == 1:
-            return self.profile_names
+        """:attr:`profile_names` on a grid of ``axes`` axes (2: each layer's depth,
+        velocity along x and :attr:`Layer.velocity_y`)."""
         return tuple(n for layer in self.layers
-                     for n in (layer.depth, layer.velocity, layer.velocity_y))
+                     for n in (layer.depth, layer.velocity, layer.velocity_y)[:1 + axes])
 
     @property
     def summary_keys(self) -> tuple[str, ...]:
