@@ -266,8 +266,8 @@ class DamBreakPage:
         for f, name in ((fh, "depths"), (fu, "velocities"), (ff, "fextra")):
             f.css_classes = [f"pdeflow-{name}"]  # for the browser tests
         self.fig_h, self.fig_u, self.fig_f = fh, fu, ff
-        # an axisymmetric run seen from above: built by the first such run
-        self.plan = PlanView()
+        # an axisymmetric run seen from above, hidden while the runs are planar
+        self.plan = PlanView(self.present)
 
     # --- running --------------------------------------------------------------------------
     def rerun(self) -> None:
