@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from pde import FieldCollection
 
-from . import systems
+from . import metrics_2d, systems
 from .cases import Case
 from .checks import (
     RunWarning,
@@ -52,6 +52,7 @@ from .solvers.diagnostics import SplitDiagnostics
 from .solvers.fv_split import SimulationBlowUp, split_stepper
 from .summary_2d import summarize_2d
 from .trackers import FextraStorageTracker
+from .trackers.peaks import PeakSpeedTracker
 from .trackers.series import SeriesTracker
 from .variant import Variant
 
@@ -269,8 +270,6 @@ def peak_tracker(case: Case, pde: GranularPDE) -> Any:
     every t_end / :data:`PEAK_SAMPLES`), None for a 1D run (no such number)."""
     if not case.is_2d:
         return None
-    from .trackers.peaks import PeakSpeedTracker
-
     return PeakSpeedTracker(case.t_end / PEAK_SAMPLES, pde.parameters.dry_tolerance)
 
 
@@ -279,8 +278,6 @@ def initial_mass(case: Case, pde: GranularPDE, data: np.ndarray, metric: Metric)
     [m^2] on a planar grid, [m^3] on an axisymmetric or 2D one."""
     densities = pde.system.densities(pde.parameters)
     if case.is_2d:
-        from . import metrics_2d
-
         return metrics_2d.mass(data, densities, case.dx * case.dy)
     return mass(data, metric.cells, densities)
 
