@@ -25,7 +25,7 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
                 "bed_thickness": (float, int), "bed_length": (float, int),
                 # the 2D shapes (pdeflow.initial_shapes_2d)
                 "x0": (float, int), "y0": (float, int), "radius": (float, int),
-                "semi_x": (float, int), "semi_y": (float, int)},
+                "semi_x": (float, int), "semi_y": (float, int), "vertices": (list,)},
     "numerics": {"solver": (str,), "cfl": (float, int), "dt": (float, int),
                  "flux": (str,), "reconstruction": (str,), "limiter": (str,),
                  "splitting": (str,)},

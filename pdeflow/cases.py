@@ -19,7 +19,7 @@ names the key and the file. Sections (all optional except ``[initial]``)::
     [sweep]       aspect_ratios = [a, ...] (H0 = a L0; see pdeflow.analysis.sweep)
 
 Initial shapes (x measured from the left end of the domain; the 2D shapes cylinder,
-elliptic_column, cap and box are those of :mod:`pdeflow.initial_shapes_2d`):
+elliptic_column, cap, box and polygon are those of :mod:`pdeflow.initial_shapes_2d`):
 
 * ``column``: a column of length L0 [m] and height H0 [m] against the left end. For
   two layers the lower layer is the wedge h2 = min(H0, (L0 - x) tan(alpha)) under the

@@ -11,12 +11,16 @@ its normalised radius about the centre (a, b its semi-axes [m]):
 * ``elliptic_column``: h = H0 where rho < 1, a = ``semi_x``, b = ``semi_y``;
 * ``cap``: the paraboloid h = H0 max(1 - rho^2, 0), a = b = ``radius`` or a =
   ``semi_x``, b = ``semi_y`` (the shape of the Savage-Hutter similarity solution);
-* ``box``: h = H0 where |x - x0| < ``semi_x`` and |y - y0| < ``semi_y`` (half-sides).
+* ``box``: h = H0 where |x - x0| < ``semi_x`` and |y - y0| < ``semi_y`` (half-sides);
+* ``polygon``: h = H0 inside the polygon ``vertices`` = [[x, y], ...] [m] (at least 3,
+  in order, either sense; the even-odd rule, so a self-crossing outline has holes); its
+  centre (x0, y0) is the area centroid, not a key.
 
 A cell is inside where its centre is (strict inequalities, as the 1D column's
 x < L0). The part of a shape beyond a side of the domain is cut off: a wall through its
 centre is a symmetry plane, so a quarter of a cylinder at a corner with two walls is
-the whole collapse on a quarter of the cells. The centre must lie in the domain.
+the whole collapse on a quarter of the cells. The centre (a polygon: every vertex) must
+lie in the domain.
 
 For two layers every 2D shape is split like the 1D ``dam_break`` and ``heap``: the
 fraction ``upper_fraction`` (default 0.5) of the depth in the upper layer, the rest in
@@ -38,10 +42,12 @@ REQUIRED_2D: dict[str, tuple[str, ...]] = {
     "elliptic_column": ("x0", "y0", "semi_x", "semi_y", "H0"),
     "cap": ("x0", "y0", "H0"),  # and radius, or semi_x and semi_y
     "box": ("x0", "y0", "semi_x", "semi_y", "H0"),
+    "polygon": ("vertices", "H0"),
 }
 """the keys of [initial] each 2D shape needs"""
 SHAPES_2D = tuple(REQUIRED_2D)
-KEYS_2D = ("shape", "x0", "y0", "radius", "semi_x", "semi_y", "H0", "upper_fraction")
+KEYS_2D = ("shape", "x0", "y0", "radius", "semi_x", "semi_y", "vertices", "H0",
+           "upper_fraction")
 """the keys of [initial] a 2D shape may have; the others are the 1D shapes'"""
 
 
@@ -65,6 +71,12 @@ def check_initial_2d(initial: dict[str, Any], length: float, width: float) -> No
     for key in REQUIRED_2D[shape]:
         if key not in initial:
             raise ValueError(f"initial.{key} is required for shape {shape!r}")
+    if shape == "polygon":
+        _check_polygon(initial, length, width)
+        return
+    if "vertices" in initial:
+        raise ValueError(f"initial.vertices is not a key of shape {shape!r} (only of "
+                         "'polygon')")
     _check_axes(initial, shape)
     for key in ("radius", "semi_x", "semi_y", "H0"):
         if key in initial:
@@ -77,6 +89,52 @@ def check_initial_2d(initial: dict[str, Any], length: float, width: float) -> No
             raise ValueError(f"initial.{key} = {initial[key]:g} m puts the centre outside "
                              f"the domain: it must lie in [0, {size:g}] m (from the "
                              f"domain's corner; {side} = {size:g} m)")
+
+
+def _check_polygon(initial: dict[str, Any], length: float, width: float) -> None:
+    """A polygon: H0 > 0, >= 3 vertices [x, y] of finite numbers inside the domain of
+    ``length`` x ``width`` [m], a non-zero area, none of the other shapes' keys."""
+    for key in ("x0", "y0", "radius", "semi_x", "semi_y"):
+        if key in initial:
+            raise ValueError(f"initial.{key} is not a key of shape 'polygon' (its "
+                             "vertices give it; its centre is their area centroid)")
+    check_range("initial.H0", initial["H0"], 0, math.inf, low_open=True, unit="m")
+    if "upper_fraction" in initial:
+        check_range("initial.upper_fraction", initial["upper_fraction"], 0, 1)
+    vertices = initial["vertices"]
+    if len(vertices) < 3 or not all(
+            isinstance(v, list) and len(v) == 2
+            and all(isinstance(c, (int, float)) and not isinstance(c, bool)
+                    and math.isfinite(c) for c in v) for v in vertices):
+        raise ValueError("initial.vertices must be a list of at least 3 points [x, y] "
+                         f"of finite numbers [m], got {vertices!r}")
+    for x, y in vertices:
+        if not (0.0 <= x <= length and 0.0 <= y <= width):
+            raise ValueError(f"initial.vertices: the vertex [{x:g}, {y:g}] lies outside "
+                             f"the domain: each must lie in [0, {length:g}] x "
+                             f"[0, {width:g}] m (from the domain's corner)")
+    if _polygon_area(np.array(vertices, dtype=float)) == 0.0:
+        raise ValueError("initial.vertices enclose no area (the points lie on a line)")
+
+
+def _polygon_area(p: np.ndarray) -> float:
+    """The signed area [m^2] of the polygon with the vertices ``p`` (n, 2) (shoelace)."""
+    x, y = p[:, 0], p[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+def inside_polygon(vertices: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Whether the points ``x``, ``y`` [m] lie inside the polygon ``vertices`` (n, 2)
+    [m], by the even-odd rule: a ray from the point towards +x crosses the outline an
+    odd number of times (each edge counts where it spans the point's y half-open,
+    so a ray through a vertex counts once)."""
+    inside = np.zeros(np.shape(x), dtype=bool)
+    for (xi, yi), (xj, yj) in zip(vertices, np.roll(vertices, -1, axis=0), strict=True):
+        spans = (yi > y) != (yj > y)
+        with np.errstate(divide="ignore", invalid="ignore"):  # horizontal edges: no span
+            crossing = x < xi + (xj - xi) * (y - yi) / (yj - yi)
+        inside ^= spans & crossing
+    return inside
 
 
 def _check_axes(initial: dict[str, Any], shape: str) -> None:
@@ -103,7 +161,11 @@ def total_depth_2d(initial: dict[str, Any], x: np.ndarray, y: np.ndarray) -> np.
     ``y`` [m from the domain's corner; arrays of the grid's shape] (formulas in the
     module docstring)."""
     shape = initial["shape"]
-    x0, y0, H0 = float(initial["x0"]), float(initial["y0"]), float(initial["H0"])
+    H0 = float(initial["H0"])
+    if shape == "polygon":
+        return np.where(inside_polygon(np.array(initial["vertices"], dtype=float), x, y),
+                        H0, 0.0)
+    x0, y0 = float(initial["x0"]), float(initial["y0"])
     a, b = semi_axes(initial)
     if shape == "box":
         return np.where((np.abs(x - x0) < a) & (np.abs(y - y0) < b), H0, 0.0)
@@ -117,6 +179,22 @@ def total_depth_2d(initial: dict[str, Any], x: np.ndarray, y: np.ndarray) -> np.
 
 
 def release_front(initial: dict[str, Any]) -> float:
-    """The release's largest x [m from the domain's corner]: x0 + a, from which the
-    run-out along x is measured (as the 1D run-out from the column's front L0)."""
+    """The release's largest x [m from the domain's corner]: x0 + a (a polygon: its
+    largest vertex x), from which the run-out along x is measured (as the 1D run-out
+    from the column's front L0)."""
+    if initial["shape"] == "polygon":
+        return float(max(x for x, _ in initial["vertices"]))
     return float(initial["x0"]) + semi_axes(initial)[0]
+
+
+def release_centre(initial: dict[str, Any]) -> tuple[float, float]:
+    """The release's centre (x0, y0) [m from the domain's corner], about which the
+    summary's mass radius is measured: the keys, or a polygon's area centroid."""
+    if initial["shape"] != "polygon":
+        return float(initial["x0"]), float(initial["y0"])
+    p = np.array(initial["vertices"], dtype=float)
+    q = np.roll(p, -1, axis=0)
+    cross = p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]  # twice each edge's triangle's area
+    area = 0.5 * cross.sum()
+    cx, cy = ((p + q) * cross[:, None]).sum(axis=0) / (6.0 * area)
+    return float(cx), float(cy)

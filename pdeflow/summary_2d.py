@@ -28,7 +28,7 @@ import numpy as np
 
 from . import metrics_2d as m2
 from .checks import MASS_WARN, result_warnings
-from .initial_shapes_2d import release_front
+from .initial_shapes_2d import release_centre, release_front
 
 SIDES_2D = ("left", "right", "y_low", "y_high")
 """the sides of a 2D domain: x low and high, y low and high"""
@@ -56,8 +56,8 @@ def summarize_2d(res: Any, mass0: float, wall: float, peak_speed: float,
     depth = m2.total_depth(d)
     thr = case.front_threshold
     front = m2.front_x(x, depth, thr, case.dx)
-    x0 = case.x_start + float(case.initial["x0"])
-    y0 = case.y_start + float(case.initial["y0"])
+    x0, y0 = release_centre(case.initial)
+    x0, y0 = case.x_start + x0, case.y_start + y0
     X, Y = np.meshgrid(x, y, indexing="ij")
     weights = res.pde.system.densities(params)
     mass1 = m2.mass(d, weights, area)
@@ -96,6 +96,13 @@ def summarize_2d(res: Any, mass0: float, wall: float, peak_speed: float,
     return out
 
 
+def lateral_cut(summary: dict[str, Any]) -> bool:
+    """Whether the 2D run of ``summary`` reached a side across (y_low, y_high) that was
+    clear at the start: its lateral spread is then a lower bound."""
+    sides = (summary.get("domain_ends") or {}).get("sides", [])
+    return "y_low" in sides or "y_high" in sides
+
+
 def _domain_ends(case: Any, initial: np.ndarray, depth: np.ndarray,
                  mass_change: float) -> dict[str, Any]:
     """The 2D ``domain_ends`` (the 1D table's keys, so that the printed table reads it
@@ -121,7 +128,10 @@ def _side_warnings(case: Any, model: str, summary: dict[str, Any]) -> list[str]:
         return []
     left = (f", and {100 * ends['outflow']:.2g} % of the mass left the domain"
             if ends["outflow"] > MASS_WARN else "")
-    bound = (": the front and the run-out are lower bounds, lengthen the domain "
-             "(grid.length)" if ends["runout_lower_bound"] else "")
+    bounds = [what for what, cut in (
+        ("the front and the run-out (grid.length)", ends["runout_lower_bound"]),
+        ("the lateral spread (grid.width)", lateral_cut(summary))) if cut]
+    bound = (f": {' and '.join(bounds)} are lower bounds, enlarge the domain"
+             if bounds else "")
     return [f"{case.name}, {model}: material reached the side(s) "
             f"{', '.join(ends['sides'])}{left}{bound}"]

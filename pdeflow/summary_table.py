@@ -9,6 +9,7 @@ from typing import Any
 
 from .checks import mass_through_ends
 from .simulate import summary_unit
+from .summary_2d import lateral_cut
 
 
 def _fmt(v: Any, unit: str = "") -> str:
@@ -89,5 +90,7 @@ def _cell(model_summary: dict[str, Any], key: str, unit: str) -> str:
     text = _fmt(model_summary.get(key), unit)
     if key in ("front_position", "runout", "front_mass_quantile", "runout_mass_quantile") \
             and model_summary.get("runout_lower_bound"):
+        return ">= " + text
+    if key == "lateral_spread" and lateral_cut(model_summary):
         return ">= " + text
     return text

@@ -89,6 +89,20 @@ def test_each_2d_shape_holds_its_volume(shape, keys, volume):
     assert abs(h.sum() / n ** 2 / volume - 1) < 0.01
 
 
+@pytest.mark.filterwarnings("ignore:.*reached the side")  # a small box, on purpose
+def test_a_polygon_is_the_box_it_outlines_and_centred_at_its_centroid():
+    box = Case.from_dict({**_case(), "initial": {"shape": "box", "x0": 0.5, "y0": 0.5,
+                                                 "semi_x": 0.3, "semi_y": 0.2, "H0": 0.2}})
+    polygon = {"shape": "polygon", "H0": 0.2,
+               "vertices": [[0.2, 0.3], [0.8, 0.3], [0.8, 0.7], [0.2, 0.7]]}
+    poly = Case.from_dict({**_case(), "initial": polygon})
+    np.testing.assert_array_equal(poly.make_state("single_layer")[1].data,
+                                  box.make_state("single_layer")[1].data)
+    s = run_model(poly, "single_layer").summary
+    assert s["mass_radius"] == run_model(box, "single_layer").summary["mass_radius"]
+    assert s["runout"] == pytest.approx(s["front_position"] - 0.8)
+
+
 # --- the run, the table and the metrics ----------------------------------------------------
 
 def test_the_cli_table_is_the_2d_metrics_of_the_same_run(tmp_path, capsys):
@@ -152,6 +166,22 @@ def test_the_default_run_folder_of_a_2d_case_holds_its_summary_only(tmp_path, ca
     assert len(folders) == 1 and [p.name for p in folders[0].iterdir()] == ["summary.json"]
 
 
+def test_material_through_open_sides_is_outflow_and_bounds_the_extents(capsys, tmp_path):
+    """The cylinder in a 2 m box whose high sides are open: what leaves is the table's
+    'mass outflow', not a mass error; the front and the spread are lower bounds."""
+    small = [f"--set={s}" for s in ("case.models=['single_layer']", "grid.length=2",
+                                    "grid.width=2", "grid.x_start=-1", "grid.y_start=-1",
+                                    "initial.x0=1", "initial.y0=1", "boundaries.right=open",
+                                    "boundaries.y_high=open")]
+    assert main(["run", str(CYLINDER), *small, "--summary", str(tmp_path / "s.json")]) == 0
+    captured = capsys.readouterr()
+    rows = {line[:18].strip(): line[18:].strip() for line in captured.out.splitlines()}
+    assert rows["mass error"] == "-" and rows["mass outflow"].endswith("%")
+    assert rows["front (x)"].startswith(">= ") and rows["lateral spread"] == ">= 2 m"
+    assert "material reached the side(s) left, right, y_low, y_high" in captured.err
+    assert "the lateral spread (grid.width) are lower bounds" in captured.err
+
+
 def test_the_slope_case_runs_down_x(tmp_path):
     case = load_case(SLOPE)
     for name in case.models:
@@ -174,6 +204,9 @@ def test_the_slope_case_runs_down_x(tmp_path):
     (["initial.shape='column'"], ["initial.shape 'column' is a 1D shape", "cylinder"]),
     (["initial.semi_x=0.5"], ["semi_x", "elliptic_column"]),
     (["initial.radius=0.01"], ["covers no cell centre"]),
+    (["initial.shape='polygon'", "initial.vertices=[[1, 1], [2, 2], [3, 3]]"],
+     ["initial.x0 is not a key of shape 'polygon'"]),
+
     (["output.snapshot_times=[0.1]"], ["output.snapshot_times", "1D only"]),
     (["numerics.solver='euler'"], ["numerics.solver", "1D only", "fv-split"]),
     (["grid.dx=1e-4", "grid.length=1000", "grid.width=1000"],
@@ -184,6 +217,20 @@ def test_bad_2d_input_is_one_line(sets, words, capsys, tmp_path):
     assert main(["run", str(CYLINDER), *args, "--summary", str(tmp_path / "s.json")]) == 2
     _one_line_error(capsys, "cylinder_2d.toml", *words)
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("vertices, words", [
+    ("[[1, 1], [2, 2], [3, 3]]", ["enclose no area"]),
+    ("[[1, 1], [2, 2]]", ["at least 3 points"]),
+    ("[[1, 1], [5, 2], [3, 3]]", ["vertex [5, 2] lies outside the domain", "[0, 4] x [0, 4]"]),
+    ("[[1, 1], [2, 'a'], [3, 3]]", ["at least 3 points [x, y] of finite numbers"]),
+])
+def test_bad_polygons_are_one_line(vertices, words, tmp_path, capsys):
+    case = tmp_path / "poly.toml"
+    text = CYLINDER.read_text().split("[initial]")[0]
+    case.write_text(text + f'[initial]\nshape = "polygon"\nH0 = 0.2\nvertices = {vertices}\n')
+    assert main(["run", str(case)]) == 2
+    _one_line_error(capsys, "poly.toml", *words)
 
 
 @pytest.mark.parametrize("key", ["grid.dy=0.1", "boundaries.y_low='open'",
