@@ -54,7 +54,9 @@ def _check_2d(case: Any) -> None:
         if "cells_y" in grid and grid["cells_y"] < 1:
             raise ValueError(f"grid.cells_y must be an integer >= 1, got "
                              f"{grid['cells_y']!r}")
-        check_range("grid.dy", case.dy, 0, case.width, low_open=True, unit="m")
+        given = "dy" in grid or "cells_y" in grid
+        check_range("grid.dy" if given else "grid.dy (by default grid.dx)", case.dy, 0,
+                    case.width, low_open=True, unit="m")
         if "cells_y" not in grid:
             n = case.width / case.dy
             if abs(n - round(n)) > 1e-9 * n:

@@ -73,6 +73,20 @@ def test_dy_and_the_boundaries_across_are_read():
     assert Case.from_dict(_case(grid={"cells_y": 5})).make_grid().shape == (40, 5)
 
 
+def test_the_size_estimate_counts_the_cells_and_steps_of_both_axes():
+    """A 2D case costs its nx ny cells, 1.5 times a 1D cell's memory (a third row per
+    layer) and the steps of the CFL over both axes: twice the 1D steps at dy = dx."""
+    from pdeflow.checks import run_cost
+
+    two_d = Case.from_dict(_case())
+    one_d = Case.from_dict({**_case(), "grid": {"length": 2.0, "dx": 0.05},
+                            "initial": {"shape": "column", "L0": 0.2, "H0": 0.2}})
+    c2, c1 = run_cost(two_d, "single_layer"), run_cost(one_d, "single_layer")
+    assert c2.cells == 40 * 20 and c1.cells == 40
+    assert c2.steps == pytest.approx(2 * c1.steps)
+    assert c2.memory_bytes == pytest.approx(1.5 * 20 * c1.memory_bytes)
+
+
 @pytest.mark.parametrize("shape, keys, volume", [
     ("cylinder", {"radius": 0.3}, math.pi * 0.3 ** 2 * 0.2),
     ("elliptic_column", {"semi_x": 0.4, "semi_y": 0.2}, math.pi * 0.4 * 0.2 * 0.2),
@@ -197,6 +211,7 @@ def test_the_slope_case_runs_down_x(tmp_path):
     (["grid.width=-1"], ["grid.width", "(0, inf"]),
     (["grid.dy=0.3"], ["grid.dy", "does not divide grid.width"]),
     (["grid.cells_y=0"], ["grid.cells_y", ">= 1"]),
+    (["grid.width=0.01"], ["grid.dy (by default grid.dx) must lie in (0, 0.01] m"]),
     (["boundaries.y_low='mirror'"], ["boundaries.y_low", "wall"]),
     (["initial.x0=9"], ["initial.x0", "outside the domain", "[0, 4] m"]),
     (["initial.radius=0"], ["initial.radius", "(0, inf"]),
@@ -265,3 +280,13 @@ def test_a_study_over_a_2d_case_is_refused(tmp_path, capsys):
     assert main(["study", str(study), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "pdeflow study is 1D only for now (issue 36)" in err and err.count("\n") == 1
+
+
+def test_the_app_offers_1d_cases_only():
+    """The teaching app draws 1D runs: it does not list the 2D case files."""
+    pytest.importorskip("panel")
+    from pdeflow.app.controls import list_cases
+
+    listed = list_cases(ROOT / "cases")
+    assert "paper_5_1_dam_break.toml" in listed
+    assert not {"cylinder_2d.toml", "column_on_slope_2d.toml"} & set(listed)
