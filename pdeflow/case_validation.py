@@ -8,7 +8,9 @@ from typing import Any
 
 from . import systems
 from .case_schema import FRAMES, SCHEMA, SERIES, CaseError
+from .case_validation_2d import check_dimension, check_shape_2d
 from .initial_shapes import SHAPES, check_initial
+from .initial_shapes_2d import SHAPES_2D
 from .models.base import check_range
 from .numerics.layout import BOUNDARIES, GEOMETRIES
 from .variant import MAX_CFL, VariantError
@@ -47,6 +49,7 @@ def validate(case: Any) -> None:
                     low_open=True, unit="s")
     except ValueError as err:
         raise _err(case, str(err)) from None
+    check_dimension(case)  # a 2D grid's keys, or none of them (before the geometry's)
     _check_geometry(case)
     if case._get("output", "erosion_series", "auto") not in SERIES:
         raise _err(case, f"output.erosion_series must be one of {list(SERIES)}, got "
@@ -66,10 +69,14 @@ def validate(case: Any) -> None:
         case.variant  # noqa: B018 - checks solver, flux, reconstruction, limiter, ...
     except VariantError as err:
         raise _err(case, str(err)) from None
-    if case.initial["shape"] not in SHAPES:
-        raise _err(case, f"initial.shape must be one of {list(SHAPES)}, got "
+    shapes = SHAPES_2D if case.is_2d else SHAPES
+    if case.initial["shape"] not in shapes:
+        raise _err(case, f"initial.shape must be one of {list(shapes)}, got "
                         f"{case.initial['shape']!r}")
-    _check_initial(case)
+    if case.is_2d:
+        check_shape_2d(case)
+    else:
+        _check_initial(case)
     try:
         check_memory(case)
     except ValueError as err:

@@ -5,8 +5,9 @@ checked against the schema below; an unknown key or a wrong type is an error tha
 names the key and the file. Sections (all optional except ``[initial]``)::
 
     [case]        name, description, t_end [s], models = ["two_layer", "single_layer"]
-    [grid]        length [m], dx [m] (or cells), x_start [m]
-    [boundaries]  left, right = "wall" | "open"
+    [grid]        length [m], dx [m] (or cells), x_start [m]; a 2D grid: width [m],
+                  dy [m] (or cells_y), y_start [m]
+    [boundaries]  left, right = "wall" | "open"; on a 2D grid y_low, y_high too
     [initial]     shape = "column" | "column_on_bed" | "dam_break" | "heap" | "file"
                   and its keys
     [numerics]    solver = "fv-split" | any py-pde solver name, cfl, dt (py-pde solvers),
@@ -17,7 +18,8 @@ names the key and the file. Sections (all optional except ``[initial]``)::
     [output]      snapshot_times [s], front_threshold [m], runout_mass_fraction
     [sweep]       aspect_ratios = [a, ...] (H0 = a L0; see pdeflow.analysis.sweep)
 
-Initial shapes (x measured from the left end of the domain):
+Initial shapes (x measured from the left end of the domain; the 2D shapes cylinder,
+elliptic_column, cap, box and polygon are those of :mod:`pdeflow.initial_shapes_2d`):
 
 * ``column``: a column of length L0 [m] and height H0 [m] against the left end. For
   two layers the lower layer is the wedge h2 = min(H0, (L0 - x) tan(alpha)) under the
@@ -53,6 +55,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from . import systems
+from .case_2d import GridAcross
 from .case_schema import CaseError
 from .case_validation import validate as _validate
 from .initial_shapes import (
@@ -77,8 +80,9 @@ memory stays that of 200 states whatever t_end, and a flow of t_end / 4 still ge
 
 
 @dataclass
-class Case:
-    """A validated case: everything needed to set up and run the models."""
+class Case(GridAcross):
+    """A validated case: everything needed to set up and run the models (the y-axis of
+    a 2D grid: :class:`~pdeflow.case_2d.GridAcross`)."""
 
     data: dict[str, dict[str, Any]]
     source: str = "<dict>"
@@ -169,9 +173,15 @@ class Case:
         return max(1, round(self.length / self.dx))
 
     @property
-    def bc(self) -> tuple[str, str]:
+    def bc(self) -> tuple:
+        """(left, right) boundaries along x; on a 2D grid one pair per axis,
+        ((left, right), (y_low, y_high)), as the models take them."""
         b = self.data.get("boundaries", {})
-        return b.get("left", "wall"), b.get("right", "open")
+        along_x = (b.get("left", "wall"), b.get("right", "open"))
+        if not self.is_2d:
+            return along_x
+        # walls across by default: a channel's side walls, and nothing leaves unseen
+        return along_x, (b.get("y_low", "wall"), b.get("y_high", "wall"))
 
     @property
     def cfl(self) -> float:
@@ -275,12 +285,16 @@ class Case:
 
     # --- model set-up ---------------------------------------------------------------------
     def make_grid(self):
-        """py-pde's grid of the case: a ``CartesianGrid`` (planar) or a ``PolarSymGrid``
-        on [0, length] (axisymmetric)."""
+        """py-pde's grid of the case: a ``CartesianGrid`` (planar; 2D with
+        ``grid.width``) or a ``PolarSymGrid`` on [0, length] (axisymmetric)."""
         from pde import CartesianGrid, PolarSymGrid
 
         if self.geometry == "axisymmetric":
             return PolarSymGrid((0.0, self.length), self.cells)
+        if self.is_2d:
+            return CartesianGrid([[self.x_start, self.x_start + self.length],
+                                  [self.y_start, self.y_start + self.width]],
+                                 [self.cells, self.cells_y])
         return CartesianGrid([[self.x_start, self.x_start + self.length]], self.cells)
 
     def make_pde(self, model: str):
@@ -302,6 +316,8 @@ class Case:
         model's system splits the shape's total depth into its layers)."""
         system = systems.get(model)
         grid = grid or self.make_grid()
+        if self.is_2d:
+            return self._initial_profiles_2d(model, grid)
         x = grid.axes_coords[0] - self.x_start
         ini = self.initial
         if ini["shape"] == "file":

@@ -35,6 +35,7 @@ import numpy as np
 
 from . import systems
 from .initial_shapes import is_column
+from .initial_shapes_2d import SHAPES_2D
 from .metrics import total_depth
 from .numerics.geometry import COORDINATES
 
@@ -133,7 +134,7 @@ def max_initial_depth(case: Any) -> float:
     """Largest initial total depth [m], from the case's keys (from the file for 'file')."""
     ini = case.initial
     shape = ini.get("shape")
-    if is_column(ini):
+    if is_column(ini) or shape in SHAPES_2D:
         return float(ini["H0"])
     if shape == "dam_break":
         return max(float(ini["h_left"]), float(ini.get("h_right", 0.0)))
@@ -149,7 +150,9 @@ def memory_bytes(case: Any, model: str) -> float:
     rows = len(system.field_names)
     frames = len(case.snapshot_times) + case.series_frames  # snapshots, erosion series
     per_cell = system.bytes_per_cell + 8 * (rows + 1) * frames
-    return float(case.cells * per_cell)
+    if case.is_2d:  # a third row per layer (the discharge across): 1.5 times the 1D
+        per_cell = per_cell * 3 // 2
+    return float(case.total_cells * per_cell)
 
 
 def run_cost(case: Any, model: str | None = None) -> RunCost:
@@ -162,16 +165,18 @@ def run_cost(case: Any, model: str | None = None) -> RunCost:
     depth = max_initial_depth(case)
     if case.solver != "fv-split":  # py-pde's solvers step with numerics.dt to t_end
         steps = case.t_end / float(case.data.get("numerics", {}).get("dt", 1e-4))
-        return RunCost(case.cells, memory_bytes(case, model), steps,
-                       case.t_end, steps * case.cells)
+        return RunCost(case.total_cells, memory_bytes(case, model), steps,
+                       case.t_end, steps * case.total_cells)
     duration = case.t_end
     if stops_by_friction(params):
         slope = 1 - math.tan(theta) / math.tan(math.radians(params.phi_b_deg))
         duration = min(duration, REST_TIME_FACTOR * math.sqrt(depth / gz) / slope)
     speed = 2 * math.sqrt(gz * depth) + abs(gx) * duration
-    steps = duration * speed / (case.cfl * case.dx)
-    return RunCost(case.cells, memory_bytes(case, model), steps, duration,
-                   steps * case.cells)
+    # the CFL step of a 2D grid is cfl / (s/dx + s/dy)
+    inverse_widths = 1 / case.dx + (1 / case.dy if case.is_2d else 0.0)
+    steps = duration * speed * inverse_widths / case.cfl
+    return RunCost(case.total_cells, memory_bytes(case, model), steps, duration,
+                   steps * case.total_cells)
 
 
 def stops_by_friction(params: Any) -> bool:
@@ -194,11 +199,14 @@ def check_memory(case: Any) -> None:
     need = max(memory_bytes(case, m) for m in case.models)
     if have is None or need <= have:
         return
-    cells_max = int(case.cells * have / need)
+    cells_max = int(case.total_cells * have / need)
+    # the cells scale as dx^-1 in 1D, as dx^-2 in 2D (dy with dx)
+    dx_min = case.dx * (need / have) ** 0.5 if case.is_2d else case.length / cells_max
+    across = " and grid.dy" if case.is_2d else ""
     raise ValueError(
-        f"the grid has {case.cells:,} cells, which need about {_bytes(need)} of memory, "
-        f"more than this machine has ({_bytes(have)}): use at most about {cells_max:,} "
-        f"cells (grid.dx >= {case.length / cells_max:.3g} m)")
+        f"the grid has {case.total_cells:,} cells, which need about {_bytes(need)} of "
+        f"memory, more than this machine has ({_bytes(have)}): use at most about "
+        f"{cells_max:,} cells (grid.dx{across} >= {dx_min:.3g} m)")
 
 
 def cost_warning(case: Any, model: str) -> str | None:

@@ -20,8 +20,10 @@ RUN_HELP = """Run every model listed in the case file (case.models) to rest or t
 
 Without output options the summary and all figures go to results/<case name>/ (the
 case as written) or results/<case name>--<overrides>/ (with --set); a run replaces
-its folder as a whole. Every output is complete or absent: a failed or interrupted
-run writes nothing (Ctrl-C while the results are written lets them finish).
+its folder as a whole. A 2D case (grid.width) writes its summary there and no
+figures; --plot, --live, --movie, --frames and --store are 1D only for now.
+Every output is complete or absent: a failed or interrupted run writes nothing
+(Ctrl-C while the results are written lets them finish).
 For cases with several models, per-model outputs (--final, --store, --movie) go to
 the given name for the first model and to NAME.<model>.SUFFIX for the others.
 
@@ -155,6 +157,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .sizecheck import check_size
 
     case = _load_run_case(args)
+    if case.is_2d:
+        _refuse_1d_options(args, case)
     for name in ("live_every", "store_every", "fps"):
         positive(f"--{name.replace('_', '-')}", getattr(args, name))
     default_out = not (args.summary or args.final or args.plot or args.outdir
@@ -165,7 +169,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     check_size(case, args.force, "use a coarser grid (--set grid.dx=...)")
     live_window = _live_window(args)
     figures = None
-    if args.plot or outdir:
+    if (args.plot or outdir) and not case.is_2d:  # a 2D run's folder: its summary only
         from .figure_worker import RunFigures
 
         figures = RunFigures(here=bool(args.live or args.movie or args.frames))
@@ -178,6 +182,20 @@ def cmd_run(args: argparse.Namespace) -> int:
     finally:
         if figures is not None:
             figures.close()
+
+
+ONE_D_OPTIONS = ("plot", "live", "movie", "frames", "store", "store_every", "live_every")
+"""the options of ``pdeflow run`` that draw or store 1D frames: refused for a 2D case"""
+
+
+def _refuse_1d_options(args: argparse.Namespace, case: Any) -> None:
+    """One line (a CaseError) before any work if ``args`` ask a 2D case for an output
+    that is 1D only for now (:data:`ONE_D_OPTIONS`)."""
+    from .case_validation_2d import require_1d
+
+    for name in ONE_D_OPTIONS:
+        if getattr(args, name):
+            require_1d(case, f"--{name.replace('_', '-')}")
 
 
 def _run_and_write(args: argparse.Namespace, case: Any, outputs: Any, figures: Any,
@@ -235,7 +253,8 @@ def _add_run(sub: Any) -> None:
     out = run.add_argument_group("result files")
     out.add_argument("--summary", metavar="OUT.json", help="write the JSON summary here")
     out.add_argument("--final", metavar="OUT.npz",
-                     help="write the final state (x, h1, u1, h2, u2 or x, h, u, and t); "
+                     help="write the final state (x, h1, u1, h2, u2 or x, h, u, and t; "
+                     "a 2D case also y and v1, v2 or v, arrays (nx, ny)); "
                      "further models go to OUT.<model>.npz")
     out.add_argument("--plot", metavar="OUT.png", help="write the final-deposit figure")
     out.add_argument("--outdir", metavar="DIR",

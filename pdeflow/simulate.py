@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from pde import FieldCollection
 
-from . import systems
+from . import metrics_2d, systems
 from .cases import Case
 from .checks import (
     RunWarning,
@@ -50,7 +50,9 @@ from .numerics.state import velocity_profile
 from .numerics.warmup import prepare
 from .solvers.diagnostics import SplitDiagnostics
 from .solvers.fv_split import SimulationBlowUp, split_stepper
+from .summary_2d import summarize_2d
 from .trackers import FextraStorageTracker
+from .trackers.peaks import PeakSpeedTracker
 from .trackers.series import SeriesTracker
 from .variant import Variant
 
@@ -89,8 +91,25 @@ class RunResult:
             return np.zeros(self.x.size)
         return self.diagnostics.cells.copy()
 
+    def _final_arrays_2d(self) -> dict[str, np.ndarray]:
+        """The final state of a 2D run: x [m] (nx), y [m] (ny), t [s], and each layer's
+        depth [m] and velocities along x and y [m/s] of shape (nx, ny)."""
+        x, y = self.state.grid.axes_coords
+        out = {"x": x, "y": y, "t": np.float64(self.t_final)}
+        d = self.state.data
+        dry = self.pde.parameters.dry_tolerance
+        for k, layer in enumerate(self.pde.system.layers):
+            h = d[3 * k]  # depth, discharge along x, discharge along y
+            out[layer.depth] = h.copy()
+            out[layer.velocity] = velocity_profile(h, d[3 * k + 1], dry)
+            out[layer.velocity_y] = velocity_profile(h, d[3 * k + 2], dry)
+        return out
+
     def final_arrays(self) -> dict[str, np.ndarray]:
-        """x, depths and velocities of the final state (keys as in the ``--final`` npz)."""
+        """x, depths and velocities of the final state (keys as in the ``--final`` npz;
+        a 2D run's: :meth:`_final_arrays_2d`)."""
+        if self.case.is_2d:
+            return self._final_arrays_2d()
         out = {"x": self.x, "t": np.float64(self.t_final)}
         d = self.state.data
         dry = self.pde.parameters.dry_tolerance
@@ -174,10 +193,12 @@ class Run:
                         cost_warning(case, model)):
             if message:
                 warnings.warn(message, RunWarning, stacklevel=2)
-        mass0 = mass(self.state.data, self.metric.cells,
-                     self.pde.system.densities(self.pde.parameters))
+        mass0 = initial_mass(self.case, self.pde, self.state.data, self.metric)
         snaps = FextraStorageTracker(sorted(case.snapshot_times))
         trackers: list[Any] = [snaps] if case.snapshot_times else []
+        peaks = peak_tracker(case, self.pde)
+        if peaks is not None:
+            trackers.append(peaks)
         series = (SeriesTracker(case.series_every, self.pde.system.diagnostics)
                   if case.erosion_series else None)
         if series is not None:
@@ -231,10 +252,34 @@ class Run:
         if series is not None:
             result.frames = series.frames
             result.series = run_series(result, series)
-        result.summary = summarize(result, mass0, wall, self.state.data)
+        result.summary = (summarize(result, mass0, wall, self.state.data) if peaks is None
+                          else summarize_2d(result, mass0, wall, peaks.peak,
+                                            self.state.data))
         for message in result.summary["warnings"]:
             warnings.warn(message, RunWarning, stacklevel=2)
         return result
+
+
+PEAK_SAMPLES = 200
+"""states a 2D run's largest speed is sampled from (every t_end / this, as the erosion
+series' frames: the peak of a collapse lasts longer than t_end / 200)"""
+
+
+def peak_tracker(case: Case, pde: GranularPDE) -> Any:
+    """The tracker of a 2D run's largest speed (its summary's ``max_speed``, sampled
+    every t_end / :data:`PEAK_SAMPLES`), None for a 1D run (no such number)."""
+    if not case.is_2d:
+        return None
+    return PeakSpeedTracker(case.t_end / PEAK_SAMPLES, pde.parameters.dry_tolerance)
+
+
+def initial_mass(case: Case, pde: GranularPDE, data: np.ndarray, metric: Metric) -> float:
+    """The mass of the state ``data`` over the densest layer's density: per unit width
+    [m^2] on a planar grid, [m^3] on an axisymmetric or 2D one."""
+    densities = pde.system.densities(pde.parameters)
+    if case.is_2d:
+        return metrics_2d.mass(data, densities, case.dx * case.dy)
+    return mass(data, metric.cells, densities)
 
 
 def run_series(res: RunResult, tracker: SeriesTracker) -> ErosionSeries:
@@ -281,7 +326,8 @@ def summary_keys(model: str, series: bool = False) -> tuple[str, ...]:
 
 
 _LENGTH_KEYS = ("front_position", "runout", "front_mass_quantile", "runout_mass_quantile",
-                "max_fextra_x", "bed_max_erosion_x", "bed_max_erosion_depth")
+                "max_fextra_x", "bed_max_erosion_x", "bed_max_erosion_depth",
+                "lateral_spread", "mass_radius", "max_depth")
 
 
 def summary_unit(key: str, geometry: str | None = None) -> str | None:
@@ -295,8 +341,10 @@ def summary_unit(key: str, geometry: str | None = None) -> str | None:
     if key in _LENGTH_KEYS:
         return "m"
     if "_volume" in key:
-        return {"planar": "m^2", "axisymmetric": "m^3"}.get(geometry or "", "m^2 or m^3")
-    units = {"max_fextra_over_rho1": "m^2/s^2", "front_velocity_max": "m/s"}
+        return {"planar": "m^2", "axisymmetric": "m^3", "planar-2d": "m^3"}.get(
+            geometry or "", "m^2 or m^3")
+    units = {"max_fextra_over_rho1": "m^2/s^2", "front_velocity_max": "m/s",
+             "max_speed": "m/s", "deposit_area": "m^2"}
     if key in units:
         return units[key]
     if key in ("steps", "mass_relative_error", "mass_change", "runout_mass_fraction",

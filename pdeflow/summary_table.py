@@ -9,6 +9,7 @@ from typing import Any
 
 from .checks import mass_through_ends
 from .simulate import summary_unit
+from .summary_2d import lateral_cut
 
 
 def _fmt(v: Any, unit: str = "") -> str:
@@ -23,6 +24,9 @@ ROWS = (("stop time", "stop_time"), ("lower stop", "lower_stop_time"),
         ("upper stop", "upper_stop_time"), ("front", "front_position"),
         ("run-out", "runout"), ("front {q} mass", "front_mass_quantile"),
         ("run-out {q} mass", "runout_mass_quantile"),
+        ("lateral spread", "lateral_spread"), ("deposit area", "deposit_area"),
+        ("radius {q} mass", "mass_radius"), ("deepest cell", "max_depth"),
+        ("max speed", "max_speed"),
         ("max F_extra/rho1", "max_fextra_over_rho1"), ("flow duration", "flow_duration"),
         ("front speed max", "front_velocity_max"), ("bed eroded", "bed_eroded_volume"),
         ("bed eroded max", "bed_eroded_volume_max"),
@@ -46,8 +50,13 @@ def print_summary(summary: dict[str, Any], out: Any = None) -> None:
     out = out or sys.stdout
     models = summary["models"]
     axisymmetric = any(s.get("geometry") == "axisymmetric" for s in models.values())
-    geometry = "axisymmetric" if axisymmetric else "planar"
+    two_d = any(s.get("geometry") == "planar-2d" for s in models.values())
+    geometry = "axisymmetric" if axisymmetric else "planar-2d" if two_d else "planar"
     rows = [(label, k, cell_unit(k, geometry)) for label, k in ROWS]
+    if two_d:
+        # the front and the run-out are along x (down the slope); the spread is across
+        rows = [(label + " (x)" if k in ("front_position", "runout") else label, k, u)
+                for label, k, u in rows]
     if axisymmetric:
         # the front and the run-out are radii: R_f and R_f - R0
         rows = [("front radius" if k == "front_position" else
@@ -81,5 +90,7 @@ def _cell(model_summary: dict[str, Any], key: str, unit: str) -> str:
     text = _fmt(model_summary.get(key), unit)
     if key in ("front_position", "runout", "front_mass_quantile", "runout_mass_quantile") \
             and model_summary.get("runout_lower_bound"):
+        return ">= " + text
+    if key == "lateral_spread" and lateral_cut(model_summary):
         return ">= " + text
     return text

@@ -19,6 +19,7 @@ import pytest
 from pde import CartesianGrid, PolarSymGrid
 
 import pdeflow
+from pdeflow.metrics_2d import mass_radius
 from pdeflow.models.base import GranularPDE
 
 R0, H0 = 0.5, 0.5  #: the column's radius and height [m]
@@ -28,10 +29,9 @@ SCHEME = "hll/muscl/mc"
 
 
 def r99(r: np.ndarray, mass: np.ndarray) -> float:
-    """The radius [m] inside which 99 % of ``mass`` (per cell, at radii ``r``) lies."""
-    order = np.argsort(r)
-    cumulative = np.cumsum(mass[order])
-    return float(r[order][np.searchsorted(cumulative, 0.99 * cumulative[-1])])
+    """The radius [m] inside which 99 % of ``mass`` (per cell, at radii ``r``) lies
+    (:func:`pdeflow.metrics_2d.mass_radius`, which 2D case summaries report)."""
+    return mass_radius(r, mass, 0.99)
 
 
 def model(name: str, bc: object) -> GranularPDE:

@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from .. import systems
+from ..case_validation_2d import require_1d
 from ..cases import PAPER_MODEL, Case, CaseError, load_case
 from ..numerics.warmup import prepare
 from ..simulate import case_steppers, summary_unit
@@ -248,6 +249,7 @@ def cmd_converge(args: argparse.Namespace) -> int:
                         f"{args.levels}")
     check_file(args.summary, "--summary", (".json",))
     case = load_case(args.case, args.set)
+    require_1d(case, "pdeflow converge")
     if not case.data.get("sweep"):
         from ..sizecheck import check_size
 

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from .. import systems
+from ..case_validation_2d import require_1d
 from ..cases import PAPER_MODEL, Case, CaseError, load_case
 from ..numerics.warmup import prepare
 from ..simulate import case_steppers
@@ -257,6 +258,7 @@ def cmd_sweep(args: Any) -> int:
     check_file(args.summary, "--summary", (".json",))
     check_file(args.plot, "--plot", FIGURE_SUFFIXES)
     case = load_case(args.case, args.set)
+    require_1d(case, "pdeflow sweep")
     sweep_ratios(case)  # before any run
     prepare(case_steppers(case), log=None if args.quiet else sys.stderr)
     summary = run_sweep(case, progress=not args.quiet and sys.stderr.isatty())

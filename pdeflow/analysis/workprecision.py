@@ -64,6 +64,7 @@ from typing import Any
 
 import numpy as np
 
+from ..case_validation_2d import require_1d
 from ..cases import Case, CaseError, load_case
 from ..study.core import Study
 from ..variant import MAX_CFL, Variant
@@ -361,6 +362,7 @@ def _cases_and_laws(args: argparse.Namespace) -> list[tuple[str, Case, str | Non
     out: list[tuple[str, Case, str | None]] = []
     for path in args.cases:
         case = load_case(path, args.set)
+        require_1d(case, "pdeflow compare")
         if not getattr(args, "laws", None):
             out.append((path, case, None))
             continue

@@ -141,7 +141,7 @@ def list_cases(case_dir: Path, need: Callable[[Case], bool] = lambda c: True
             case = load_case(path)
         except CaseError:
             continue  # not runnable as it is: not offered
-        if need(case) and case.cells <= MAX_CELLS:
+        if need(case) and not case.is_2d and case.cells <= MAX_CELLS:  # the app is 1D
             out[path.name] = path
     return out
 

@@ -45,6 +45,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from .. import systems
+from ..case_validation_2d import require_1d
 from ..cases import Case, CaseError, load_case, read_text
 from ..simulate import summary_keys
 from .expressions import Expression, StudyError
@@ -210,7 +211,9 @@ def _case(path: Path, raw: Any, overrides: list[str], key: str) -> Case:
     if not isinstance(raw, str):
         raise StudyError(f"study.{key} must be a case file name, got {raw!r}")
     try:
-        return load_case(path.parent / raw, overrides)
+        case = load_case(path.parent / raw, overrides)
+        require_1d(case, "pdeflow study")
+        return case
     except CaseError as err:
         raise StudyError(f"study.{key}: {err}") from None
 

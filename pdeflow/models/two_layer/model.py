@@ -170,14 +170,17 @@ def summarize(diag, tf: float, at_rest: bool, x: np.ndarray, d: np.ndarray,
         "lower_slow_time": stop_time(diag.last_fast_lower, tf, False),
         "upper_slow_time": stop_time(diag.last_fast_upper, tf, False),
         "max_fextra_over_rho1": diag.fextra_max,
-        "max_fextra_x": float(x[int(diag.fextra_cell)]),
+        # the cell index is flat over a 2D grid's cells: its x is that of row
+        # cell // (stride of axis 0), the stride 1 in 1D
+        "max_fextra_x": float(x[int(diag.fextra_cell) // metric.axes[0][0]]),
         "max_fextra_time": diag.fextra_time,
         "hyperbolicity_events": int(diag.hyperbolicity_events),
         "hyperbolicity_bisections": int(diag.hyperbolicity_bisections),
         "deposited_volume": float(diag.deposited * dx) if planar else None,
         "eroded_volume": float(diag.eroded * dx) if planar else None,
-        "upper_volume_final": metric.integral(d[0]),
-        "lower_volume_final": metric.integral(d[2]),
+        # h1 is row 0, h2 the first row of the second half (2 in 1D, 3 in 2D)
+        "upper_volume_final": metric.integral(np.ravel(d[0])),
+        "lower_volume_final": metric.integral(np.ravel(d[len(d) // 2])),
     }
 
 
