@@ -81,6 +81,8 @@ class ProgressBar(ProgressTracker):
                 bar.initial = bar.n
             self._clock_started = True
         desc = self.label if self._clock_started else self._waiting
+        if bar.total and bar.n >= bar.total:
+            return  # the full bar is drawn by finalize's close (which always draws)
         if (bar.n, desc) != self._drawn:  # py-pde's call at t_start would repeat a draw
             bar.set_description(desc)  # draws the bar
             self._drawn = (bar.n, desc)
