@@ -52,7 +52,7 @@ from .solvers.diagnostics import SplitDiagnostics
 from .solvers.fv_split import SimulationBlowUp, split_stepper
 from .summary_2d import summarize_2d
 from .trackers import FextraStorageTracker
-from .trackers.peaks import PeakSpeedTracker
+from .trackers.peaks import PeakTracker
 from .trackers.series import SeriesTracker
 from .variant import Variant
 
@@ -270,7 +270,8 @@ def peak_tracker(case: Case, pde: GranularPDE) -> Any:
     every t_end / :data:`PEAK_SAMPLES`), None for a 1D run (no such number)."""
     if not case.is_2d:
         return None
-    return PeakSpeedTracker(case.t_end / PEAK_SAMPLES, pde.parameters.dry_tolerance)
+    dry = pde.parameters.dry_tolerance
+    return PeakTracker(case.t_end / PEAK_SAMPLES, lambda data: metrics_2d.max_speed(data, dry))
 
 
 def initial_mass(case: Case, pde: GranularPDE, data: np.ndarray, metric: Metric) -> float:

@@ -14,7 +14,7 @@ wall_time_s, stop_reason, flux_fallback_steps, positivity_retries, warnings):
   ``output.runout_mass_fraction`` (0.99: r99) of the mass, for radial spreads;
 * ``max_depth`` [m]: the final state's deepest cell (all layers); ``max_speed`` [m/s]:
   the largest speed of any layer, sampled over the run
-  (:class:`pdeflow.trackers.peaks.PeakSpeedTracker`);
+  (:class:`pdeflow.trackers.peaks.PeakTracker`);
 * ``mass_relative_error``, ``mass_change`` [-] as in 1D; ``domain_ends``: the sides
   ('left', 'right' along x, 'y_low', 'y_high' across) whose outermost cells are deeper
   than the threshold at the end, and the mass lost through open ones.

@@ -1,9 +1,11 @@
-"""The largest speed of a run, sampled: :class:`PeakSpeedTracker` (2D summaries).
+"""The largest value of a measure of the state over a run, sampled: :class:`PeakTracker`
+(a 2D summary's largest speed).
 
 The fastest moment of a collapse lies inside the run (the final deposit is at rest),
 so the summary's ``max_speed`` needs a look at the run: this tracker reads the state
 every ``interval`` [s] of simulation time (and the final one) and keeps the largest
-speed of any layer in any wet cell (:func:`pdeflow.metrics_2d.max_speed`). Like every
+value of its ``measure`` (the caller's: e.g. :func:`pdeflow.metrics_2d.max_speed`, so
+that the trackers need no metrics, as they need no models). Like every
 tracker here it only reads: fv-split takes the same steps with it as without
 (:mod:`pdeflow.solvers.outputs`). A peak between two samples is missed: the value is a
 lower bound of the run's peak, as close as the interval is fine.
@@ -11,21 +13,22 @@ lower bound of the run's peak, as close as the interval is fine.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
+import numpy as np
 from pde.trackers.base import InfoDict, TrackerBase
 
-from ..metrics_2d import max_speed
 from .frames import show_final_state
 
 
-class PeakSpeedTracker(TrackerBase):
-    """The largest speed [m/s] (:attr:`peak`) over the states seen every ``interval``
-    [s] and the final one; cells thinner than ``dry`` [m] have no speed."""
+class PeakTracker(TrackerBase):
+    """The largest ``measure(data)`` (:attr:`peak`, 0 before any) over the states'
+    data seen every ``interval`` [s] and the final one."""
 
-    def __init__(self, interval: float, dry: float):
+    def __init__(self, interval: float, measure: Callable[[np.ndarray], float]):
         super().__init__(interrupts=interval)
-        self.dry = dry
+        self.measure = measure
         self.peak = 0.0
         self.last_time = -float("inf")
 
@@ -34,7 +37,7 @@ class PeakSpeedTracker(TrackerBase):
         return super().initialize(field, info)
 
     def handle(self, field: Any, t: float) -> None:
-        self.peak = max(self.peak, max_speed(field.data, self.dry))
+        self.peak = max(self.peak, self.measure(field.data))
         self.last_time = t
 
     def finalize(self, info: InfoDict | None = None) -> None:
