@@ -27,6 +27,11 @@ attributes (the controller's information, the field attributes).
 Velocities (in :meth:`StoredRun.profiles` and the exports) are zero where a layer is
 not thicker than the model's dry tolerance, as in the solver.
 
+A run on a 2D grid (a 2D case, issue 36) is stored the same way, each field of shape
+(nx, ny) (h1, h1u1, h1v1, h2, h2u2, h2v2 or h, hu, hv, then ``fextra_over_rho1``), and
+:func:`open_run` reads it back as a :class:`pdeflow.storage_2d.StoredRun2D` (its
+export has dimensions time, x, y).
+
 Files are complete or absent: the run writes to a temporary name next to the target
 (``.NAME.XXXX.part.h5``) and renames it once the run has finished; a run that fails
 leaves no file behind. HDF5 needs ``h5py`` (``pip install 'pdeflow[storage]'``).
