@@ -168,3 +168,38 @@ def test_bad_store_options_of_a_2d_run_are_one_line(option, words, capsys, tmp_p
     for w in words:
         assert w in err, (w, err)
     assert not list(tmp_path.iterdir())
+
+
+def test_a_failed_2d_run_leaves_no_file(tmp_path, monkeypatch):
+    """A 2D run that fails half-way keeps no stored file (nor a temporary), as in 1D."""
+    import pdeflow.simulate as sim
+    from pdeflow.trackers import FextraStorageTracker
+
+    original = sim.run_model
+
+    class Boom(RuntimeError):
+        pass
+
+    class Fail(FextraStorageTracker):
+        def handle(self, field, t):
+            if t > 0.2:
+                raise Boom("simulated failure")
+
+    def failing(case, model, *, tracker=None, **kw):
+        return original(case, model, tracker=[*tracker, Fail(0.1)], **kw)
+
+    monkeypatch.setattr(sim, "run_model", failing)
+    with pytest.raises(Boom):
+        main(["run", str(CYLINDER), *SMALL, "--store", str(tmp_path / "a.h5"), "-q"])
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_1d_store_keeps_its_metadata_keys():
+    """The y-axis keys are a 2D file's only: a 1D file's metadata is as before."""
+    from pdeflow.cases import load_case
+    from pdeflow.storage import run_metadata
+
+    one = run_metadata(load_case(ROOT / "cases" / "ritter_dam_break.toml"), "single_layer")
+    assert not {"dimensions", "dy", "width", "y_start", "cells_y"} & set(one)
+    two = run_metadata(load_case(CYLINDER), "single_layer")
+    assert two["dimensions"] == 2 and two["cells_y"] == 80
