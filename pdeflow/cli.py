@@ -21,7 +21,7 @@ RUN_HELP = """Run every model listed in the case file (case.models) to rest or t
 Without output options the summary and all figures go to results/<case name>/ (the
 case as written) or results/<case name>--<overrides>/ (with --set); a run replaces
 its folder as a whole. A 2D case (grid.width) writes its summary there and no
-figures; --plot, --live, --movie, --frames and --store are 1D only for now.
+figures; --plot, --live, --movie and --frames are 1D only for now.
 Every output is complete or absent: a failed or interrupted run writes nothing
 (Ctrl-C while the results are written lets them finish).
 For cases with several models, per-model outputs (--final, --store, --movie) go to
@@ -184,8 +184,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             figures.close()
 
 
-ONE_D_OPTIONS = ("plot", "live", "movie", "frames", "store", "store_every", "live_every")
-"""the options of ``pdeflow run`` that draw or store 1D frames: refused for a 2D case"""
+ONE_D_OPTIONS = ("plot", "live", "movie", "frames", "live_every")
+"""the options of ``pdeflow run`` that draw 1D frames: refused for a 2D case"""
 
 
 def _refuse_1d_options(args: argparse.Namespace, case: Any) -> None:

@@ -16,14 +16,20 @@ PLOT_HELP = """Plot stored runs (written by `pdeflow run --store`) at one time, 
 The first run is drawn filled (layers stacked on the bed), further runs as lines on
 top, for comparison: e.g. the two-layer and single-layer runs of one case, or two
 parameter sets. Each run is shown at its stored time nearest to --time (default: its
-last frame, the final state). A short description of each file is printed."""
+last frame, the final state). A short description of each file is printed.
+Runs on a 2D grid are not plotted yet (issue 36): export them (pdeflow export)."""
 
 EXPORT_HELP = """Export a stored run to CSV, NumPy .npz or NetCDF (chosen by the suffix).
 
 CSV: one row per (time, cell), columns t [s], x [m], h1, u1, h2, u2 [m, m/s] and
 fextra_over_rho1 [m^2/s^2] (two layers) or h, u (one layer). NPZ: arrays t, x and
 each quantity as (time, cell), plus the metadata as JSON. NetCDF needs xarray
-(pip install 'pdeflow[export]'); the metadata goes into its attributes."""
+(pip install 'pdeflow[export]'); the metadata goes into its attributes.
+
+A run on a 2D grid (a 2D case's --store) exports per layer its depth and velocities
+along x and y (h1, u1, v1, h2, u2, v2 or h, u, v) and F_extra/rho1: NetCDF with
+dimensions time [s], x and y [m] (cell centres), units and long_name on every variable;
+NPZ arrays t, x, y and (time, nx, ny) per quantity; CSV one row per (time, x, y)."""
 
 
 def _plot_labels(runs: list[Any]) -> list[str]:
@@ -48,6 +54,17 @@ def _say_nearest_frames(runs: list[Any], idx: list[int], t: float | None) -> Non
                   f"the nearest, t = {shown:.4g} s{last}", file=sys.stderr)
 
 
+def _refuse_2d_runs(paths: list[str]) -> None:
+    """A StorageError (one line) before any work if a run in ``paths`` is on a 2D grid:
+    the figures of :mod:`pdeflow.plotting` draw profiles along x."""
+    from .storage import StorageError, stored_axes
+
+    for path in paths:
+        if stored_axes(path) == 2:
+            raise StorageError(f"{path}: plotting a 2D stored run is not available yet "
+                               f"(issue 36); export it: pdeflow export {path} OUT.nc")
+
+
 def cmd_plot(args: argparse.Namespace) -> int:
     from .outpaths import FIGURE_SUFFIXES, check_file
     from .plotting import RunFigure, Series, display_name
@@ -64,6 +81,7 @@ def cmd_plot(args: argparse.Namespace) -> int:
         from .trackers.live import check_movie_path
 
         check_movie_path(args.movie)
+    _refuse_2d_runs(args.runs)
     runs = [open_run(p) for p in args.runs]
     series = [Series(r.x, r.model, lab, r.dry_tolerance, r.coordinate)
               for r, lab in zip(runs, _plot_labels(runs), strict=True)]

@@ -27,6 +27,11 @@ attributes (the controller's information, the field attributes).
 Velocities (in :meth:`StoredRun.profiles` and the exports) are zero where a layer is
 not thicker than the model's dry tolerance, as in the solver.
 
+A run on a 2D grid (a 2D case, issue 36) is stored the same way, each field of shape
+(nx, ny) (h1, h1u1, h1v1, h2, h2u2, h2v2 or h, hu, hv, then ``fextra_over_rho1``), and
+:func:`open_run` reads it back as a :class:`pdeflow.storage_2d.StoredRun2D` (its
+export has dimensions time, x, y).
+
 Files are complete or absent: the run writes to a temporary name next to the target
 (``.NAME.XXXX.part.h5``) and renames it once the run has finished; a run that fails
 leaves no file behind. HDF5 needs ``h5py`` (``pip install 'pdeflow[storage]'``).
@@ -59,10 +64,13 @@ FORMAT = "pdeflow-run/1"
 
 
 def units(system: systems.EquationSystem) -> dict[str, str]:
-    """Units of the stored fields and exported columns of ``system``'s runs."""
-    out = {"x": "m", "t": "s", FEXTRA_LABEL: "m^2/s^2"}
+    """Units of the stored fields and exported columns of ``system``'s runs (1D and 2D:
+    the cross-slope velocity and discharge of a 2D grid too)."""
+    out = {"x": "m", "y": "m", "t": "s", FEXTRA_LABEL: "m^2/s^2"}
     for layer in system.layers:
         out.update({layer.depth: "m", layer.velocity: "m/s", layer.discharge: "m^2/s"})
+        if layer.velocity_y is not None:
+            out.update({layer.velocity_y: "m/s", layer.discharge_y: "m^2/s"})
     return out
 
 
@@ -124,6 +132,9 @@ def run_metadata(case: Any, model: str, *, overrides: Sequence[str] = (),
         "coordinate": COORDINATES[case.geometry],
         "pdeflow_version": __version__,
     }
+    if case.is_2d:  # the y-axis [m]; a 1D file keeps the keys it always had
+        meta.update({"dimensions": 2, "dy": case.dy, "width": case.width,
+                     "y_start": case.y_start, "cells_y": case.cells_y})
     meta.update(extra)
     return jsonable(meta)
 
@@ -172,7 +183,8 @@ class RunStorageTracker(FextraStorageTracker):
         meta["py_pde_version"] = pde.__version__
         meta["created"] = datetime.datetime.now(datetime.timezone.utc).isoformat(
             timespec="seconds")
-        meta["fields"] = [*system.field_names, FEXTRA_LABEL]
+        # a 2D state has each layer's discharge across (y) after the one along x
+        meta["fields"] = [*system.field_names_on(field.grid.num_axes), FEXTRA_LABEL]
         meta["units"] = {k: units(system)[k] for k in meta["fields"]}
         self._pending = PendingFile(self.path)
         self.storage = FileStorage(self._pending.tmp, info={"pdeflow": jsonable(meta)},
@@ -240,6 +252,9 @@ class StoredRun:
     fextra: np.ndarray
     """F_extra/rho1 per time and cell [m^2/s^2], shape (nt, n)"""
     metadata: dict[str, Any] = field(default_factory=dict)
+
+    dimensions = 1
+    """the grid's axes (:class:`pdeflow.storage_2d.StoredRun2D`: 2)"""
 
     @property
     def model(self) -> str:
@@ -395,6 +410,18 @@ def open_storage(path: str | Path) -> Any:
     return storage
 
 
+def stored_axes(path: str | Path) -> int:
+    """The axes of a stored run's grid (1 or 2), read from the file's grid alone (no
+    frames loaded): what a command checks before any work."""
+    storage = open_storage(path)
+    try:
+        return int(storage.grid.num_axes)
+    except (OSError, KeyError, RuntimeError, AttributeError) as err:
+        raise StorageError(f"{path}: cannot read the stored run's grid ({err})") from None
+    finally:
+        storage.close()
+
+
 def open_run(path: str | Path) -> StoredRun:
     """Load a stored run (written by :class:`RunStorageTracker` or ``--store``).
 
@@ -412,14 +439,17 @@ def open_run(path: str | Path) -> StoredRun:
         raise StorageError(f"{path}: cannot read the stored run ({err})") from None
     finally:
         storage.close()
-    if times.size == 0 or data.ndim != 3 or grid is None:
-        raise StorageError(f"{path}: holds no frames of a 1D run")
+    if times.size == 0 or data.ndim not in (3, 4) or grid is None:
+        raise StorageError(f"{path}: holds no frames of a 1D or 2D run")
+    axes = data.ndim - 2  # (frames, fields, cells along x[, cells along y])
     x = np.asarray(grid.axes_coords[0], dtype=float)
     rows = data.shape[1]
-    if meta.get("fields", [None])[-1] == FEXTRA_LABEL or rows in (3, 5):
+    # with F_extra/rho1 a frame has one row more than the state: 2 or 4 rows per 1D
+    # state, 3 or 6 per 2D state
+    if meta.get("fields", [None])[-1] == FEXTRA_LABEL or rows in ((3, 5), (4, 7))[axes - 1]:
         state, fextra = data[:, :-1], data[:, -1]
     else:
-        state, fextra = data, np.zeros((data.shape[0], data.shape[2]))
+        state, fextra = data, np.zeros((data.shape[0], *data.shape[2:]))
     if "model" not in meta:
         fields = meta.get("fields", [])[:state.shape[1]]
         try:
@@ -427,8 +457,13 @@ def open_run(path: str | Path) -> StoredRun:
         except ValueError:
             raise StorageError(f"{path}: {rows} fields per frame {fields} are no granular "
                                "run of a registered model") from None
+    if axes == 2:
+        from .storage_2d import StoredRun2D
+
+        y = np.asarray(grid.axes_coords[1], dtype=float)
+        return StoredRun2D(path, times, x, state, fextra, meta, y=y)
     return StoredRun(path, times, x, state, fextra, meta)
 
 
 __all__ = ["FORMAT", "RunStorageTracker", "StorageError", "StoredRun", "open_run",
-           "open_storage", "run_metadata"]
+           "open_storage", "run_metadata", "stored_axes"]

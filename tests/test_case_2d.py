@@ -256,7 +256,7 @@ def test_2d_keys_in_a_1d_case_ask_for_the_width(key, capsys):
 
 
 @pytest.mark.parametrize("option", [["--plot", "p.png"], ["--movie", "m.gif"],
-                                    ["--frames", "fr"], ["--store", "s.h5"], ["--live"]])
+                                    ["--frames", "fr"], ["--live"]])
 def test_outputs_that_are_1d_only_are_refused_before_any_work(option, capsys, tmp_path,
                                                               monkeypatch):
     monkeypatch.chdir(tmp_path)

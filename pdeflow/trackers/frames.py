@@ -30,14 +30,16 @@ FEXTRA_LABEL = "fextra_over_rho1"
 """Label of the F_extra/rho1 field [m^2/s^2] that follows the state in every frame."""
 
 
-def fextra_over_rho1(info: InfoDict | None, n: int) -> np.ndarray:
+def fextra_over_rho1(info: InfoDict | None, n: int | tuple[int, ...]) -> np.ndarray:
     """F_extra/rho1 per cell [m^2/s^2] of the last step, from the ``fv-split`` solver's
     post-step data in the simulation ``info``; zeros if the solver keeps none (py-pde
-    solvers, one layer)."""
+    solvers, one layer). ``n``: the cells (1D) or the grid's shape, e.g. (nx, ny): the
+    solver keeps a 2D grid's cells flat, in the state's (C) order."""
+    shape = (n,) if isinstance(n, (int, np.integer)) else tuple(n)
     diag = None if info is None else info.get("solver", {}).get("post_step_data")
-    if isinstance(diag, np.ndarray) and diag.size == L.N_DIAG + n:
-        return diag[L.N_DIAG:].copy()
-    return np.zeros(n)
+    if isinstance(diag, np.ndarray) and diag.size == L.N_DIAG + int(np.prod(shape)):
+        return diag[L.N_DIAG:].reshape(shape).copy()
+    return np.zeros(shape)
 
 
 def state_labels(field: FieldCollection) -> tuple[str, ...]:
@@ -107,7 +109,7 @@ class FextraStorageTracker(StorageTracker):
         assert self._frame is not None, "initialize() first"
         data = self._frame.data
         data[:-1] = field.data
-        data[-1] = fextra_over_rho1(self._info, data.shape[1])
+        data[-1] = fextra_over_rho1(self._info, data.shape[1:])  # 1D: (n,), 2D: (nx, ny)
         return self._frame
 
     def handle(self, field: Any, t: float) -> None:
