@@ -108,4 +108,5 @@ def require_1d(case: Any, what: str) -> None:
     '--movie', 'pdeflow sweep') is 1D only for now."""
     if case.is_2d:
         raise CaseError(f"{case.source}: {what} {ISSUE}; a 2D case runs with "
-                        "`pdeflow run CASE.toml` (its summary table, --summary, --outdir, --final)")
+                        "`pdeflow run CASE.toml` (its summary table, --summary, --outdir, "
+                        "--final, --plot)")
