@@ -32,9 +32,16 @@ Run2D = tuple[str, np.ndarray]
 """a run drawn: (its model's registered name, its final state data (rows, nx, ny))"""
 
 MAP_SIZE = 3.4
-"""the width of one plan-view map with its colour bar [inch]"""
-SECTION = 2.6
-"""the height of the cross-sections' row [inch]"""
+"""the width of one plan-view map's column, with its labels and colour bar [inch]"""
+MAP_WIDTH = 2.05
+"""the width of a map's axes [inch]"""
+MARGIN = 0.65
+"""left of each map and cross-section: its y tick labels and label [inch]"""
+TITLE, LABEL, TOP = 0.5, 0.5, 0.55
+"""above each map (its two-line title), below it (x ticks and label) and above the
+figure (its two-line title) [inch]"""
+SECTION = 2.2
+"""the height of the cross-sections' axes [inch]"""
 CONTOURS = (0.25, 0.5, 0.75)
 """the depth maps' contour lines, as fractions of the map's deepest cell"""
 EDGE = 1e-3
@@ -75,9 +82,10 @@ def layer_speed(data: np.ndarray, k: int) -> np.ndarray:
     return _velocity(h, np.hypot(hu, hv))
 
 
-def depth_map(ax: Any, fig: Any, x: np.ndarray, y: np.ndarray, h: np.ndarray,
+def depth_map(ax: Any, cax: Any, fig: Any, x: np.ndarray, y: np.ndarray, h: np.ndarray,
               total: np.ndarray, threshold: float) -> Any:
-    """A layer's depth ``h`` [m] (nx, ny) on ``ax``: colours (blank where dry), the
+    """A layer's depth ``h`` [m] (nx, ny) on ``ax``: colours (blank where dry; their
+    scale in ``cax``), the
     :data:`CONTOURS` (white) and the deposit outline, the contour of the total
     depth ``total`` [m] at ``threshold`` [m] (black, labelled 'deposit'). Returns the
     outline's ContourSet (None if no cell is deeper than the threshold)."""
@@ -85,7 +93,7 @@ def depth_map(ax: Any, fig: Any, x: np.ndarray, y: np.ndarray, h: np.ndarray,
     top = float(np.max(h)) if np.max(h) > 0 else 1.0
     mesh = ax.pcolormesh(cell_edges(x), cell_edges(y), shown.T, cmap="viridis",
                          vmin=0.0, vmax=top, shading="flat")
-    fig.colorbar(mesh, ax=ax, fraction=0.046, pad=0.03)
+    fig.colorbar(mesh, cax=cax)
     if np.max(h) > DRY and x.size > 1 and y.size > 1:
         ax.contour(x, y, h.T, levels=[f * top for f in CONTOURS], colors="w",
                    linewidths=0.7)
@@ -100,32 +108,36 @@ def depth_map(ax: Any, fig: Any, x: np.ndarray, y: np.ndarray, h: np.ndarray,
     return outline
 
 
-def speed_map(ax: Any, fig: Any, x: np.ndarray, y: np.ndarray,
+def speed_map(ax: Any, cax: Any, fig: Any, x: np.ndarray, y: np.ndarray,
               speed: np.ndarray) -> None:
-    """A layer's speed ``speed`` [m/s] (nx, ny; NaN where dry) on ``ax``; a run at rest
-    shows 0 everywhere it is wet (the colour scale then runs to 1 m/s)."""
-    top = float(np.nanmax(speed)) if np.any(np.isfinite(speed)) else 0.0
+    """A layer's speed ``speed`` [m/s] (nx, ny; NaN where dry) on ``ax``, its colour
+    scale in ``cax``; a layer at rest shows 0 wherever it is wet (the scale then runs
+    to 1 m/s, and the map says 'at rest')."""
+    wet = bool(np.any(np.isfinite(speed)))
+    top = float(np.nanmax(speed)) if wet else 0.0
     mesh = ax.pcolormesh(cell_edges(x), cell_edges(y), speed.T, cmap="magma",
                          vmin=0.0, vmax=top if top > 0 else 1.0, shading="flat")
-    fig.colorbar(mesh, ax=ax, fraction=0.046, pad=0.03)
-    if not np.any(np.isfinite(speed)):
-        ax.text(0.5, 0.5, "dry", transform=ax.transAxes, ha="center", va="center",
-                color="0.4")
+    fig.colorbar(mesh, cax=cax)
+    if top == 0:  # an all-black or empty map: say why
+        ax.text(0.5, 0.5, "at rest" if wet else "dry", transform=ax.transAxes,
+                ha="center", va="center", color="0.6")
 
 
 def model_row(fig: Any, axes: Sequence[Any], x: np.ndarray, y: np.ndarray,
               run: Run2D, t: float, threshold: float,
               box: tuple[tuple[float, float], tuple[float, float]]) -> list[Any]:
-    """The maps of one run (model name, state data) at time ``t`` [s] on ``axes`` (two
-    per layer: depth, speed); the deposit outlines drawn (see :func:`depth_map`)."""
+    """The maps of one run (model name, state data) at time ``t`` [s] on ``axes``
+    ((map, colour bar) pairs, two per layer: depth, speed); the deposit outlines drawn
+    (see :func:`depth_map`)."""
     model, data = run
     system = systems.get(model)
     total = m2.total_depth(data)
     outlines = []
     for k, layer in enumerate(system.layers):
-        ax_h, ax_u = axes[2 * k], axes[2 * k + 1]
-        outlines.append(depth_map(ax_h, fig, x, y, data[3 * k], total, threshold))
-        speed_map(ax_u, fig, x, y, layer_speed(data, k))
+        (ax_h, cax_h), (ax_u, cax_u) = axes[2 * k], axes[2 * k + 1]
+        outlines.append(depth_map(ax_h, cax_h, fig, x, y, data[3 * k], total,
+                                  threshold))
+        speed_map(ax_u, cax_u, fig, x, y, layer_speed(data, k))
         head = f"{system.label}, t = {t:.3g} s"
         ax_h.set_title(f"{head}\n{_short(layer)} depth {_symbol(layer.depth)} [m]",
                        fontsize=9)
@@ -189,24 +201,38 @@ def final_figure_2d(x: np.ndarray, y: np.ndarray, runs: Sequence[Run2D],
     ncols = max(maps)
     box = plan_box(x, y, [*(m2.total_depth(d) for _, d in runs), initial])
     ratio = (box[1][1] - box[1][0]) / (box[0][1] - box[0][0])
-    # a map's axes take about 60 % of its column's width (tick labels, colour bar);
-    # its row also holds the two-line title and the x label
-    row = float(np.clip(0.6 * MAP_SIZE * ratio + 0.9, 2.0, 6.0))
-    fig = new_figure((MAP_SIZE * ncols, row * len(runs) + SECTION + 0.5))
-    # constrained layout: the colour bars and the titles of maps of any aspect fit
-    # without overlapping their neighbours (fixed margins cannot know the aspect)
-    fig.set_layout_engine("constrained", h_pad=0.06, w_pad=0.06)
-    grid = fig.add_gridspec(len(runs) + 1, ncols,
-                            height_ratios=[row] * len(runs) + [SECTION])
-    for r, (run, t, n) in enumerate(zip(runs, times, maps, strict=True)):
-        axes = [fig.add_subplot(grid[r, c]) for c in range(n)]
+    # a map's height for its width at equal aspect, within bounds (a long, narrow
+    # domain keeps a readable height; equal aspect then shrinks the map inside it)
+    height = float(np.clip(MAP_WIDTH * ratio, 0.8, 4.0))
+    rows = [TITLE + height + LABEL] * len(runs) + [0.35 + SECTION + LABEL]
+    size = (MAP_SIZE * ncols, TOP + sum(rows))
+    fig = new_figure(size)
+    top = size[1] - TOP
+    for run, t, n, row in zip(runs, times, maps, rows, strict=False):
+        bottom = top - row + LABEL
+        axes = [_map_axes(fig, size, c * MAP_SIZE, bottom, height) for c in range(n)]
         model_row(fig, axes, x, y, run, t, threshold, box)
-    half = ncols // 2
-    ax_x = fig.add_subplot(grid[-1, :half])
-    ax_y = fig.add_subplot(grid[-1, half:])
+        top -= row
+    half = ncols * MAP_SIZE / 2
+    ax_x, ax_y = (fig.add_axes([(left + MARGIN) / size[0], LABEL / size[1],
+                                (half - MARGIN - 0.3) / size[0], SECTION / size[1]])
+                  for left in (0.0, half))
     cross_sections(ax_x, ax_y, x, y, runs, initial, y0, box)
-    fig.suptitle(f"{title}: final state\n{stops}".strip(), fontsize=10)
+    fig.suptitle(f"{title}: final state\n{stops}".strip(), fontsize=10,
+                 y=1 - 0.08 / size[1], va="top")
     return fig
+
+
+def _map_axes(fig: Any, size: tuple[float, float], left: float, bottom: float,
+              height: float) -> tuple[Any, Any]:
+    """A map's axes and its colour bar's, placed in inches (``left``, ``bottom`` of the
+    map's column and axes, ``height`` of the axes) in a figure of ``size`` [inch]:
+    fixed places, no layout engine (constrained layout took half the drawing time)."""
+    w, h = size
+    ax = fig.add_axes([(left + MARGIN) / w, bottom / h, MAP_WIDTH / w, height / h])
+    cax = fig.add_axes([(left + MARGIN + MAP_WIDTH + 0.1) / w, bottom / h, 0.12 / w,
+                        height / h], label="<colorbar>")
+    return ax, cax
 
 
 def _initial_total(res: Any) -> np.ndarray:

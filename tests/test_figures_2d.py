@@ -205,3 +205,25 @@ def test_plot_of_a_1d_case_is_the_final_deposit_figure_as_before(tmp_path):
     assert main(["run", str(RITTER), "-q", "--set", "grid.cells=40", "--plot",
                  str(tmp_path / "q.png")]) == 0
     assert (tmp_path / "q.png").read_bytes().startswith(PNG)
+
+
+@pytest.mark.filterwarnings("ignore:.*still moving")  # stopped early, on purpose
+def test_the_maps_are_the_final_depths_and_speeds_of_a_moving_run():
+    """Stopped at t_end = 0.1 s, still moving: each map's colours are its layer's final
+    depth (blank where dry) and speed |(hu, hv)|/h [m/s]; nothing says 'at rest'."""
+    case = load_case(CYLINDER, [*COARSE, "case.t_end=0.1", "case.models=['two_layer']"])
+    res = run_model(case, "two_layer")
+    assert not res.summary["at_rest"]
+    panels = _panels(_figure({"two_layer": res}))
+    d = res.state.data
+    for k in range(2):
+        h, hu, hv = d[3 * k], d[3 * k + 1], d[3 * k + 2]
+        wet = h > 1e-9
+        depth = panels[2 * k].collections[0].get_array().reshape(h.T.shape)
+        np.testing.assert_array_equal(depth.T[wet], h[wet])
+        assert np.all(np.ma.getmaskarray(depth.T) | ~np.isfinite(depth.T) == ~wet)
+        speed = panels[2 * k + 1].collections[0].get_array().reshape(h.T.shape).T
+        moving = np.isfinite(speed)
+        assert moving.any() and np.nanmax(speed) > 0.5
+        np.testing.assert_allclose(speed[moving], np.hypot(hu, hv)[moving] / h[moving])
+        assert not [t for t in panels[2 * k + 1].texts if t.get_text() == "at rest"]
