@@ -94,10 +94,10 @@ def depth_map(ax: Any, cax: Any, fig: Any, x: np.ndarray, y: np.ndarray, h: np.n
     mesh = ax.pcolormesh(cell_edges(x), cell_edges(y), shown.T, cmap="viridis",
                          vmin=0.0, vmax=top, shading="flat")
     fig.colorbar(mesh, cax=cax)
-    if np.max(h) > DRY and x.size > 1 and y.size > 1:
+    if np.max(h) > DRY and x.size > 1 and y.size > 1:  # contours need a 2 x 2 grid
         ax.contour(x, y, h.T, levels=[f * top for f in CONTOURS], colors="w",
                    linewidths=0.7)
-    else:  # a layer that is gone (the upper layer after its exchange): say so
+    if not np.max(h) > DRY:  # a layer that is gone (the upper one after its exchange)
         ax.text(0.5, 0.5, "dry", transform=ax.transAxes, ha="center", va="center",
                 color="0.4")
     outline = None
@@ -168,23 +168,23 @@ def cross_sections(ax_x: Any, ax_y: Any, x: np.ndarray, y: np.ndarray,
     totals = [m2.total_depth(d) for _, d in runs]
     j = int(np.argmin(np.abs(y - y0)))
     i = int(np.unravel_index(np.argmax(np.max(totals, axis=0)), totals[0].shape)[0])
+    dots = {"marker": "o", "ms": 3} if y.size == 1 else {}  # one cell across
     for (model, _), total in zip(runs, totals, strict=True):
         system = systems.get(model)
         colour = LAYER_STYLES[system.layers[-1].style][2]  # the lowest layer's line
         ax_x.plot(x, total[:, j], color=colour, lw=1.2, label=system.label)
-        ax_y.plot(y, total[i, :], color=colour, lw=1.2, label=system.label)
+        ax_y.plot(y, total[i, :], color=colour, lw=1.2, label=system.label, **dots)
     ax_x.plot(x, initial[:, j], color="0.35", ls="--", lw=1, label="initial state")
-    ax_y.plot(y, initial[i, :], color="0.35", ls="--", lw=1, label="initial state")
-    ax_x.set_title(f"total depth along x at y = {y[j]:.3g} m (release centre)",
-                   fontsize=9)
-    ax_y.set_title(f"total depth along y at x = {x[i]:.3g} m (deepest cell)",
-                   fontsize=9)
+    ax_y.plot(y, initial[i, :], color="0.35", ls="--", lw=1, label="initial state",
+              **dots)
+    ax_x.set_title(f"along x at y = {y[j]:.3g} m (release centre)", fontsize=9)
+    ax_y.set_title(f"along y at x = {x[i]:.3g} m (deepest cell)", fontsize=9)
     ax_x.set_xlabel("x [m]")
     ax_y.set_xlabel("y [m]")
     ax_x.set_xlim(*box[0])
     ax_y.set_xlim(*box[1])
     for ax in (ax_x, ax_y):
-        ax.set_ylabel("depth [m]")
+        ax.set_ylabel("total depth [m]")
         ax.grid(alpha=0.3)
         ax.legend(loc="upper right", fontsize=8)
 

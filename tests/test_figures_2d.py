@@ -75,8 +75,8 @@ def test_the_figure_has_a_row_of_maps_per_model_and_the_cross_sections(cylinder)
     assert titles[3] == f"two layers, t = {t2:.3g} s\nlower speed $|u_2|$ [m/s]"
     assert titles[4].startswith("single layer, t = ") and "depth $h$ [m]" in titles[4]
     assert titles[5].endswith("speed $|u|$ [m/s]")
-    assert titles[6].startswith("total depth along x at y = ")
-    assert titles[7].startswith("total depth along y at x = ")
+    assert titles[6].startswith("along x at y = ") and "release centre" in titles[6]
+    assert titles[7].startswith("along y at x = ") and "deepest cell" in titles[7]
     for ax in panels[:6]:
         assert (ax.get_xlabel(), ax.get_ylabel()) == ("x [m]", "y [m]")
         assert ax.get_aspect() == 1.0
