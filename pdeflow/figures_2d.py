@@ -85,10 +85,10 @@ def layer_speed(data: np.ndarray, k: int) -> np.ndarray:
 def depth_map(ax: Any, cax: Any, fig: Any, x: np.ndarray, y: np.ndarray, h: np.ndarray,
               total: np.ndarray, threshold: float) -> Any:
     """A layer's depth ``h`` [m] (nx, ny) on ``ax``: colours (blank where dry; their
-    scale in ``cax``), the
-    :data:`CONTOURS` (white) and the deposit outline, the contour of the total
-    depth ``total`` [m] at ``threshold`` [m] (black, labelled 'deposit'). Returns the
-    outline's ContourSet (None if no cell is deeper than the threshold)."""
+    scale in ``cax``), the :data:`CONTOURS` (white) and the deposit outline, the
+    contour of the total depth ``total`` [m] at ``threshold`` [m] (black, labelled
+    'deposit'). Returns the outline's ContourSet (None if no cell is deeper than the
+    threshold, or the grid is one cell wide)."""
     shown = np.where(h > DRY, h, np.nan)
     top = float(np.max(h)) if np.max(h) > 0 else 1.0
     mesh = ax.pcolormesh(cell_edges(x), cell_edges(y), shown.T, cmap="viridis",
@@ -139,9 +139,9 @@ def model_row(fig: Any, axes: Sequence[Any], x: np.ndarray, y: np.ndarray,
                                   threshold))
         speed_map(ax_u, cax_u, fig, x, y, layer_speed(data, k))
         head = f"{system.label}, t = {t:.3g} s"
-        ax_h.set_title(f"{head}\n{_short(layer)} depth {_symbol(layer.depth)} [m]",
+        ax_h.set_title(f"{head}\n{_layer_name(layer)} depth {_symbol(layer.depth)} [m]",
                        fontsize=9)
-        ax_u.set_title(f"{head}\n{_short(layer)} speed "
+        ax_u.set_title(f"{head}\n{_layer_name(layer)} speed "
                        f"$|{_symbol(layer.velocity)[1:-1]}|$ [m/s]", fontsize=9)
         for ax in (ax_h, ax_u):
             ax.set_aspect("equal")
@@ -152,7 +152,7 @@ def model_row(fig: Any, axes: Sequence[Any], x: np.ndarray, y: np.ndarray,
     return outlines
 
 
-def _short(layer: Any) -> str:
+def _layer_name(layer: Any) -> str:
     """'upper layer' -> 'upper', 'single layer' -> 'single layer' (a one-layer model
     has no other)."""
     return layer.label if layer.style == "single" else layer.label.replace(" layer", "")
@@ -162,9 +162,9 @@ def cross_sections(ax_x: Any, ax_y: Any, x: np.ndarray, y: np.ndarray,
                    runs: Sequence[Run2D], initial: np.ndarray, y0: float,
                    box: tuple[tuple[float, float], tuple[float, float]]) -> None:
     """The total depth [m] of each run along x at the row of cells nearest ``y0`` [m]
-    (``ax_x``) and along y at the column through the deepest cell of the runs
-    (``ax_y``); the released total depth ``initial`` [m] (nx, ny) dashed; x and y
-    limited to the maps' ``box`` [m] (:func:`plan_box`)."""
+    (the lower of two as near; ``ax_x``) and along y at the column through the deepest
+    cell of the runs (``ax_y``); the released total depth ``initial`` [m] (nx, ny)
+    dashed; x and y limited to the maps' ``box`` [m] (:func:`plan_box`)."""
     totals = [m2.total_depth(d) for _, d in runs]
     j = int(np.argmin(np.abs(y - y0)))
     i = int(np.unravel_index(np.argmax(np.max(totals, axis=0)), totals[0].shape)[0])
@@ -208,7 +208,7 @@ def final_figure_2d(x: np.ndarray, y: np.ndarray, runs: Sequence[Run2D],
     size = (MAP_SIZE * ncols, TOP + sum(rows))
     fig = new_figure(size)
     top = size[1] - TOP
-    for run, t, n, row in zip(runs, times, maps, rows, strict=False):
+    for run, t, n, row in zip(runs, times, maps, rows[:-1], strict=True):
         bottom = top - row + LABEL
         axes = [_map_axes(fig, size, c * MAP_SIZE, bottom, height) for c in range(n)]
         model_row(fig, axes, x, y, run, t, threshold, box)

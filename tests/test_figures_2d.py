@@ -44,12 +44,15 @@ def _panels(fig) -> list:
 
 
 def test_plot_writes_the_2d_figure_of_both_models(tmp_path, capsys):
-    out = tmp_path / "cyl.png"
+    """--plot and --outdir together: the figure at both (and nothing else left)."""
+    out, folder = tmp_path / "cyl.png", tmp_path / "od"
     assert main(["run", str(CYLINDER), *[f"--set={s}" for s in COARSE],
-                 "--plot", str(out)]) == 0
+                 "--plot", str(out), "--outdir", str(folder)]) == 0
     assert out.read_bytes().startswith(PNG)
     assert f"wrote {out}" in capsys.readouterr().out
-    assert [p.name for p in tmp_path.iterdir()] == ["cyl.png"]  # no temporaries left
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cyl.png", "od"]
+    assert sorted(p.name for p in folder.iterdir()) == ["final_deposits.png",
+                                                        "summary.json"]
 
 
 def test_the_default_folder_of_a_2d_run_holds_its_summary_and_figure(tmp_path,
