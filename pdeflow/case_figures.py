@@ -223,7 +223,10 @@ def case_figures(results: dict[str, Any], outdir: str | Path, prefix: str = "",
 def run_figure_jobs(results: dict[str, Any], outdir: str | Path | None = None,
                     plot: str | Path | None = None) -> list[Job]:
     """The figures of ``pdeflow run``: the final deposits at ``plot`` (``--plot``), then
-    those of :func:`figure_jobs` in ``outdir`` (``--outdir``)."""
+    those of :func:`figure_jobs` in ``outdir`` (``--outdir``); a 2D case's final-state
+    figure (:mod:`pdeflow.figures_2d`) at both instead."""
+    if next(iter(results.values())).case.is_2d:
+        return _run_figure_jobs_2d(results, outdir, plot)
     jobs: list[Job] = []
     if plot:
         runs = list(results.values())
@@ -234,6 +237,22 @@ def run_figure_jobs(results: dict[str, Any], outdir: str | Path | None = None,
     if outdir:
         jobs.extend(figure_jobs(results, outdir))
     return jobs
+
+
+def _run_figure_jobs_2d(results: dict[str, Any], outdir: str | Path | None,
+                        plot: str | Path | None) -> list[Job]:
+    """:func:`run_figure_jobs` of a 2D case: its one figure
+    (:func:`pdeflow.figures_2d.final_figure_2d`) at ``plot`` and as
+    ``final_deposits.png`` in ``outdir`` (the 1D folder's name for the final state; a
+    2D run has no snapshots or bed figures yet)."""
+    from .figures_2d import final_figure_job
+
+    stops = _stops(list(results.values()))
+    targets = [Path(plot)] if plot else []
+    if outdir:
+        Path(outdir).mkdir(parents=True, exist_ok=True)
+        targets.append(Path(outdir) / "final_deposits.png")
+    return [final_figure_job(results, path, stops) for path in targets]
 
 
 def figure_jobs(results: dict[str, Any], outdir: str | Path,

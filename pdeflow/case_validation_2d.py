@@ -109,4 +109,4 @@ def require_1d(case: Any, what: str) -> None:
     if case.is_2d:
         raise CaseError(f"{case.source}: {what} {ISSUE}; a 2D case runs with "
                         "`pdeflow run CASE.toml` (its summary table, --summary, --outdir, "
-                        "--final, --store)")
+                        "--final, --store, --plot)")

@@ -20,8 +20,10 @@ RUN_HELP = """Run every model listed in the case file (case.models) to rest or t
 
 Without output options the summary and all figures go to results/<case name>/ (the
 case as written) or results/<case name>--<overrides>/ (with --set); a run replaces
-its folder as a whole. A 2D case (grid.width) writes its summary there and no
-figures; --plot, --live, --movie and --frames are 1D only for now.
+its folder as a whole. A 2D case (grid.width) writes its summary there and one
+figure, final_deposits.png (plan-view maps of each layer's depth and speed, the
+deposit outline, cross-sections; also --plot); --live, --movie and --frames are 1D
+only for now.
 Every output is complete or absent: a failed or interrupted run writes nothing
 (Ctrl-C while the results are written lets them finish).
 For cases with several models, per-model outputs (--final, --store, --movie) go to
@@ -169,7 +171,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     check_size(case, args.force, "use a coarser grid (--set grid.dx=...)")
     live_window = _live_window(args)
     figures = None
-    if (args.plot or outdir) and not case.is_2d:  # a 2D run's folder: its summary only
+    if args.plot or outdir:
         from .figure_worker import RunFigures
 
         figures = RunFigures(here=bool(args.live or args.movie or args.frames))
@@ -184,7 +186,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             figures.close()
 
 
-ONE_D_OPTIONS = ("plot", "live", "movie", "frames", "live_every")
+ONE_D_OPTIONS = ("live", "movie", "frames", "live_every")
 """the options of ``pdeflow run`` that draw 1D frames: refused for a 2D case"""
 
 
@@ -256,7 +258,9 @@ def _add_run(sub: Any) -> None:
                      help="write the final state (x, h1, u1, h2, u2 or x, h, u, and t; "
                      "a 2D case also y and v1, v2 or v, arrays (nx, ny)); "
                      "further models go to OUT.<model>.npz")
-    out.add_argument("--plot", metavar="OUT.png", help="write the final-deposit figure")
+    out.add_argument("--plot", metavar="OUT.png",
+                     help="write the final-deposit figure (2D: plan-view maps and "
+                     "cross-sections of the final state)")
     out.add_argument("--outdir", metavar="DIR",
                      help="write summary.json and all figures (snapshots, deposits) here; "
                      "the folder is replaced as a whole (refused if it holds other files)")

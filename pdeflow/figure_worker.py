@@ -190,4 +190,4 @@ def import_matplotlib(lean: bool = False) -> None:
         if blocked:
             del sys.modules["mpl_toolkits.mplot3d"]
 
-    from . import bed_figures, case_figures  # noqa: F401
+    from . import bed_figures, case_figures, figures_2d  # noqa: F401

@@ -1,7 +1,7 @@
 """2D case files (issue 36, the first slice): a case with ``grid.width`` becomes a 2D grid
 and state, ``pdeflow run`` runs it and prints the 2D summary, whose numbers are those of
 :mod:`pdeflow.metrics_2d`; bad 2D input and the outputs that are 1D only are one line
-before any work."""
+before any work. Its figure: tests/test_figures_2d.py."""
 
 from __future__ import annotations
 
@@ -171,13 +171,15 @@ def test_the_cylinders_r99_is_the_quadrants_of_the_verification():
         assert s["max_depth"] == pytest.approx(deepest, rel=1e-9)
 
 
-def test_the_default_run_folder_of_a_2d_case_holds_its_summary_only(tmp_path, capsys,
-                                                                    monkeypatch):
+def test_the_default_run_folder_of_a_2d_case_holds_its_summary_and_figure(
+        tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(["run", str(CYLINDER), "--set", "case.models=['single_layer']",
                  "--set", "grid.dx=0.1"]) == 0
     folders = list((tmp_path / "results").iterdir())
-    assert len(folders) == 1 and [p.name for p in folders[0].iterdir()] == ["summary.json"]
+    assert len(folders) == 1
+    assert sorted(p.name for p in folders[0].iterdir()) == ["final_deposits.png",
+                                                            "summary.json"]
 
 
 def test_material_through_open_sides_is_outflow_and_bounds_the_extents(capsys, tmp_path):
@@ -255,7 +257,7 @@ def test_2d_keys_in_a_1d_case_ask_for_the_width(key, capsys):
     _one_line_error(capsys, "grid.width")
 
 
-@pytest.mark.parametrize("option", [["--plot", "p.png"], ["--movie", "m.gif"],
+@pytest.mark.parametrize("option", [["--movie", "m.gif"],
                                     ["--frames", "fr"], ["--live"]])
 def test_outputs_that_are_1d_only_are_refused_before_any_work(option, capsys, tmp_path,
                                                               monkeypatch):

@@ -14,7 +14,8 @@ ROOT = Path(__file__).resolve().parents[1]
 CASE = ROOT / "cases" / "paper_5_1_dam_break.toml"
 NOT_NEEDED = ("matplotlib", "panel", "bokeh", "dask", "distributed", "pandas", "h5py",
               "xarray", "optuna", "SALib", "imageio_ffmpeg", "pdeflow.plotting",
-              "pdeflow.case_figures", "pdeflow.trackers.live", "pdeflow.app.dam_break",
+              "pdeflow.case_figures", "pdeflow.figures_2d", "pdeflow.trackers.live",
+              "pdeflow.app.dam_break",
               # the other commands' modules and the stored runs' (pdeflow.cli builds
               # only the options of the command it runs)
               "pdeflow.analysis.convergence", "pdeflow.analysis.workprecision",
@@ -72,4 +73,23 @@ def test_a_run_with_figures_draws_them_in_the_figure_workers_process(tmp_path):
         "final_deposits.png", "snapshot_t0.1.png", "snapshot_t0.25.png",
         "snapshot_t0.4.png", "snapshot_t0.7.png"]
     if forks:  # else the figures are drawn in this process (macOS, Windows, one core)
+        assert imported == [], f"pdeflow run --outdir imported {imported}"
+
+
+def test_a_2d_run_draws_its_figure_in_the_figure_workers_process(tmp_path):
+    """A 2D case's folder: its one figure (pdeflow/figures_2d.py), drawn in the worker
+    as the 1D ones are."""
+    import os
+
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}  # this checkout's pdeflow, from tmp_path
+    proc = subprocess.run([sys.executable, "-c", FIGURES, str(ROOT / "cases" /
+                                                               "cylinder_2d.toml"),
+                           str(tmp_path / "out")],
+                          capture_output=True, text=True, cwd=tmp_path, timeout=600, env=env)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    line = next(x for x in proc.stdout.splitlines() if x.startswith("MODULES"))
+    forks, imported = json.loads(line[len("MODULES"):])
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [
+        "final_deposits.png", "summary.json"]
+    if forks:
         assert imported == [], f"pdeflow run --outdir imported {imported}"
