@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from . import systems
-from .initial_shapes_2d import total_depth_2d
+from .initial_shapes_2d import release_centre, total_depth_2d
 
 
 class GridAcross:
@@ -55,6 +55,13 @@ class GridAcross:
     def total_cells(self) -> int:
         """Cells of the grid: :attr:`cells` (along x) times :attr:`cells_y`."""
         return self.cells * self.cells_y
+
+    @property
+    def release_centre(self) -> tuple[float, float]:
+        """The release's centre (x, y) [m] in the grid's coordinates (the shape's x0, y0
+        from the domain's corner, or a polygon's area centroid, plus x_start, y_start)."""
+        x0, y0 = release_centre(self.initial)
+        return self.x_start + x0, self.y_start + y0
 
     def _initial_profiles_2d(self, model: str, grid) -> dict[str, np.ndarray]:
         """:meth:`initial_profiles` on a 2D grid: the 2D shape's total depth

@@ -68,7 +68,7 @@ def _refuse_2d_runs(paths: list[str]) -> None:
 def cmd_plot(args: argparse.Namespace) -> int:
     from .outpaths import FIGURE_SUFFIXES, check_file
     from .plotting import RunFigure, Series, display_name
-    from .storage import open_run
+    from .stored_runs import open_run
 
     positive("--fps", args.fps)
     if args.time is not None and not math.isfinite(args.time):
@@ -131,7 +131,7 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
 def cmd_export(args: argparse.Namespace) -> int:
     from .outpaths import EXPORT_SUFFIXES, check_file
-    from .storage import open_run
+    from .stored_runs import open_run
 
     check_file(args.out, "OUT", EXPORT_SUFFIXES)
     run = open_run(args.run)

@@ -245,13 +245,11 @@ def final_figure_job(results: dict[str, Any], path: str | Path, stops: str) -> t
     """The job (make, args, path) of :func:`final_figure_2d` for the 2D runs of one
     case (``results``: model -> :class:`~pdeflow.simulate.RunResult`), saved at
     ``path``; ``stops`` the title's second line (when each run came to rest)."""
-    from .initial_shapes_2d import release_centre
-
     runs = list(results.values())
     first = runs[0]
     case = first.case
     x, y = first.state.grid.axes_coords
-    y0 = case.y_start + release_centre(case.initial)[1]
+    y0 = case.release_centre[1]
     args = (x, y, [(r.model, r.state.data) for r in runs], [r.t_final for r in runs],
             case.front_threshold, _initial_total(first), y0, display_name(case.name),
             stops)

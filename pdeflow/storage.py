@@ -2,7 +2,8 @@
 
 Writing (``pdeflow run CASE --store out.h5 [--store-every DT]``, or in Python)::
 
-    from pdeflow.storage import RunStorageTracker, open_run, run_metadata
+    from pdeflow.storage import RunStorageTracker, run_metadata
+    from pdeflow.stored_runs import open_run
     tracker = RunStorageTracker("out.h5", interrupts=0.05,
                                 metadata=run_metadata(case, PAPER_MODEL))
     run_model(case, PAPER_MODEL, tracker=tracker)          # or eq.solve(..., tracker=...)
@@ -29,8 +30,8 @@ not thicker than the model's dry tolerance, as in the solver.
 
 A run on a 2D grid (a 2D case, issue 36) is stored the same way, each field of shape
 (nx, ny) (h1, h1u1, h1v1, h2, h2u2, h2v2 or h, hu, hv, then ``fextra_over_rho1``), and
-:func:`open_run` reads it back as a :class:`pdeflow.storage_2d.StoredRun2D` (its
-export has dimensions time, x, y).
+:func:`pdeflow.stored_runs.open_run` reads it back as a
+:class:`pdeflow.storage_2d.StoredRun2D` (its export has dimensions time, x, y).
 
 Files are complete or absent: the run writes to a temporary name next to the target
 (``.NAME.XXXX.part.h5``) and renames it once the run has finished; a run that fails
@@ -240,7 +241,7 @@ class RunStorageTracker(FextraStorageTracker):
 # --- reading ------------------------------------------------------------------------------
 @dataclass
 class StoredRun:
-    """A stored run loaded into memory (see :func:`open_run`)."""
+    """A stored run loaded into memory (see :func:`pdeflow.stored_runs.open_run`)."""
 
     path: Path
     times: np.ndarray
@@ -422,48 +423,5 @@ def stored_axes(path: str | Path) -> int:
         storage.close()
 
 
-def open_run(path: str | Path) -> StoredRun:
-    """Load a stored run (written by :class:`RunStorageTracker` or ``--store``).
-
-    Plain py-pde storages of a granular state (2 or 4 fields, no F_extra, no metadata)
-    are read as well.
-    """
-    path = Path(path)
-    storage = open_storage(path)
-    try:
-        times = np.array(storage.times[:], dtype=float)
-        data = np.array(storage.data[:], dtype=float)
-        grid = storage.grid
-        meta = dict(storage.info.get("pdeflow") or {})
-    except (OSError, KeyError, RuntimeError) as err:
-        raise StorageError(f"{path}: cannot read the stored run ({err})") from None
-    finally:
-        storage.close()
-    if times.size == 0 or data.ndim not in (3, 4) or grid is None:
-        raise StorageError(f"{path}: holds no frames of a 1D or 2D run")
-    axes = data.ndim - 2  # (frames, fields, cells along x[, cells along y])
-    x = np.asarray(grid.axes_coords[0], dtype=float)
-    rows = data.shape[1]
-    # with F_extra/rho1 a frame has one row more than the state: 2 or 4 rows per 1D
-    # state, 3 or 6 per 2D state
-    if meta.get("fields", [None])[-1] == FEXTRA_LABEL or rows in ((3, 5), (4, 7))[axes - 1]:
-        state, fextra = data[:, :-1], data[:, -1]
-    else:
-        state, fextra = data, np.zeros((data.shape[0], *data.shape[2:]))
-    if "model" not in meta:
-        fields = meta.get("fields", [])[:state.shape[1]]
-        try:
-            meta["model"] = systems.of_fields(fields).name
-        except ValueError:
-            raise StorageError(f"{path}: {rows} fields per frame {fields} are no granular "
-                               "run of a registered model") from None
-    if axes == 2:
-        from .storage_2d import StoredRun2D
-
-        y = np.asarray(grid.axes_coords[1], dtype=float)
-        return StoredRun2D(path, times, x, state, fextra, meta, y=y)
-    return StoredRun(path, times, x, state, fextra, meta)
-
-
-__all__ = ["FORMAT", "RunStorageTracker", "StorageError", "StoredRun", "open_run",
-           "open_storage", "run_metadata", "stored_axes"]
+__all__ = ["FORMAT", "RunStorageTracker", "StorageError", "StoredRun", "open_storage",
+           "run_metadata", "stored_axes"]

@@ -1,5 +1,5 @@
 """A stored run on a 2D grid (issue 36): :class:`StoredRun2D`, what
-:func:`pdeflow.storage.open_run` returns for a file of ``pdeflow run CASE2D --store``.
+:func:`pdeflow.stored_runs.open_run` returns for a file of ``pdeflow run CASE2D --store``.
 
 The file is the 1D store's (:mod:`pdeflow.storage`) on py-pde's 2D ``CartesianGrid``:
 each frame is the state h1, h1u1, h1v1, h2, h2u2, h2v2 (two layers) or h, hu, hv (one

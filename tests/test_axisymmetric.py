@@ -157,7 +157,7 @@ def test_axisymmetric_outputs_name_the_radius(tmp_path):
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert "front radius" in proc.stdout
     assert "warning" not in proc.stderr
-    from pdeflow.storage import open_run
+    from pdeflow.stored_runs import open_run
 
     run = open_run(tmp_path / "run.h5")
     assert run.coordinate == "r" and run.metadata["geometry"] == "axisymmetric"

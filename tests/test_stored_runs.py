@@ -25,7 +25,8 @@ h5py = pytest.importorskip("h5py")
 
 
 def test_store_reopen_metadata_and_fextra(tmp_path):
-    from pdeflow.storage import RunStorageTracker, open_run, open_storage, run_metadata
+    from pdeflow.storage import RunStorageTracker, open_storage, run_metadata
+    from pdeflow.stored_runs import open_run
 
     case = load_case(ROOT / "cases" / "paper_5_1_dam_break.toml",
                      ["grid.dx=0.1", "case.t_end=0.2", "output.snapshot_times=[]"])
@@ -72,7 +73,7 @@ def test_cli_store_plot_compare_and_export(tmp_path, capsys, monkeypatch):
     table = np.loadtxt(csv, delimiter=",", skiprows=1)
     assert csv.read_text().splitlines()[0] == "t,x,h,u"
     assert table.shape == (6 * 100, 4)
-    from pdeflow.storage import open_run
+    from pdeflow.stored_runs import open_run
 
     run = open_run(a)
     np.testing.assert_allclose(table[-100:, 2], run.data[-1, 0], rtol=1e-9)

@@ -51,8 +51,9 @@ def test_storing_does_not_change_the_runs_numbers(stored):
 
 
 def test_the_store_holds_the_2d_frames_and_metadata(stored):
-    from pdeflow.storage import open_run, open_storage, stored_axes
+    from pdeflow.storage import open_storage, stored_axes
     from pdeflow.storage_2d import StoredRun2D
+    from pdeflow.stored_runs import open_run
 
     d, plain, _ = stored
     for model, path, final in (("two_layer", d / "a.h5", d / "final.npz"),
@@ -90,7 +91,7 @@ def test_the_store_holds_the_2d_frames_and_metadata(stored):
 
 def test_export_netcdf_has_time_x_y_and_cf_attributes(stored):
     xr = pytest.importorskip("xarray")
-    from pdeflow.storage import open_run
+    from pdeflow.stored_runs import open_run
 
     d, _, _ = stored
     nc = d / "a.nc"
@@ -122,7 +123,7 @@ def test_export_netcdf_has_time_x_y_and_cf_attributes(stored):
 
 
 def test_export_npz_and_csv_of_a_2d_run(stored):
-    from pdeflow.storage import open_run
+    from pdeflow.stored_runs import open_run
 
     d, _, _ = stored
     run = open_run(d / "a.single_layer.h5")

@@ -59,7 +59,8 @@ def test_shallow_water_through_cli_storage_sweep_and_figures(tmp_path):
     model's fields, a sweep gives a run-out per aspect ratio, and the figures draw."""
     from pdeflow.case_figures import case_figures
     from pdeflow.simulate import run_model
-    from pdeflow.storage import RunStorageTracker, open_run, run_metadata
+    from pdeflow.storage import RunStorageTracker, run_metadata
+    from pdeflow.stored_runs import open_run
 
     sets = [f"case.models=['{NAME}']", "output.snapshot_times=[0.1]", "case.t_end=0.2"]
     case = load_case(ROOT / "cases" / "ritter_dam_break.toml", sets)
