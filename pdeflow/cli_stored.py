@@ -17,7 +17,8 @@ The first run is drawn filled (layers stacked on the bed), further runs as lines
 top, for comparison: e.g. the two-layer and single-layer runs of one case, or two
 parameter sets. Each run is shown at its stored time nearest to --time (default: its
 last frame, the final state). A short description of each file is printed.
-Runs on a 2D grid are not plotted yet (issue 36): export them (pdeflow export)."""
+Runs on a 2D grid: the maps and sections of the stored state nearest to --time
+(no --movie yet, issue 36)."""
 
 EXPORT_HELP = """Export a stored run to CSV, NumPy .npz or NetCDF (chosen by the suffix).
 
@@ -54,15 +55,42 @@ def _say_nearest_frames(runs: list[Any], idx: list[int], t: float | None) -> Non
                   f"the nearest, t = {shown:.4g} s{last}", file=sys.stderr)
 
 
-def _refuse_2d_runs(paths: list[str]) -> None:
-    """A StorageError (one line) before any work if a run in ``paths`` is on a 2D grid:
-    the figures of :mod:`pdeflow.plotting` draw profiles along x."""
+def _stored_axes(args: argparse.Namespace) -> int:
+    """The axes of the stored runs' grids (1 or 2), read before any work; a one-line
+    error for a mix, or for ``--movie`` of 2D runs (1D only for now, issue 36)."""
     from .storage import StorageError, stored_axes
 
-    for path in paths:
-        if stored_axes(path) == 2:
-            raise StorageError(f"{path}: plotting a 2D stored run is not available yet "
-                               f"(issue 36); export it: pdeflow export {path} OUT.nc")
+    axes = {stored_axes(p) for p in args.runs}
+    if len(axes) > 1:
+        raise StorageError("pdeflow plot draws 1D runs or 2D runs, not both: "
+                           + ", ".join(args.runs))
+    if axes == {2} and args.movie:
+        raise StorageError("--movie of a 2D stored run is 1D only for now (issue 36)")
+    return axes.pop()
+
+
+def _plot_2d(args: argparse.Namespace, runs: list[Any]) -> Any:
+    """The 2D figure (:func:`pdeflow.figures_2d.final_figure_2d`) of the stored 2D runs
+    at the stored time nearest to ``--time`` (default: the last), saved; its path."""
+    from .cases import Case
+    from .figures_2d import final_figure_2d
+    from .metrics_2d import total_depth
+    from .plotting import display_name, save
+
+    first = runs[0]
+    case = Case.from_dict(first.metadata["case"], source=str(first.path))
+    idx = [r.index(args.time) for r in runs]
+    if not args.quiet:
+        _say_nearest_frames(runs, idx, args.time)
+    title = args.title if args.title is not None else display_name(case.name)
+    last = all(i == len(r.times) - 1 for r, i in zip(runs, idx, strict=True))
+    fig = final_figure_2d(first.x, first.y, [(r.model, r.data[i]) for r, i in
+                                             zip(runs, idx, strict=True)],
+                          [float(r.times[i]) for r, i in zip(runs, idx, strict=True)],
+                          case.front_threshold, total_depth(first.data[0]),
+                          case.release_centre[1], title,
+                          state="last stored state" if last else "stored state")
+    return save(fig, args.out or first.path.with_suffix(".png"))
 
 
 def cmd_plot(args: argparse.Namespace) -> int:
@@ -81,8 +109,15 @@ def cmd_plot(args: argparse.Namespace) -> int:
         from .trackers.live import check_movie_path
 
         check_movie_path(args.movie)
-    _refuse_2d_runs(args.runs)
+    two_d = _stored_axes(args) == 2
     runs = [open_run(p) for p in args.runs]
+    if two_d:
+        written = [_plot_2d(args, runs)]
+        if not args.quiet:
+            for r in runs:
+                print(r.describe())
+            print(f"wrote {written[0]}")
+        return 0
     series = [Series(r.x, r.model, lab, r.dry_tolerance, r.coordinate)
               for r, lab in zip(runs, _plot_labels(runs), strict=True)]
     title = args.title if args.title is not None else display_name(

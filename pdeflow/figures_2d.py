@@ -191,12 +191,14 @@ def cross_sections(ax_x: Any, ax_y: Any, x: np.ndarray, y: np.ndarray,
 
 def final_figure_2d(x: np.ndarray, y: np.ndarray, runs: Sequence[Run2D],
                     times: Sequence[float], threshold: float, initial: np.ndarray,
-                    y0: float, title: str = "", stops: str = "") -> Any:
+                    y0: float, title: str = "", stops: str = "",
+                    state: str = "final state") -> Any:
     """The final state of a 2D case's runs (model name, state data) at ``times`` [s]:
     per run a row of maps (:func:`model_row`), then the cross-sections
     (:func:`cross_sections`); ``x``, ``y`` the cell centres [m], ``threshold`` the
     deposit outline's depth [m], ``initial`` the released total depth [m], ``y0`` the
-    release centre's y [m]; the title: the case's ``title`` and ``stops``."""
+    release centre's y [m]; the title: the case's ``title``, ``state`` (what is drawn)
+    and ``stops``."""
     maps = [2 * len(systems.get(model).layers) for model, _ in runs]
     ncols = max(maps)
     box = plan_box(x, y, [*(m2.total_depth(d) for _, d in runs), initial])
@@ -218,7 +220,7 @@ def final_figure_2d(x: np.ndarray, y: np.ndarray, runs: Sequence[Run2D],
                                 (half - MARGIN - 0.3) / size[0], SECTION / size[1]])
                   for left in (0.0, half))
     cross_sections(ax_x, ax_y, x, y, runs, initial, y0, box)
-    fig.suptitle(f"{title}: final state\n{stops}".strip(), fontsize=10,
+    fig.suptitle(f"{title}: {state}\n{stops}".strip(), fontsize=10,
                  y=1 - 0.08 / size[1], va="top")
     return fig
 

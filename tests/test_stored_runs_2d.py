@@ -142,16 +142,58 @@ def test_export_npz_and_csv_of_a_2d_run(stored):
     np.testing.assert_allclose(last[:16, 2], run.y)
 
 
-@pytest.mark.parametrize("extra", [[], ["--time", "0.2"], ["--movie", "m.gif"]])
-def test_plot_of_a_2d_run_is_one_line_before_any_work(stored, extra, capsys, tmp_path,
-                                                      monkeypatch):
+@pytest.mark.parametrize("extra", [[], ["--time", "0.2"]])
+def test_plot_of_2d_runs_draws_their_maps_at_the_stored_time(stored, extra, capsys,
+                                                             tmp_path, monkeypatch):
+    """``pdeflow plot`` of stored 2D runs draws figures_2d's maps and sections of the
+    stored state nearest to --time (the last by default), one axes per map and a
+    section along x and y: both models' runs, 4 + 2 maps."""
+    import matplotlib.image as mpimg
+
     d, _, _ = stored
     monkeypatch.chdir(tmp_path)
-    assert main(["plot", str(d / "a.h5"), *extra, "--out", "f.png"]) == 2
+    assert main(["plot", str(d / "a.h5"), str(d / "a.single_layer.h5"), *extra,
+                 "--out", "f.png", "-q"]) == 0
+    assert capsys.readouterr().err == ""
+    image = mpimg.imread(tmp_path / "f.png")
+    assert image.shape[0] > 600 and image.shape[1] > 1000  # the maps' rows and sections
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.png"]
+
+
+def test_the_2d_plot_shows_the_state_asked_for(stored, monkeypatch):
+    """The figure of a stored 2D run at --time holds that frame's depths (the maps'
+    images), and its title says it is a stored state, not the final one."""
+    from pdeflow import cli_stored, figures_2d
+    from pdeflow.cli import build_parser
+    from pdeflow.stored_runs import open_run
+
+    d, _, _ = stored
+    drawn = {}
+    draw = figures_2d.final_figure_2d
+
+    def spy(*args, **kwargs):
+        drawn["runs"], drawn["times"], drawn["state"] = args[2], args[3], kwargs["state"]
+        return draw(*args, **kwargs)
+
+    monkeypatch.setattr(figures_2d, "final_figure_2d", spy)
+    run = open_run(d / "a.single_layer.h5")
+    i = run.index(0.2)
+    args = build_parser().parse_args(["plot", str(d / "a.single_layer.h5"), "--time",
+                                      "0.2", "--out", str(d / "g.png"), "-q"])
+    cli_stored.cmd_plot(args)
+    assert drawn["times"] == [float(run.times[i])] and drawn["state"] == "stored state"
+    np.testing.assert_array_equal(drawn["runs"][0][1], run.data[i])
+
+
+def test_a_movie_of_a_2d_run_is_one_line_before_any_work(stored, capsys, tmp_path,
+                                                         monkeypatch):
+    d, _, _ = stored
+    monkeypatch.chdir(tmp_path)
+    assert main(["plot", str(d / "a.h5"), "--movie", "m.gif"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("pdeflow: error:") and err.count("\n") == 1, err
-    assert "plotting a 2D stored run is not available yet (issue 36)" in err
-    assert "pdeflow export" in err and not list(tmp_path.iterdir())
+    assert "--movie of a 2D stored run is 1D only for now (issue 36)" in err
+    assert not list(tmp_path.iterdir())
 
 
 @pytest.mark.parametrize("option, words", [
