@@ -90,10 +90,12 @@ def advect_step_function(order: int, strang: bool, update: Any = None, width: in
 
     ``advect_step(advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
     P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, e_lo, e_hi,
-    b_lo, b_hi, s_rest)`` advances the cells ``b_lo..b_hi`` with the model's kernels (see
+    b_lo, b_hi, s_rest, line)`` advances the cells of the box ``b_lo, b_hi``
+    (:mod:`pdeflow.numerics.boxes`, ``line`` cells a row; on a 1D grid the range
+    ``b_lo..b_hi``) with the model's kernels (see
     :func:`stepping_kernel`): the cells the step may change, saved in ``backup`` (and,
     for Strang, the bookkeeping in ``diag_keep``, ``fex_keep``). The advection stages
-    evaluate the wet cells of ``e_lo..e_hi`` (``b`` widened by one, so that every face
+    evaluate the wet cells of the box ``e_lo, e_hi`` (``b`` widened by one, so that every face
     of a cell of ``b`` is evaluated) and update only those of ``b``; ``s_rest`` [m/s]
     is the largest wave speed of the faces at rest they skip
     (:mod:`pdeflow.numerics.resting`), so that dt is that of a full sweep.

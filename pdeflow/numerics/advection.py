@@ -330,17 +330,21 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
 
     Writes the rate of the state ``q`` (fields x cells, flattened) into ``rate`` in the
     cells it can change, ``r_lo..r_hi``: the wet cells within ``start..stop``
-    (:func:`wet_cells`; all others must be dry) widened by the largest stride of the
-    grid's axes (1 on a 1D grid), clipped to the grid; the rest of ``rate`` is left as it
-    was. Returns the largest wave speed over the faces visited [m/s], on a grid of
-    several axes each face's scaled by (dx / dx_a) times the number of axes, so that
-    ``cfl dx / smax`` bounds the sum over axes of the Courant numbers by ``cfl``; and
-    ``r_lo, r_hi`` (``0.0, 1, 0`` if nothing is wet). ``work`` is scratch space of shape
-    (2, fields, cells); ``g``, ``r``, ``dry``: the model's constants
-    (:attr:`ModelKernels.constants`). ``model`` gives the face states, fluctuations and
-    the MUSCL cell jump; ``flux`` (layout.FLUX_*), ``order`` (1: first order, 2: MUSCL)
-    and ``limiter`` (layout.LIMITER_*) choose the scheme. ``bc_left``, ``bc_right``: the
-    boundary codes of the low and high sides (several axes: :func:`layout.sides`).
+    (:func:`wet_cells`; all others must be dry) widened by one cell, clipped to the
+    grid; the rest of ``rate`` is left as it was. On a 2D grid ``start, stop`` and
+    ``r_lo, r_hi`` are boxes (:mod:`pdeflow.numerics.boxes`: rows x columns, named by
+    their first and last cell): the bounding box of the wet cells of the box ``start,
+    stop``, widened by one cell along both axes; cells outside the box are not read
+    beyond the stencil of its cells, nor written. Returns the largest wave speed over
+    the faces visited [m/s], on a grid of several axes each face's scaled by (dx / dx_a)
+    times the number of axes, so that ``cfl dx / smax`` bounds the sum over axes of the
+    Courant numbers by ``cfl``; and ``r_lo, r_hi`` (``0.0, 1, 0`` if nothing is wet).
+    ``work`` is scratch space of shape (2, fields, cells); ``g``, ``r``, ``dry``: the
+    model's constants (:attr:`ModelKernels.constants`). ``model`` gives the face states,
+    fluctuations and the MUSCL cell jump; ``flux`` (layout.FLUX_*), ``order`` (1: first
+    order, 2: MUSCL) and ``limiter`` (layout.LIMITER_*) choose the scheme. ``bc_left``,
+    ``bc_right``: the boundary codes of the low and high sides (several axes:
+    :func:`layout.sides`).
 
     ``geometry`` (layout.GEOMETRY_*) and ``metric`` (the rows layout.M_* of
     :class:`~pdeflow.numerics.geometry.Metric`) weight the faces. Planar: every weight is

@@ -78,16 +78,6 @@ def box_join(lo: int, hi: int, lo2: int, hi2: int, line: int) -> tuple[int, int]
 
 
 @cached(inline="always")
-def in_box(i: int, lo: int, hi: int, line: int) -> bool:
-    """Whether cell ``i`` lies in the box (lo, hi)."""
-    if lo > hi:
-        return False
-    x = i // line
-    y = i % line
-    return lo // line <= x <= hi // line and lo % line <= y <= hi % line
-
-
-@cached(inline="always")
 def contiguous(lo: int, hi: int, line: int) -> bool:
     """Whether the box (lo, hi) is the range lo..hi of the flattened index (one row,
     or whole rows): then a kernel on cells lo..hi visits exactly the box."""
@@ -130,10 +120,12 @@ def clear_outside(a: np.ndarray, lo: int, hi: int, lo2: int, hi2: int,
                   line: int) -> None:
     """a[:, i] = 0 for the cells i of the box (lo, hi) outside the box (lo2, hi2)."""
     x0, x1, y0, y1 = rows_of(lo, hi, line)
+    a0, a1, b0, b1 = rows_of(lo2, hi2, line)  # (1, 0, 1, 0) if empty: no row inside
     for x in range(x0, x1 + 1):
-        for i in range(x * line + y0, x * line + y1 + 1):
-            if not in_box(i, lo2, hi2, line):
-                a[:, i] = 0.0
+        inside = a0 <= x <= a1
+        for y in range(y0, y1 + 1):
+            if not (inside and b0 <= y <= b1):
+                a[:, x * line + y] = 0.0
 
 
 @cached(inline="always")
@@ -141,10 +133,12 @@ def clear_outside1(a: np.ndarray, lo: int, hi: int, lo2: int, hi2: int,
                    line: int) -> None:
     """:func:`clear_outside` for 1D arrays (one value a cell)."""
     x0, x1, y0, y1 = rows_of(lo, hi, line)
+    a0, a1, b0, b1 = rows_of(lo2, hi2, line)
     for x in range(x0, x1 + 1):
-        for i in range(x * line + y0, x * line + y1 + 1):
-            if not in_box(i, lo2, hi2, line):
-                a[i] = 0.0
+        inside = a0 <= x <= a1
+        for y in range(y0, y1 + 1):
+            if not (inside and b0 <= y <= b1):
+                a[x * line + y] = 0.0
 
 
 def _sources_in_box(sources, q, dt, t, P, diag, lo, hi, line):

@@ -16,13 +16,18 @@ Davis bound of every flux with zero velocities, single or two layers). The loop 
 the running maxima of c from either end of the grid (:func:`extend_prefix`,
 :func:`extend_suffix`) and updates them only where cells froze, so that a run gives the
 same numbers, bit for bit, as one that visits every wet cell
-(``tests/test_resting_cells.py``).
+(``tests/test_resting_cells.py``; 2D: ``tests/test_two_d_dry_margin.py``).
 
 Cells are the flattened index of any grid (:mod:`pdeflow.numerics.geometry`): a cell's
 neighbours are those along its line of the last axis (``line`` cells long; on a 1D grid
 the whole grid) and ``line`` cells before and after it (the first axis of a 2D grid).
-The prefix and suffix maxima run over the flattened index; on a 2D grid the loop scales
-them as the advection stage scales the speeds of its faces.
+The loop's windows are boxes of rows x columns (:mod:`pdeflow.numerics.boxes`; on a 1D
+grid ranges), so on a 2D grid a flow's dry (or resting) margins in y are skipped as well
+as those in x. The running maxima of the rest speeds outside a box
+(:func:`rest_outside`) are kept along the flattened index for the rows before and
+after the box, and along each of the box's rows for its cells before and after the
+box's columns; on a 2D grid the loop scales them as the advection stage scales the
+speeds of its faces.
 """
 
 from __future__ import annotations

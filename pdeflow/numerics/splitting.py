@@ -180,7 +180,9 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
 ADVECT = types.FunctionType(types.Tuple((f8, i8, i8))(*ADVECT_SIGNATURE))
 """type of an advection stage passed to the loop (a function pointer)"""
 SOURCES = types.FunctionType(types.none(STATE, f8, f8, PARAMS, VECTOR, i8, i8))
-"""type of a source stage on a range of cells (e.g. :mod:`pdeflow.models.two_layer.sources`)"""
+"""type of a source stage on a range of cells (e.g. :mod:`pdeflow.models.two_layer.sources`);
+on a 2D grid the loop calls it on each row of a box (:func:`.boxes._sources_in_box` says
+what its bookkeeping must allow)"""
 PREDICTOR = types.FunctionType(types.none(STATE, f8, PARAMS, i8, i8))
 """type of a MUSCL predictor (e.g. :mod:`pdeflow.models.two_layer.friction`)"""
 
