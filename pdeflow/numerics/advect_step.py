@@ -17,6 +17,15 @@ import numpy as np
 from numba import njit
 
 from . import layout as L
+from .boxes import (
+    box_join,
+    box_meet,
+    clear_outside,
+    copy_box,
+    copy_box1,
+    row_calls,
+    update_in_box_function,
+)
 from .compiled import cached
 
 
@@ -58,17 +67,9 @@ def update_kernel(width: int) -> Any:
 
 
 @cached(inline="always")
-def _copy_cells(dst, src, lo, hi):
-    """dst[..., lo:hi + 1] = src[..., lo:hi + 1] for 2D arrays (a loop: numba compiles
-    an array-to-array slice assignment with its shape-mismatch error message, seconds)."""
-    for k in range(dst.shape[0]):
-        for i in range(lo, hi + 1):
-            dst[k, i] = src[k, i]
-
-
-@cached(inline="always")
 def _copy_range(dst, src, lo, hi):
-    """dst[lo:hi + 1] = src[lo:hi + 1] for 1D arrays (see :func:`_copy_cells`)."""
+    """dst[lo:hi + 1] = src[lo:hi + 1] for 1D arrays (a loop: numba compiles an
+    array-to-array slice assignment with its shape-mismatch error message, seconds)."""
     for i in range(lo, hi + 1):
         dst[i] = src[i]
 
@@ -89,10 +90,12 @@ def advect_step_function(order: int, strang: bool, update: Any = None, width: in
 
     ``advect_step(advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
     P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, e_lo, e_hi,
-    b_lo, b_hi, s_rest)`` advances the cells ``b_lo..b_hi`` with the model's kernels (see
+    b_lo, b_hi, s_rest, line)`` advances the cells of the box ``b_lo, b_hi``
+    (:mod:`pdeflow.numerics.boxes`, ``line`` cells a row; on a 1D grid the range
+    ``b_lo..b_hi``) with the model's kernels (see
     :func:`stepping_kernel`): the cells the step may change, saved in ``backup`` (and,
     for Strang, the bookkeeping in ``diag_keep``, ``fex_keep``). The advection stages
-    evaluate the wet cells of ``e_lo..e_hi`` (``b`` widened by one, so that every face
+    evaluate the wet cells of the box ``e_lo, e_hi`` (``b`` widened by one, so that every face
     of a cell of ``b`` is evaluated) and update only those of ``b``; ``s_rest`` [m/s]
     is the largest wave speed of the faces at rest they skip
     (:mod:`pdeflow.numerics.resting`), so that dt is that of a full sweep.
@@ -103,17 +106,21 @@ def advect_step_function(order: int, strang: bool, update: Any = None, width: in
     layer; ``two_d``: a 2D grid (the wave speeds are scaled, :func:`speed_scale`).
     """
     muscl = order == 2
+    compiled = update is None
     update = update or update_kernel(width)
+    update_box = update_in_box_function(update)
+    if compiled:
+        update_box = njit(inline="always")(update_box)
+    sources_box, predictor_box = row_calls(compiled)
 
     def advect_step(advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
                     P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep,
-                    first, e_lo, e_hi, b_lo, b_hi, s_rest):
+                    first, e_lo, e_hi, b_lo, b_hi, s_rest, line):
         fex = diag[L.N_DIAG:]
         smax, a_lo, a_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry,
                                   e_lo, e_hi)
         smax = max(smax, s_rest)
-        a_lo = max(a_lo, b_lo)
-        a_hi = min(a_hi, b_hi)
+        a_lo, a_hi = box_meet(a_lo, a_hi, b_lo, b_hi, line)
         dt = t_end - t
         if strang:
             # the first half source step may accelerate a layer by up to dt/2 |g_x|
@@ -130,45 +137,39 @@ def advect_step_function(order: int, strang: bool, update: Any = None, width: in
             h_hi = b_hi if first else a_hi
             for attempt in range(40):
                 diag[L.D_DT] = 0.5 * dt
-                sources(q, 0.5 * dt, t, P, diag, h_lo, h_hi)
+                sources_box(sources, q, 0.5 * dt, t, P, diag, h_lo, h_hi, line)
                 changed = diag[L.D_CHANGED]
                 # (a deposit can lift a cell of sub-dry layers above dry: search wider)
                 smax2, a_lo, a_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry,
                                            e_lo, e_hi)
                 smax2 = max(smax2, s_rest)
-                a_lo = max(a_lo, b_lo)
-                a_hi = min(a_hi, b_hi)
+                a_lo, a_hi = box_meet(a_lo, a_hi, b_lo, b_hi, line)
                 if smax2 * dt <= cfl * dx * (1.0 + 1e-9) or attempt == 39:
                     break
                 # the half source step made the waves faster than dt allows (erosion
                 # can deepen the upper layer 1/r-fold): undo it and retry shorter
-                _copy_cells(q, backup, b_lo, b_hi)
+                copy_box(q, backup, b_lo, b_hi, line)
                 _copy_range(diag, diag_keep, 0, L.N_DIAG - 1)
-                _copy_range(fex, fex_keep, b_lo, b_hi)
+                copy_box1(fex, fex_keep, b_lo, b_hi, line)
                 dt = min(0.5 * dt, cfl * dx / smax2)
         if not muscl:
-            mass_rate, ok = update(q, q, rate, dt, 0.0, a_lo, a_hi)
+            mass_rate, ok = update_box(q, q, rate, dt, 0.0, a_lo, a_hi, line)
             return dt, mass_rate, ok, a_lo, a_hi, changed
-        _copy_cells(q0, q, b_lo, b_hi)
-        mass_rate, ok = update(q, q0, rate, dt, 0.0, a_lo, a_hi)
+        copy_box(q0, q, b_lo, b_hi, line)
+        mass_rate, ok = update_box(q, q0, rate, dt, 0.0, a_lo, a_hi, line)
         if ok:
-            predictor(q, dt, P, a_lo, a_hi)
+            predictor_box(predictor, q, dt, P, a_lo, a_hi, line)
             _, c_lo, c_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry, e_lo,
                                    e_hi)
-            c_lo = max(c_lo, b_lo)
-            c_hi = min(c_hi, b_hi)
-            # cells of the first stage that the second does not reach get rate 0
-            for i in range(a_lo, a_hi + 1):
-                if i < c_lo or i > c_hi:
-                    rate[:, i] = 0.0
-            if a_lo > a_hi:
-                a_lo = c_lo
-                a_hi = c_hi
-            elif c_lo <= c_hi:
-                a_lo = min(a_lo, c_lo)
-                a_hi = max(a_hi, c_hi)
-            mass2, ok = update(q, q0, rate, dt, 0.5, a_lo, a_hi)
+            c_lo, c_hi = box_meet(c_lo, c_hi, b_lo, b_hi, line)
+            # cells of the first stage that the second does not reach get rate 0 (on a
+            # 2D grid also those of the joined box in neither: their rate is stale)
+            u_lo, u_hi = box_join(a_lo, a_hi, c_lo, c_hi, line)
+            clear_outside(rate, u_lo, u_hi, c_lo, c_hi, line)
+            mass2, ok = update_box(q, q0, rate, dt, 0.5, u_lo, u_hi, line)
             mass_rate = max(mass_rate, mass2)
+            a_lo = u_lo
+            a_hi = u_hi
         return dt, mass_rate, ok, a_lo, a_hi, changed
 
     return advect_step

@@ -41,6 +41,7 @@ import numpy as np
 from numba import njit
 
 from . import layout as L
+from .boxes import box_grow, box_of, rows_of, zero_box
 from .compiled import FIELDS, METRIC, STATE, WORK, cached, f8, i8, kernel, specialise
 from .model_kernels import ModelKernels, check_flux
 from .state import velocity
@@ -163,19 +164,41 @@ def line_wet(q: np.ndarray, dry: float, width: int, base: int, stride: int, k0: 
     return klo, khi
 
 
+@cached(inline="always")
+def wet_box(q: np.ndarray, dry: float, lo: int, hi: int, width: int,
+            line: int) -> tuple[int, int]:
+    """The bounding box of the wet cells (:func:`wet_cells`) of the box (lo, hi) of a
+    grid of ``line`` cells a row (:mod:`pdeflow.numerics.boxes`); ``(1, 0)`` if none."""
+    x0, x1, y0, y1 = rows_of(lo, hi, line)
+    a0 = x1 + 1
+    a1 = x0 - 1
+    b0 = y1 + 1
+    b1 = y0 - 1
+    for x in range(x0, x1 + 1):
+        klo, khi = line_wet(q, dry, width, x * line, 1, y0, y1)
+        if klo <= khi:
+            a0 = min(a0, x)
+            a1 = x
+            b0 = min(b0, klo)
+            b1 = max(b1, khi)
+    return box_of(a0, a1, b0, b1, line)
+
+
 def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, axis: int,
                     axisymmetric: bool, lines: bool) -> Any:
     """The faces of one axis as a Python closure (inlined into the advection stage):
 
     ``faces(q, qm, qp, rate, metric, lo, hi, stride, count, inv_dx, s_lo, s_hi, g, r,
-    dry) -> smax`` subtracts the fluctuations of the axis' faces next to the wet cells
-    of ``lo..hi`` (``qp``: the face values on the cells' high sides, ``qm`` on their low
-    sides) from ``rate``, weighted ``inv_dx`` [1/m] (axisymmetric: the metric's rows),
-    in the rows ``rows`` (``width`` rows per layer); line by line of the axis
-    (``lines``; else the one line of a 1D grid, whose wet cells are ``lo..hi``), in each
-    the faces between and beside its wet cells as on a 1D grid: interior faces first,
-    then the low and the high boundary sides, whose ghost cells have their normal
-    momenta times ``s_lo``, ``s_hi`` (-1: wall, 1: open). Returns the largest wave speed [m/s].
+    dry, per_row) -> smax`` subtracts the fluctuations of the axis' faces next to the wet
+    cells of ``lo..hi`` (``qp``: the face values on the cells' high sides, ``qm`` on
+    their low sides) from ``rate``, weighted ``inv_dx`` [1/m] (axisymmetric: the
+    metric's rows), in the rows ``rows`` (``width`` rows per layer); line by line of the
+    axis (``lines``: a 2D grid of ``per_row`` cells a row, and ``lo, hi`` a box,
+    :mod:`pdeflow.numerics.boxes`, whose cells on each line are all that line's visited;
+    else the one line of a 1D grid, whose wet cells are ``lo..hi``), in each the faces
+    between and beside its wet cells as on a 1D grid: interior faces first, then the
+    low and the high boundary sides, whose ghost cells have their normal momenta times
+    ``s_lo``, ``s_hi`` (-1: wall, 1: open). Returns the largest wave speed [m/s].
 
     A line's faces beyond its last wet cell are not visited, as on a 1D grid: a face
     between sub-dry traces of depth is not exactly zero (its hydrostatic jump), so
@@ -219,23 +242,24 @@ def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, ax
         return smax
 
     def faces(q, qm, qp, rate, metric, lo, hi, stride, count, inv_dx, s_lo, s_hi, g, r,
-              dry):
+              dry, per_row):
         if not lines:
             return line(qm, qp, rate, metric, 0, 1, count, lo, hi, inv_dx, s_lo, s_hi, g,
                         r, dry)
+        # a 2D grid: the axis' lines through the box (lo, hi), each over the box's cells
+        # on it only, so that the dry margins beside a flow are not swept
+        x0, x1, y0, y1 = rows_of(lo, hi, per_row)
+        if axis == 1:  # lines of the last axis: the box's rows
+            l0, l1, step, k0, k1 = x0, x1, per_row, y0, y1
+        else:  # lines of the first axis: the box's columns
+            l0, l1, step, k0, k1 = y0, y1, 1, x0, x1
         smax = 0.0
-        block = stride * count
-        c0 = (lo // block) * block
-        while c0 <= hi:
-            for j in range(stride):
-                base = c0 + j  # the line of cells base + k stride, k = 0..count - 1
-                k0 = max(0, (lo - base + stride - 1) // stride)
-                k1 = min(count - 1, (hi - base) // stride)
-                klo, khi = line_wet(q, dry, width, base, stride, k0, k1)
-                if klo <= khi:
-                    smax = max(smax, line(qm, qp, rate, metric, base, stride, count, klo,
-                                          khi, inv_dx, s_lo, s_hi, g, r, dry))
-            c0 += block
+        for m in range(l0, l1 + 1):
+            base = m * step  # the line of cells base + k stride, k = 0..count - 1
+            klo, khi = line_wet(q, dry, width, base, stride, k0, k1)
+            if klo <= khi:
+                smax = max(smax, line(qm, qp, rate, metric, base, stride, count, klo, khi,
+                                      inv_dx, s_lo, s_hi, g, r, dry))
         return smax
 
     return faces
@@ -245,9 +269,10 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
                    axisymmetric: bool, lines: bool) -> Any:
     """One axis' part of the advection stage as a Python closure (inlined):
     ``along(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count, inv_dx, bc_lo,
-    bc_hi, g, r, dry) -> smax``: MUSCL's face values along the axis in cells
+    bc_hi, g, r, dry, per_row) -> smax``: MUSCL's face values along the axis in cells
     ``r_lo..r_hi``, the axis' faces next to ``lo..hi`` (:func:`_faces_function`), the
-    MUSCL cell jump along the axis."""
+    MUSCL cell jump along the axis; with ``lines`` (a 2D grid of ``per_row`` cells a
+    row) ``lo, hi`` and ``r_lo, r_hi`` are boxes (:mod:`pdeflow.numerics.boxes`)."""
     check_flux(model, flux)
     rows = model.axis_rows(axis)
     width = model.layer_rows
@@ -259,9 +284,12 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
     cell_jump = model.cell_jump if muscl else None
 
     def along(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count, inv_dx, bc_lo,
-              bc_hi, g, r, dry):
+              bc_hi, g, r, dry, per_row):
+        x0, x1, y0, y1 = rows_of(r_lo, r_hi, per_row) if lines else (0, 0, r_lo, r_hi)
         if muscl:
-            reconstruct(q, work, r_lo, r_hi, stride, count, bc_lo, bc_hi, dry, limiter)
+            for x in range(x0, x1 + 1):  # a 2D grid's box row by row
+                reconstruct(q, work, x * per_row + y0, x * per_row + y1, stride, count,
+                            bc_lo, bc_hi, dry, limiter)
             qm = work[0]
             qp = work[1]
         else:
@@ -271,10 +299,12 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
         s_lo = -1.0 if bc_lo == L.BC_WALL else 1.0
         s_hi = -1.0 if bc_hi == L.BC_WALL else 1.0
         smax = faces(q, qm, qp, rate, metric, lo, hi, stride, count, inv_dx, s_lo, s_hi, g,
-                     r, dry)
+                     r, dry, per_row)
         if muscl:
             # axisymmetric too: the mean face area over the volume is 1/dr exactly
-            cell_jump(qm, qp, rate, r_lo, r_hi, inv_dx, g, r, dry, axis)
+            for x in range(x0, x1 + 1):
+                cell_jump(qm, qp, rate, x * per_row + y0, x * per_row + y1, inv_dx, g, r,
+                          dry, axis)
         return smax
 
     return along
@@ -300,17 +330,21 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
 
     Writes the rate of the state ``q`` (fields x cells, flattened) into ``rate`` in the
     cells it can change, ``r_lo..r_hi``: the wet cells within ``start..stop``
-    (:func:`wet_cells`; all others must be dry) widened by the largest stride of the
-    grid's axes (1 on a 1D grid), clipped to the grid; the rest of ``rate`` is left as it
-    was. Returns the largest wave speed over the faces visited [m/s], on a grid of
-    several axes each face's scaled by (dx / dx_a) times the number of axes, so that
-    ``cfl dx / smax`` bounds the sum over axes of the Courant numbers by ``cfl``; and
-    ``r_lo, r_hi`` (``0.0, 1, 0`` if nothing is wet). ``work`` is scratch space of shape
-    (2, fields, cells); ``g``, ``r``, ``dry``: the model's constants
-    (:attr:`ModelKernels.constants`). ``model`` gives the face states, fluctuations and
-    the MUSCL cell jump; ``flux`` (layout.FLUX_*), ``order`` (1: first order, 2: MUSCL)
-    and ``limiter`` (layout.LIMITER_*) choose the scheme. ``bc_left``, ``bc_right``: the
-    boundary codes of the low and high sides (several axes: :func:`layout.sides`).
+    (:func:`wet_cells`; all others must be dry) widened by one cell, clipped to the
+    grid; the rest of ``rate`` is left as it was. On a 2D grid ``start, stop`` and
+    ``r_lo, r_hi`` are boxes (:mod:`pdeflow.numerics.boxes`: rows x columns, named by
+    their first and last cell): the bounding box of the wet cells of the box ``start,
+    stop``, widened by one cell along both axes; cells outside the box are not read
+    beyond the stencil of its cells, nor written. Returns the largest wave speed over
+    the faces visited [m/s], on a grid of several axes each face's scaled by (dx / dx_a)
+    times the number of axes, so that ``cfl dx / smax`` bounds the sum over axes of the
+    Courant numbers by ``cfl``; and ``r_lo, r_hi`` (``0.0, 1, 0`` if nothing is wet).
+    ``work`` is scratch space of shape (2, fields, cells); ``g``, ``r``, ``dry``: the
+    model's constants (:attr:`ModelKernels.constants`). ``model`` gives the face states,
+    fluctuations and the MUSCL cell jump; ``flux`` (layout.FLUX_*), ``order`` (1: first
+    order, 2: MUSCL) and ``limiter`` (layout.LIMITER_*) choose the scheme. ``bc_left``,
+    ``bc_right``: the boundary codes of the low and high sides (several axes:
+    :func:`layout.sides`).
 
     ``geometry`` (layout.GEOMETRY_*) and ``metric`` (the rows layout.M_* of
     :class:`~pdeflow.numerics.geometry.Metric`) weight the faces. Planar: every weight is
@@ -342,28 +376,36 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
     area_change = (_area_change_muscl if muscl else _area_change) if axisymmetric else None
 
     def advect(q, rate, work, dx, metric, bc_left, bc_right, g, r, dry, start, stop):
-        lo, hi = wet_cells(q, dry, start, stop, width)
         n = q.shape[1]
-        if lo > hi:
-            return 0.0, 1, 0
-        reach = int(metric[L.M_AXES, 0]) if two_d else 1  # the largest stride
-        r_lo = max(lo - reach, 0)
-        r_hi = min(hi + reach, n - 1)
-        rate[:, r_lo:r_hi + 1] = 0.0
         if not two_d:
+            lo, hi = wet_cells(q, dry, start, stop, width)
+            if lo > hi:
+                return 0.0, 1, 0
+            r_lo = max(lo - 1, 0)
+            r_hi = min(hi + 1, n - 1)
+            rate[:, r_lo:r_hi + 1] = 0.0
             smax = along_x(q, rate, work, metric, lo, hi, r_lo, r_hi, 1, n, 1.0 / dx,
-                           bc_left, bc_right, g, r, dry)
+                           bc_left, bc_right, g, r, dry, n)
             if axisymmetric and muscl:
                 area_change(work[0], work[1], rate, r_lo, r_hi, metric, dry, width)
             elif axisymmetric:
                 area_change(q, q, rate, r_lo, r_hi, metric, dry, width)
             return smax, r_lo, r_hi
+        # a 2D grid: start, stop and what is returned are boxes, the wet cells' widened
+        # by one cell along both axes: the cells their faces write to
+        per_row = int(metric[L.M_AXES, 4])
+        lo, hi = wet_box(q, dry, start, stop, width, per_row)
+        if lo > hi:
+            return 0.0, 1, 0
+        r_lo, r_hi = box_grow(lo, hi, 1, per_row, n)
+        zero_box(rate, r_lo, r_hi, per_row)
         stride, count, inv_width, scale = _axis(metric, 0, dx)
         smax = scale * along_x(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count,
-                               inv_width, bc_left & 1, bc_right & 1, g, r, dry)
+                               inv_width, bc_left & 1, bc_right & 1, g, r, dry, per_row)
         stride, count, inv_width, scale = _axis(metric, 1, dx)
         s = scale * along_y(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count,
-                            inv_width, (bc_left >> 1) & 1, (bc_right >> 1) & 1, g, r, dry)
+                            inv_width, (bc_left >> 1) & 1, (bc_right >> 1) & 1, g, r, dry,
+                            per_row)
         return max(smax, s), r_lo, r_hi
 
     return specialise(advect, *ADVECT_SIGNATURE)

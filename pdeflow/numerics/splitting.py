@@ -29,8 +29,9 @@ import numpy as np
 from numba import njit, types
 
 from . import layout as L
-from .advect_step import _copy_cells, _copy_range, advect_step_function, speed_scale
+from .advect_step import _copy_range, advect_step_function, speed_scale
 from .advection import ADVECT_SIGNATURE, advection_kernel
+from .boxes import box_grow, clear_outside1, copy_box, copy_box1, row_calls
 from .compiled import (
     FIELDS,
     METRIC,
@@ -47,7 +48,7 @@ from .compiled import (
     specialise,
 )
 from .model_kernels import ModelKernels
-from .resting import extend_prefix, extend_suffix, live_cells
+from .resting import live_box, rest_changed, rest_maxima, rest_outside
 from .resting import reach as reach_of
 
 STATUS_END = 0  #: reached t_end
@@ -57,25 +58,25 @@ MAX_RETRIES = 30  #: halvings of dt tried on a step that left a depth negative
 
 
 def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
-                      width: int = 2, two_d: bool = False) -> Any:
+                      width: int = 2, two_d: bool = False, compiled: bool = True) -> Any:
     """The stepping loop as a Python closure (compiled by :func:`stepping_kernel`, which
     documents it); ``advect_step`` is :func:`advect_step_function`, ``reach`` that of
     its reconstruction order (:func:`pdeflow.numerics.resting.reach`), ``width`` the
-    model's rows per layer, ``two_d`` a 2D grid.
+    model's rows per layer, ``two_d`` a 2D grid, ``compiled`` whether the loop is
+    compiled (else it runs in Python, :func:`python_stepping`).
 
-    Windows of cells are ranges of the flattened cell index: on a 2D grid a window
-    widened by ``reach`` strides of the first axis (the largest) holds every cell within
-    ``reach`` of its cells along either axis, a conservative over-approximation of the
-    stencil (it also holds the rest of those rows); on a 1D grid the stride is 1.
+    The loop's windows of cells are boxes (:mod:`pdeflow.numerics.boxes`): the bounding
+    box of the live cells widened by ``reach`` cells along every axis, so that on a 2D
+    grid the dry (or resting) cells beside a flow in y are skipped as well as those
+    ahead of it in x; on a 1D grid a box is a range of cells.
     """
+    sources_box = row_calls(compiled)[0]
 
     def advance(q, t, t_pause, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag,
                 rate, backup, diag_backup, work, prev, max_steps, stop_at_rest, advect, sources,
                 predictor, fallback):
         n = q.shape[1]
-        # a line of the last axis, and the largest stride in the cell index
-        line = int(metric[L.M_AXES, 4]) if two_d else n
-        stride = int(metric[L.M_AXES, 0]) if two_d else 1
+        line = int(metric[L.M_AXES, 4]) if two_d else n  # a line of the last axis
         scale = speed_scale(metric, dx) if two_d else 1.0
         steps = 0
         rec = work[:2]
@@ -94,41 +95,18 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
         v_hi = n - 1 if first else int(diag[L.D_LIVE_HI])
         s_lo = 0
         s_hi = n - 1
-        # running maxima of the wave speed of cells at rest, from the left and right
-        # ends: valid for cells < p_ok and >= s_ok (none has changed since)
-        pre = np.zeros(n)
-        suf = np.zeros(n)
-        p_ok = 0
-        s_ok = n
+        # running maxima of the wave speed of the cells at rest outside the box visited
+        speeds, valid = rest_maxima(n, line)
         while t < t_pause and steps < max_steps:
-            if first:
-                b_lo = 0
-                b_hi = n - 1
-            elif v_lo > v_hi:
-                b_lo = 1
-                b_hi = 0
-            else:
-                b_lo = max(v_lo - reach * stride, 0)
-                b_hi = min(v_hi + reach * stride, n - 1)
-            if b_lo <= b_hi:
-                e_lo = max(b_lo - stride, 0)
-                e_hi = min(b_hi + stride, n - 1)
-            else:
-                e_lo = n  # nothing is evaluated: every cell is at rest or dry
-                e_hi = n - 1
-            s_rest = 0.0
-            if e_lo > 0:
-                p_ok = extend_prefix(pre, q, p_ok, e_lo, g, dry, width, line)
-                s_rest = pre[e_lo - 1]
-            if e_hi < n - 1:
-                s_ok = extend_suffix(suf, q, s_ok, e_hi + 1, g, dry, width, line)
-                s_rest = max(s_rest, suf[e_hi + 1])
+            b_lo, b_hi = (0, n - 1) if first else box_grow(v_lo, v_hi, reach, line, n)
+            e_lo, e_hi = box_grow(b_lo, b_hi, 1, line, n)
+            s_rest = rest_outside(speeds, valid, q, e_lo, e_hi, g, dry, width, line)
             if two_d:
                 s_rest *= scale
-            _copy_cells(backup, q, b_lo, b_hi)
+            copy_box(backup, q, b_lo, b_hi, line)
             if strang or ifcp:
                 _copy_range(diag_keep, diag, 0, L.N_DIAG - 1)
-                _copy_range(fex_keep, fex, b_lo, b_hi)
+                copy_box1(fex_keep, fex, b_lo, b_hi, line)
             # One call site of the (inlined) advection stage for every attempt: numba
             # types and lowers an inlined function again at each site.
             fell_back = False
@@ -138,7 +116,8 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
                 dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
                     fallback if fell_back else advect, sources, predictor, q, t, step_end,
                     dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag, rate, backup,
-                    rec, q0, diag_keep, fex_keep, first, e_lo, e_hi, b_lo, b_hi, s_rest)
+                    rec, q0, diag_keep, fex_keep, first, e_lo, e_hi, b_lo, b_hi, s_rest,
+                    line)
                 if ok:
                     break
                 if ifcp and not fell_back:
@@ -154,46 +133,41 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
                     step_end = t + 0.5 * dt
                 else:
                     break
-                _copy_cells(q, backup, b_lo, b_hi)
+                copy_box(q, backup, b_lo, b_hi, line)
                 if strang or ifcp:
                     _copy_range(diag, diag_keep, 0, L.N_DIAG - 1)
-                    _copy_range(fex, fex_keep, b_lo, b_hi)
+                    copy_box1(fex, fex_keep, b_lo, b_hi, line)
             if fell_back:
                 diag[L.D_FLUX_FALLBACKS] += 1.0
             diag[L.D_RETRIES] += retries
             t_new = t + dt if dt < t_end - t else t_end
             if not ok:
-                _copy_cells(q, backup, b_lo, b_hi)
+                copy_box(q, backup, b_lo, b_hi, line)
                 return t, steps, STATUS_FAIL
             diag[L.D_DT] = 0.5 * dt if strang else dt
             if first:
                 a_lo = 0
                 a_hi = n - 1
-            elif a_lo > a_hi:
-                a_lo = s_lo  # nothing wet: the stage only needs to clear the last F_extra
-                a_hi = s_lo - 1
-            # F_extra of cells that left the active region
-            for i in range(s_lo, min(s_hi, a_lo - 1) + 1):
-                fex[i] = 0.0
-            for i in range(max(s_lo, a_hi + 1), s_hi + 1):
-                fex[i] = 0.0
-            sources(q, 0.5 * dt if strang else dt, t_new, P, diag, a_lo, a_hi)
+            # F_extra of cells that left the active region (if nothing is wet, the stage
+            # only needs to clear the last F_extra)
+            clear_outside1(fex, s_lo, s_hi, a_lo, a_hi, line)
+            sources_box(sources, q, 0.5 * dt if strang else dt, t_new, P, diag, a_lo, a_hi,
+                        line)
             changed = max(changed, diag[L.D_CHANGED])
             s_lo = a_lo
             s_hi = a_hi
             if b_lo <= b_hi:
-                v_lo, v_hi = live_cells(q, backup, b_lo, b_hi, width)
-                p_ok = min(p_ok, b_lo)
-                s_ok = max(s_ok, b_hi + 1)
+                v_lo, v_hi = live_box(q, backup, b_lo, b_hi, width, line)
+                rest_changed(valid, b_lo, b_hi, line)
             diag[L.D_LIVE_LO] = v_lo
             diag[L.D_LIVE_HI] = v_hi
             diag[L.D_RESUME] = 1.0
             first = False
             if t_new >= t_pause:
                 # the state before this step, for output at t_pause (interpolated by the
-                # caller): the step changed cells b_lo..b_hi only, kept in backup
-                _copy_cells(prev, q, 0, n - 1)
-                _copy_cells(prev, backup, b_lo, b_hi)
+                # caller): the step changed the cells of box b only, kept in backup
+                copy_box(prev, q, 0, n - 1, line)
+                copy_box(prev, backup, b_lo, b_hi, line)
             t = t_new
             steps += 1
             if stop_at_rest and mass_rate == 0.0 and changed == 0.0:
@@ -206,7 +180,9 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
 ADVECT = types.FunctionType(types.Tuple((f8, i8, i8))(*ADVECT_SIGNATURE))
 """type of an advection stage passed to the loop (a function pointer)"""
 SOURCES = types.FunctionType(types.none(STATE, f8, f8, PARAMS, VECTOR, i8, i8))
-"""type of a source stage on a range of cells (e.g. :mod:`pdeflow.models.two_layer.sources`)"""
+"""type of a source stage on a range of cells (e.g. :mod:`pdeflow.models.two_layer.sources`);
+on a 2D grid the loop calls it on each row of a box (:func:`.boxes._sources_in_box` says
+what its bookkeeping must allow)"""
 PREDICTOR = types.FunctionType(types.none(STATE, f8, PARAMS, i8, i8))
 """type of a MUSCL predictor (e.g. :mod:`pdeflow.models.two_layer.friction`)"""
 
@@ -332,5 +308,5 @@ def python_stepping(model: ModelKernels, flux: int, order: int, limiter: int,
     width = model.layer_rows
     loop = stepping_function(compiled.ifcp, strang,
                              advect_step_function(order, strang, update, width, compiled.two_d),
-                             reach_of(order), width, compiled.two_d)
+                             reach_of(order), width, compiled.two_d, compiled=False)
     return functools.partial(compiled.run, loop)
