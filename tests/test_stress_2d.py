@@ -174,3 +174,29 @@ def test_a_state_mirrored_across_the_slope_gives_the_mirrored_run_long(scenario,
     """:func:`test_a_state_mirrored_across_the_slope_gives_the_mirrored_run` on 1000
     states."""
     check_mirror(scenario, n_steps)
+
+
+def test_friction_newton_stops_where_the_lower_layer_is_stuck_to_round_off():
+    """Found by test_random_2d_states_keep_the_invariants_every_law (slow run,
+    two/hll/first-order+strang-mu_i: layers of ~1e-5 m, r = 0.064, exchange 'none'; the
+    hypothesis blob is in the report of issue 36's verification 7). One cell's implicit
+    friction (velocities b [m/s], m1 = r h1 and m2 = h2 [m], the interface's K dt = 0
+    and C dt, the bed's B dt [m^2/s]): the lower layer is pushed just past its bound, so
+    the 2D Newton step solves for its velocity, whose iterates fall to |u2| ~ 1e-18 m/s.
+    There the Hessian's B dt/|u2| term (~1e10 m) makes it rank one to round-off, its
+    determinant rounded to 0, and the compiled kernel raised ZeroDivisionError; inside
+    the stepper numba swallowed it and left the source stage half done (dry cells kept
+    their momentum). Newton now stops at that iterate, the minimum to round-off."""
+    from pdeflow.models.two_layer.friction_2d import _upper_over, friction_two_layer_2d
+    from pdeflow.numerics.compiled import ready
+
+    b1x, b1y, b2x, b2y = (0.008141392258105819, -0.013373215375611494,
+                          0.005889556549602334, -0.0024680719583932125)
+    m1, m2, kdt, cdt, bdt = (2.9497088043108923e-07, 3.3266591051888287e-06, 0.0,
+                             1.9479721315184736e-06, 2.156737456542439e-08)
+    u1x, u1y, u2x, u2y = ready(friction_two_layer_2d)(b1x, b1y, b2x, b2y, m1, m2, kdt,
+                                                      cdt, bdt)
+    assert np.hypot(u2x, u2y) < 1e-15  # stuck, to round-off
+    # the upper layer slides over it as over a lower layer at rest
+    s, nx, ny, _, _ = ready(_upper_over)(0.0, 0.0, b1x, b1y, m1, kdt, cdt)
+    np.testing.assert_allclose([u1x, u1y], [s * nx, s * ny], rtol=1e-12)
