@@ -306,12 +306,15 @@ def scenarios(draw, axes: int = 1, **fixed) -> Scenario:
         flux, rec = draw(st.sampled_from(SCHEMES))
         scheme = {"flux": flux, "reconstruction": rec}
     splitting = choose("splitting", st.sampled_from(["lie", "strang"]))
-    if splitting == "strang" and two:
+    if splitting == "strang" and two and axes == 1:
         # known bug (docs/stability.md, test_strang_step_keeps_the_cfl_condition): Strang
         # takes dt before its first half source step; erosion in that half step turns
         # lower-layer material into upper-layer material 1/r times deeper, the wave
         # speed grows and the advection breaks the CFL condition. Without exchange the
         # half step only brakes, or accelerates by gravity, which dt accounts for.
+        # Fixed since (the stepper undoes such a half step and retries with a shorter
+        # dt: docs/stability.md, finding 2); the 1D draws keep the restriction, so that
+        # their examples stay those recorded, the 2D ones run Strang with exchange.
         params["exchange_closure"] = "none"
     if axes == 2:
         # cells from 1/3 to 3 times as wide across as along the slope
