@@ -152,18 +152,21 @@ def mirrored(scenario: Scenario) -> Scenario:
                     scenario.width)
 
 
-MIRROR_TOLERANCE = 1e-12
+MIRROR_TOLERANCE = {False: 1e-12, True: 1e-9}
 """|difference| allowed between a run and its mirrored run, relative to the largest
-|value| of each field [-]: not bit for bit, since a cell adds its low and high y-faces'
-terms in the same order however the state is mirrored, so mirrored cells round
-differently (measured: 22 of 150 runs bit-identical, the others within 7e-14 after up
-to 30 steps, the times within 5e-15)"""
+|value| of each field (and for the times) [-], by two-layer or not. Not bit for bit: a
+cell adds its low and high y-faces' terms in the same order however the state is
+mirrored, so mirrored cells round differently (measured over 150 runs of both models:
+22 bit-identical, the others within 7e-14 after up to 30 steps). The two-layer model's
+restoration and friction iterate (bisection, Newton) and its flow amplifies that
+round-off: the slow run found 6.5e-11 after 18 steps (paper closure, MUSCL), within
+the 1e-9 of its x <-> y mirror (tests/test_two_d_two_layer_pde.py, docs/two_d.md)."""
 
 
 def check_mirror(scenario: Scenario, n_steps: int) -> None:
     """Run ``scenario`` and :func:`mirrored` ``n_steps`` single fv-split steps each:
     the times and the final state, read back from y = W - y with hv negated, agree to
-    :data:`MIRROR_TOLERANCE`."""
+    :data:`MIRROR_TOLERANCE` of its model."""
     note(repr(scenario))
     runs = []
     for s in (scenario, mirrored(scenario)):
@@ -178,9 +181,10 @@ def check_mirror(scenario: Scenario, n_steps: int) -> None:
     (t1, q1), (t2, q2) = runs
     back = q2[:, :, ::-1].copy()
     back[2::3] *= -1.0  # the cross-slope momenta
-    np.testing.assert_allclose(t2, t1, rtol=MIRROR_TOLERANCE, atol=0.0)
+    tolerance = MIRROR_TOLERANCE[scenario.two_layer]
+    np.testing.assert_allclose(t2, t1, rtol=tolerance, atol=0.0)
     scale = np.abs(q1).max(axis=(1, 2))
-    assert np.all(np.abs(back - q1).max(axis=(1, 2)) <= MIRROR_TOLERANCE * scale), \
+    assert np.all(np.abs(back - q1).max(axis=(1, 2)) <= tolerance * scale), \
         np.abs(back - q1).max(axis=(1, 2)) / np.where(scale > 0, scale, 1.0)
 
 
