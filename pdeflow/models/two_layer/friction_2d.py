@@ -119,6 +119,14 @@ def _newton(u2x, u2y, b1x, b1y, b2x, b2y, m1, m2, Kdt, Cdt, Bdt):
                                       Bdt)
     for _ in range(NEWTON_ITERATIONS):
         det = hxx * hyy - hxy * hxy
+        if not det > 0.0:
+            # Near u2 = 0 the kink's term B dt / |u2| (the 'bend') dominates the
+            # Hessian, which is then rank one to round-off (det rounds to 0 or below:
+            # measured |u2| ~ 1e-19 m/s, Hessian ~ 1e10 m). The iterate is at the
+            # minimum to round-off, as when the line search finds no decrease; dividing
+            # would raise ZeroDivisionError in the compiled kernel, which numba cannot
+            # propagate out of it and swallows, leaving the source stage half done.
+            return u2x, u2y
         dx = -(hyy * gx - hxy * gy) / det
         dy = -(hxx * gy - hxy * gx) / det
         norm = gx * gx + gy * gy
