@@ -170,10 +170,7 @@ def wet_box(q: np.ndarray, dry: float, lo: int, hi: int, width: int,
     """The bounding box of the wet cells (:func:`wet_cells`) of the box (lo, hi) of a
     grid of ``line`` cells a row (:mod:`pdeflow.numerics.boxes`); ``(1, 0)`` if none."""
     x0, x1, y0, y1 = rows_of(lo, hi, line)
-    a0 = x1 + 1
-    a1 = x0 - 1
-    b0 = y1 + 1
-    b1 = y0 - 1
+    a0, a1, b0, b1 = x1 + 1, x0 - 1, y1 + 1, y0 - 1  # an empty box
     for x in range(x0, x1 + 1):
         klo, khi = line_wet(q, dry, width, x * line, 1, y0, y1)
         if klo <= khi:
@@ -246,8 +243,7 @@ def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, ax
         if not lines:
             return line(qm, qp, rate, metric, 0, 1, count, lo, hi, inv_dx, s_lo, s_hi, g,
                         r, dry)
-        # a 2D grid: the axis' lines through the box (lo, hi), each over the box's cells
-        # on it only, so that the dry margins beside a flow are not swept
+        # the axis' lines through the box, each over its cells: dry margins not swept
         x0, x1, y0, y1 = rows_of(lo, hi, per_row)
         if axis == 1:  # lines of the last axis: the box's rows
             l0, l1, step, k0, k1 = x0, x1, per_row, y0, y1
