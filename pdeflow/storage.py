@@ -326,10 +326,14 @@ class StoredRun:
         """Name of the grid's coordinate: 'x' (planar) or 'r' (axisymmetric) [m]."""
         return str(self.metadata.get("coordinate", "x"))
 
+    def table_axes(self) -> list[str]:
+        """The names of :meth:`table`'s leading columns: t and the coordinate."""
+        return ["t", self.coordinate]
+
     def to_csv(self, path: str | Path) -> Path:
         """Write the long table as CSV (header t,x,... or t,r,...; units in
         docs/user_guide.md)."""
-        header = ",".join(["t", self.coordinate, *self.columns()])
+        header = ",".join([*self.table_axes(), *self.columns()])
         with atomic_path(path) as tmp:
             np.savetxt(tmp, self.table(), delimiter=",", header=header, comments="",
                        fmt="%.10g")

@@ -102,14 +102,9 @@ class StoredRun2D(StoredRun):
         cols += [v.reshape(-1) for v in self._stacked().values()]
         return np.column_stack(cols)
 
-    def to_csv(self, path: str | Path) -> Path:
-        """Write :meth:`table` as CSV, header t,x,y,... (s, m, m, then the units of
-        :func:`pdeflow.storage.units`)."""
-        header = ",".join(["t", "x", "y", *self.columns()])
-        with atomic_path(path) as tmp:
-            np.savetxt(tmp, self.table(), delimiter=",", header=header, comments="",
-                       fmt="%.10g")
-        return Path(path)
+    def table_axes(self) -> list[str]:
+        """The names of :meth:`table`'s leading columns: t, x and y (CSV header)."""
+        return ["t", "x", "y"]
 
     def to_npz(self, path: str | Path) -> Path:
         """Write t [s], x and y [m] and each quantity as a (nt, nx, ny) array, plus the
