@@ -52,8 +52,18 @@ def on_grid(case: Case, *, cells: int | None = None, dx: float | None = None) ->
 
 
 def refined(case: Case, level: int) -> Case:
-    """Copy of ``case`` with dx = (the case's dx) / 2**level."""
-    return on_grid(case, dx=case.dx / 2**level)
+    """Copy of ``case`` with dx = (the case's dx) / 2**level; on a 2D grid dy too (a
+    ``grid.dy`` halved, ``grid.cells_y`` doubled, per level; a dy by default follows
+    dx), so that the cells keep their shape."""
+    c = case
+    grid = case.data.get("grid", {})
+    if case.is_2d and ("dy" in grid or "cells_y" in grid):
+        c = case.copy()
+        if "cells_y" in grid:
+            c.data["grid"]["cells_y"] = int(grid["cells_y"]) * 2**level
+        else:
+            c.data["grid"]["dy"] = case.dy / 2**level
+    return on_grid(c, dx=case.dx / 2**level)
 
 
 def with_sets(case: Case, items: Iterable[str], validate: bool = True) -> Case:
