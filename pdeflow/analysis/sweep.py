@@ -256,7 +256,8 @@ def sweep_figure(summary: dict[str, Any], path: str | Path) -> Path:
 
 def add_arguments(ap: Any) -> None:
     """The options of ``pdeflow sweep``."""
-    ap.add_argument("case", help="sweep case file (a column case with a [sweep] section)")
+    ap.add_argument("case", help="sweep case file (a column case, or a 2D release, with a "
+                    "[sweep] section)")
     ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                     help="override a case value (repeatable)")
     ap.add_argument("--summary", metavar="OUT.json", help="write the sweep summary here")
