@@ -267,13 +267,6 @@ def test_outputs_that_are_1d_only_are_refused_before_any_work(option, capsys, tm
     assert not list(tmp_path.iterdir())
 
 
-def test_compare_refuses_a_2d_case(capsys, tmp_path):
-    """sweep, converge and study run 2D cases (tests/test_studies_2d.py); compare not yet."""
-    assert main(["compare", str(CYLINDER)]) == 2
-    _one_line_error(capsys, "pdeflow compare is 1D only for now (issue 36)",
-                    prefix="pdeflow")  # 'pdeflow compare: error:' names its command
-
-
 def test_the_app_offers_1d_cases_only():
     """The teaching app draws 1D runs: it does not list the 2D case files."""
     pytest.importorskip("panel")

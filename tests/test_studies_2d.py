@@ -14,7 +14,7 @@ import pytest
 
 from pdeflow.analysis.points import refined
 from pdeflow.analysis.sweep_2d import release_length
-from pdeflow.cases import load_case
+from pdeflow.cases import Case, load_case
 from pdeflow.cli import main
 from pdeflow.simulate import run_model, summary_keys
 
@@ -143,3 +143,51 @@ def test_a_2d_sweep_needs_its_aspect_ratios(capsys):
     err = capsys.readouterr().err
     assert err.startswith("pdeflow: error:") and err.count("\n") == 1
     assert "[sweep]" in err and "aspect_ratios" in err
+
+
+def _column(two_d: bool) -> Case:
+    """A single-layer column (L0 = 0.5 m, H0 = 0.5 m) on 2 m, 16 cells; ``two_d``: the
+    same as a box across a 0.5 m wide channel with walls (4 cells across), uniform in y."""
+    data = {"case": {"name": "col", "models": ["single_layer"], "t_end": 0.2},
+            "grid": {"length": 2.0, "dx": 0.125},
+            # the 2D time step bounds the sum of the Courant numbers over both axes:
+            # twice the 1D number gives the 1D steps on a state uniform across
+            "numerics": {"cfl": 0.4 if two_d else 0.2},
+            "boundaries": {"left": "wall", "right": "open"},
+            "initial": {"shape": "column", "L0": 0.5, "H0": 0.5}}
+    if two_d:
+        data["grid"]["width"] = 0.5
+        data["initial"] = {"shape": "box", "x0": 0.0, "semi_x": 0.5, "y0": 0.25,
+                           "semi_y": 0.5, "H0": 0.5}
+    case = Case(data, "col.toml", ROOT)
+    case.validate()
+    return case
+
+
+def test_compare_over_a_2d_case_uniform_across_gives_the_1d_errors_times_the_width():
+    """A 2D run uniform in y is the 1D run bit for bit (docs/two_d.md), and so is its fine
+    reference: its L1 errors over the area are the 1D errors per unit width times the
+    width (0.5 m), to the round-off of sums over 4x more cells in another order (1e-12
+    relative); the observed orders are the same."""
+    from pdeflow.analysis.workprecision import compare
+
+    kw = {"variants": ["hll/first-order", "hll/muscl/mc"], "grids": [8, 16],
+          "out_dir": None, "repeats": 1}
+    one, two = compare(_column(False), **kw), compare(_column(True), **kw)
+    assert [r["cells_y"] for r in two.rows] == [2, 4, 2, 4]
+    for r1, r2 in zip(one.rows, two.rows, strict=True):
+        assert r1["status"] == r2["status"] == "ok" and r1["steps"] == r2["steps"]
+        for key in ("err_h", "err_hu"):
+            assert r2[key] == pytest.approx(0.5 * r1[key], rel=1e-12), key
+        assert r2["rel_err_h"] == pytest.approx(r1["rel_err_h"], rel=1e-12)
+        assert r2["cell_updates"] == r1["cell_updates"] * r2["cells_y"]
+
+
+def test_compare_refuses_mol_rk_and_hyperbolicity_on_a_2d_case(tmp_path, capsys):
+    for extra, words in ((["--variants", "mol-rk"], "mol-rk"),
+                         (["--hyperbolicity"], "--hyperbolicity")):
+        assert main(["compare", str(CYLINDER), *extra, "--out-dir", str(tmp_path / "o")]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("pdeflow compare: error:") and err.count("\n") == 1, err
+        assert words in err and "1D only for now (issue 36)" in err
+        assert not (tmp_path / "o").exists()
