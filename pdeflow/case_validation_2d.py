@@ -103,8 +103,8 @@ def check_shape_2d(case: Any) -> None:
 
 def require_1d(case: Any, what: str) -> None:
     """CaseError (one line) if ``case`` is 2D: ``what`` (an option or a command, e.g.
-    '--movie', 'pdeflow sweep') is 1D only for now."""
+    'pdeflow sweep') is 1D only for now."""
     if case.is_2d:
         raise CaseError(f"{case.source}: {what} {ISSUE}; a 2D case runs with "
                         "`pdeflow run CASE.toml` (its summary table, --summary, --outdir, "
-                        "--final, --store, --plot)")
+                        "--final, --store, --plot, --live, --movie, --frames)")

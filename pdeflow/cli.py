@@ -22,8 +22,8 @@ Without output options the summary and all figures go to results/<case name>/ (t
 case as written) or results/<case name>--<overrides>/ (with --set); a run replaces
 its folder as a whole. A 2D case (grid.width) writes its summary there and one
 figure, final_deposits.png (plan-view maps of each layer's depth and speed, the
-deposit outline, cross-sections; also --plot); --live, --movie and --frames are 1D
-only for now.
+deposit outline, cross-sections; also --plot); its --live, --movie and --frames
+draw the plan view of the total depth with the deposit outline.
 Every output is complete or absent: a failed or interrupted run writes nothing
 (Ctrl-C while the results are written lets them finish).
 For cases with several models, per-model outputs (--final, --store, --movie) go to
@@ -71,7 +71,8 @@ def _run_trackers(args: argparse.Namespace, case: Any, model: str,
         trackers.append(LayersPlotTracker(
             args.live_every or interval, title=f"{case.name}: {model.replace('_', ' ')}",
             display="auto" if show else "none", movie=movie, frames=frames,
-            fps=args.fps, autocommit=False))
+            fps=args.fps, autocommit=False, model=model,
+            threshold=case.front_threshold))
     if args.store:
         from .storage import RunStorageTracker, run_metadata
 
@@ -159,8 +160,6 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .sizecheck import check_size
 
     case = _load_run_case(args)
-    if case.is_2d:
-        _refuse_1d_options(args, case)
     for name in ("live_every", "store_every", "fps"):
         positive(f"--{name.replace('_', '-')}", getattr(args, name))
     default_out = not (args.summary or args.final or args.plot or args.outdir
@@ -184,20 +183,6 @@ def cmd_run(args: argparse.Namespace) -> int:
     finally:
         if figures is not None:
             figures.close()
-
-
-ONE_D_OPTIONS = ("live", "movie", "frames", "live_every")
-"""the options of ``pdeflow run`` that draw 1D frames: refused for a 2D case"""
-
-
-def _refuse_1d_options(args: argparse.Namespace, case: Any) -> None:
-    """One line (a CaseError) before any work if ``args`` ask a 2D case for an output
-    that is 1D only for now (:data:`ONE_D_OPTIONS`)."""
-    from .case_validation_2d import require_1d
-
-    for name in ONE_D_OPTIONS:
-        if getattr(args, name):
-            require_1d(case, f"--{name.replace('_', '-')}")
 
 
 def _run_and_write(args: argparse.Namespace, case: Any, outputs: Any, figures: Any,
@@ -278,7 +263,8 @@ def _add_run(sub: Any) -> None:
                        "or --frames)")
     watch.add_argument("--live", action="store_true",
                        help="draw the layers, velocities and F_extra/rho1 in a window "
-                       "while the run goes (needs a display; close it to finish)")
+                       "while the run goes (a 2D case: the plan view of the total depth "
+                       "with the deposit outline; needs a display; close it to finish)")
     watch.add_argument("--movie", metavar="OUT.mp4",
                        help="write the live plot as a movie, headless: .mp4 (also "
                        ".m4v, .mov, .mkv, .avi; H.264, needs ffmpeg, e.g. pip install "

@@ -17,8 +17,9 @@ The first run is drawn filled (layers stacked on the bed), further runs as lines
 top, for comparison: e.g. the two-layer and single-layer runs of one case, or two
 parameter sets. Each run is shown at its stored time nearest to --time (default: its
 last frame, the final state). A short description of each file is printed.
-Runs on a 2D grid: the maps and sections of the stored state nearest to --time
-(no --movie yet, issue 36)."""
+Runs on a 2D grid: the maps and sections of the stored state nearest to --time;
+--movie draws the plan view of each run's total depth with the deposit outline over
+all stored frames, side by side on one colour scale."""
 
 EXPORT_HELP = """Export a stored run to CSV, NumPy .npz or NetCDF (chosen by the suffix).
 
@@ -57,28 +58,57 @@ def _say_nearest_frames(runs: list[Any], idx: list[int], t: float | None) -> Non
 
 def _stored_axes(args: argparse.Namespace) -> int:
     """The axes of the stored runs' grids (1 or 2), read before any work; a one-line
-    error for a mix, or for ``--movie`` of 2D runs (1D only for now, issue 36)."""
+    error for a mix."""
     from .storage import StorageError, stored_axes
 
     axes = {stored_axes(p) for p in args.runs}
     if len(axes) > 1:
         raise StorageError("pdeflow plot draws 1D runs or 2D runs, not both: "
                            + ", ".join(args.runs))
-    if axes == {2} and args.movie:
-        raise StorageError("--movie of a 2D stored run is 1D only for now (issue 36)")
     return axes.pop()
+
+
+def _stored_case(run: Any) -> Any:
+    """The case a stored run was run from (its metadata)."""
+    from .cases import Case
+
+    return Case.from_dict(run.metadata["case"], source=str(run.path))
+
+
+def _frames(runs: list[Any]) -> list[tuple[float, list[Any], list[Any]]]:
+    """The movie's frames (t, states, F_extra/rho1): at the first run's stored times,
+    each run at its frame nearest to that time (its last after its end)."""
+    frames = []
+    for t in runs[0].times:
+        idx = [r.index(min(t, r.times[-1])) for r in runs]
+        frames.append((float(t), [r.data[i] for r, i in zip(runs, idx, strict=True)],
+                       [r.fextra[i] for r, i in zip(runs, idx, strict=True)]))
+    return frames
+
+
+def _movie_2d(args: argparse.Namespace, runs: list[Any]) -> Any:
+    """The movie of the stored 2D runs (:func:`pdeflow.trackers.live.replay`: the plan
+    view of :mod:`pdeflow.plan_view`); its path."""
+    from .plotting import Series, display_name
+    from .trackers.live import replay
+
+    case = _stored_case(runs[0])
+    series = [Series(r.x, r.model, lab, r.dry_tolerance, y=r.y)
+              for r, lab in zip(runs, _plot_labels(runs), strict=True)]
+    title = args.title if args.title is not None else display_name(case.name)
+    return replay(_frames(runs), series, args.movie, title=title, fps=args.fps,
+                  progress=not args.quiet, threshold=case.front_threshold)
 
 
 def _plot_2d(args: argparse.Namespace, runs: list[Any]) -> Any:
     """The 2D figure (:func:`pdeflow.figures_2d.final_figure_2d`) of the stored 2D runs
     at the stored time nearest to ``--time`` (default: the last), saved; its path."""
-    from .cases import Case
     from .figures_2d import final_figure_2d
     from .metrics_2d import total_depth
     from .plotting import display_name, save
 
     first = runs[0]
-    case = Case.from_dict(first.metadata["case"], source=str(first.path))
+    case = _stored_case(first)
     idx = [r.index(args.time) for r in runs]
     if not args.quiet:
         _say_nearest_frames(runs, idx, args.time)
@@ -112,11 +142,14 @@ def cmd_plot(args: argparse.Namespace) -> int:
     two_d = _stored_axes(args) == 2
     runs = [open_run(p) for p in args.runs]
     if two_d:
-        written = [_plot_2d(args, runs)]
+        written = [_movie_2d(args, runs)] if args.movie else []
+        if args.out or not args.movie:
+            written.append(_plot_2d(args, runs))
         if not args.quiet:
             for r in runs:
                 print(r.describe())
-            print(f"wrote {written[0]}")
+            for p in written:
+                print(f"wrote {p}")
         return 0
     series = [Series(r.x, r.model, lab, r.dry_tolerance, r.coordinate)
               for r, lab in zip(runs, _plot_labels(runs), strict=True)]
@@ -126,13 +159,8 @@ def cmd_plot(args: argparse.Namespace) -> int:
     if args.movie:
         from .trackers.live import replay
 
-        frames = []
-        for t in runs[0].times:
-            idx = [r.index(min(t, r.times[-1])) for r in runs]
-            frames.append((float(t), [r.data[i] for r, i in zip(runs, idx, strict=True)],
-                           [r.fextra[i] for r, i in zip(runs, idx, strict=True)]))
-        written.append(replay(frames, series, args.movie, title=title, fps=args.fps,
-                              progress=not args.quiet))
+        written.append(replay(_frames(runs), series, args.movie, title=title,
+                              fps=args.fps, progress=not args.quiet))
     if args.out or not args.movie:
         idx = [r.index(args.time) for r in runs]
         times = [float(r.times[i]) for r, i in zip(runs, idx, strict=True)]

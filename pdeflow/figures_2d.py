@@ -100,11 +100,19 @@ def depth_map(ax: Any, cax: Any, fig: Any, x: np.ndarray, y: np.ndarray, h: np.n
     if not np.max(h) > DRY:  # a layer that is gone (the upper one after its exchange)
         ax.text(0.5, 0.5, "dry", transform=ax.transAxes, ha="center", va="center",
                 color="0.4")
-    outline = None
-    if np.any(total > threshold) and x.size > 1 and y.size > 1:
-        outline = ax.contour(x, y, total.T, levels=[threshold], colors="k",
-                             linewidths=1.2)
-        outline.set_label("deposit")
+    return deposit_outline(ax, x, y, total, threshold)
+
+
+def deposit_outline(ax: Any, x: np.ndarray, y: np.ndarray, total: np.ndarray,
+                    threshold: float) -> Any:
+    """The deposit outline on ``ax``: the contour of the total depth ``total`` [m]
+    (nx, ny) at ``threshold`` [m] (black, labelled 'deposit'; the cells a 2D summary's
+    ``deposit_area`` counts). Returns its ContourSet, None if no cell is deeper than
+    the threshold or the grid is one cell wide (a contour needs a 2 x 2 grid)."""
+    if not (np.any(total > threshold) and x.size > 1 and y.size > 1):
+        return None
+    outline = ax.contour(x, y, total.T, levels=[threshold], colors="k", linewidths=1.2)
+    outline.set_label("deposit")
     return outline
 
 

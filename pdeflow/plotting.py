@@ -124,7 +124,8 @@ def _set(lines: dict[str, Any], key: str, y: np.ndarray) -> None:
 
 @dataclass
 class Series:
-    """One run drawn in a :class:`RunFigure`: its cell centres, model and legend label."""
+    """One run drawn in a :class:`RunFigure` (on a 2D grid: in a
+    :class:`pdeflow.plan_view.PlanFigure`): its cell centres, model and legend label."""
 
     x: np.ndarray
     """cell centres [m]"""
@@ -136,9 +137,52 @@ class Series:
     """the model's dry tolerance [m]: no velocity is drawn where a layer is thinner"""
     coordinate: str = "x"
     """name of the grid's coordinate: 'x' (planar) or 'r' (axisymmetric) [m]"""
+    y: np.ndarray | None = None
+    """cell centres across the slope [m] of a run on a 2D grid (None: a 1D grid)"""
 
 
-class RunFigure:
+class RedrawnFigure:
+    """What a figure redrawn in place offers its users (a live plot, a movie, frames):
+    its ``fig`` (a matplotlib figure) and title ``_title`` (the suptitle: ``title``,
+    then the time), set by the figure (:class:`RunFigure`, the 2D runs'
+    :class:`pdeflow.plan_view.PlanFigure`), which draws a frame with
+    ``update(t, states, fextras)``."""
+
+    fig: Any
+    title: str
+    _title: Any
+
+    def set_title(self, text: str) -> None:
+        """Title: the figure's ``title`` followed by ``text`` (normally the time)."""
+        self._title.set_text(f"{self.title}  {text}".strip())
+
+    def png(self, dpi: int = 100) -> bytes:
+        """The figure as PNG bytes."""
+        import io
+
+        buf = io.BytesIO()
+        self.fig.savefig(buf, format="png", dpi=dpi)
+        return buf.getvalue()
+
+    def _repr_png_(self) -> bytes:
+        """Jupyter shows the figure as its PNG (independent of the matplotlib backend)."""
+        return self.png()
+
+    def save(self, path: str | Path, dpi: int = 110) -> Path:
+        """Write the figure atomically (the figure stays open for further frames)."""
+        path = Path(path)
+        with atomic_path(path) as tmp:
+            self.fig.savefig(tmp, dpi=dpi, format=path.suffix.lstrip(".") or "png")
+        return path
+
+    def close(self) -> None:
+        """Release the figure (and its window, if it was made through pyplot)."""
+        import matplotlib.pyplot as plt
+
+        plt.close(self.fig)
+
+
+class RunFigure(RedrawnFigure):
     """Three stacked panels of one or more runs at one time, redrawn in place.
 
     Panel 1: the bed (grey, at depth 0; depths are measured normal to the bed), the
@@ -374,31 +418,3 @@ class RunFigure:
                 base = top
         return us
 
-    def set_title(self, text: str) -> None:
-        """Title: the figure's ``title`` followed by ``text`` (normally the time)."""
-        self._title.set_text(f"{self.title}  {text}".strip())
-
-    def png(self, dpi: int = 100) -> bytes:
-        """The figure as PNG bytes."""
-        import io
-
-        buf = io.BytesIO()
-        self.fig.savefig(buf, format="png", dpi=dpi)
-        return buf.getvalue()
-
-    def _repr_png_(self) -> bytes:
-        """Jupyter shows a RunFigure as its PNG (independent of the matplotlib backend)."""
-        return self.png()
-
-    def save(self, path: str | Path, dpi: int = 110) -> Path:
-        """Write the figure atomically (the figure stays open for further frames)."""
-        path = Path(path)
-        with atomic_path(path) as tmp:
-            self.fig.savefig(tmp, dpi=dpi, format=path.suffix.lstrip(".") or "png")
-        return path
-
-    def close(self) -> None:
-        """Release the figure (and its window, if it was made through pyplot)."""
-        import matplotlib.pyplot as plt
-
-        plt.close(self.fig)

@@ -196,11 +196,12 @@ def get(name: str) -> EquationSystem:
 
 def of_fields(labels: Any) -> EquationSystem:
     """The system whose state has the field labels ``labels`` (a state or stored run
-    without the model's name): the first registered one, so the shipped models win over
-    a later system with the same fields; ValueError if none has them."""
+    without the model's name; on a 1D or a 2D grid): the first registered one, so the
+    shipped models win over a later system with the same fields; ValueError if none
+    has them."""
     labels = tuple(labels)
     for system in _REGISTRY.values():
-        if system.field_names == labels:
+        if labels in (system.field_names, system.field_names_on(2)):
             return system
     raise ValueError(f"no model has the state fields {list(labels)}; models: "
                      f"{[(s.name, s.field_names) for s in _REGISTRY.values()]}")

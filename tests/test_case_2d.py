@@ -257,16 +257,6 @@ def test_2d_keys_in_a_1d_case_ask_for_the_width(key, capsys):
     _one_line_error(capsys, "grid.width")
 
 
-@pytest.mark.parametrize("option", [["--movie", "m.gif"],
-                                    ["--frames", "fr"], ["--live"]])
-def test_outputs_that_are_1d_only_are_refused_before_any_work(option, capsys, tmp_path,
-                                                              monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    assert main(["run", str(CYLINDER), *option]) == 2
-    _one_line_error(capsys, f"{option[0]} is 1D only for now (issue 36)")
-    assert not list(tmp_path.iterdir())
-
-
 def test_the_app_offers_1d_cases_only():
     """The teaching app draws 1D runs: it does not list the 2D case files."""
     pytest.importorskip("panel")

@@ -5,6 +5,7 @@ them, not made by shortening a step."""
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import warnings
 from pathlib import Path
@@ -199,3 +200,31 @@ def test_an_output_time_inside_the_step_that_comes_to_rest(plain):
     assert numbers(res.summary) == plain["two_layer"]
     assert list(res.snapshots) == [t_snap]
     assert np.all(res.snapshots[t_snap][0][::2] >= 0)
+
+
+CYLINDER_2D = ROOT / "cases" / "cylinder_2d.toml"
+SMALL_2D = ["grid.dx=0.2", "grid.width=3.2", "case.t_end=0.6"]  # 20 x 16 cells
+
+
+def test_cli_observers_do_not_change_a_2d_summary(tmp_path):
+    """A 2D case (both models): --progress, --store, the plan view's frames and movie
+    (every 0.1 s) give the summary of the run with --summary alone, number for number.
+    The bar and the store (every t_end/100) meet every other sample of the peak speed
+    (every t_end/200) to within round-off of the time; the peak is still the plain
+    run's (:mod:`pdeflow.trackers.peaks`)."""
+    sets = sum((["--set", s] for s in SMALL_2D), [])
+    plain, watched = tmp_path / "plain.json", tmp_path / "watched.json"
+    assert main(["run", str(CYLINDER_2D), *sets, "--summary", str(plain), "-q",
+                 "--no-progress"]) == 0
+    args = ["--summary", str(watched), "-q", "--progress", "--frames",
+            str(tmp_path / "frames"), "--movie", str(tmp_path / "m.gif"), "--live-every",
+            "0.1"]
+    if importlib.util.find_spec("h5py") is not None:
+        args += ["--store", str(tmp_path / "r.h5")]
+    assert main(["run", str(CYLINDER_2D), *sets, *args]) == 0
+    assert len(list((tmp_path / "frames" / "two_layer").glob("frame_*.png"))) >= 6
+    ref = json.loads(plain.read_text())["models"]
+    models = json.loads(watched.read_text())["models"]
+    assert set(models) == {"two_layer", "single_layer"}
+    for model, s in models.items():
+        assert numbers(s) == numbers(ref[model]), model

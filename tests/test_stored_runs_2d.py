@@ -1,8 +1,8 @@
 """Stored runs of 2D cases (issue 36): ``pdeflow run CASE2D --store`` writes the run on
 the 2D grid with its metadata, without changing the run's numbers; ``pdeflow export``
 writes NetCDF (time, x, y), NPZ and CSV that read back to the stored values; ``pdeflow
-plot`` refuses a 2D run with one line (no 2D figures yet); bad input is one line
-before any work. Needs h5py (the test extra); NetCDF needs xarray."""
+plot`` draws a 2D run's stored state and its movie; bad input is one line before any
+work. Needs h5py (the test extra); NetCDF needs xarray."""
 
 from __future__ import annotations
 
@@ -185,15 +185,41 @@ def test_the_2d_plot_shows_the_state_asked_for(stored, monkeypatch):
     np.testing.assert_array_equal(drawn["runs"][0][1], run.data[i])
 
 
-def test_a_movie_of_a_2d_run_is_one_line_before_any_work(stored, capsys, tmp_path,
-                                                         monkeypatch):
+def test_a_movie_of_2d_runs_shows_every_stored_frame(stored, capsys, tmp_path,
+                                                    monkeypatch):
+    """``pdeflow plot A.h5 B.h5 --movie``: a frame per stored frame of the first run,
+    both runs side by side at their frames nearest to its time (the plan view,
+    :mod:`pdeflow.plan_view`); --movie alone writes no figure, with --out it does."""
+    from PIL import Image
+
+    from pdeflow.plan_view import PlanFigure
+    from pdeflow.stored_runs import open_run
+
     d, _, _ = stored
+    drawn = []
+    update = PlanFigure.update
+
+    def spy(self, t, states, fextras=None):
+        drawn.append((t, states))
+        return update(self, t, states, fextras)
+
+    monkeypatch.setattr(PlanFigure, "update", spy)
     monkeypatch.chdir(tmp_path)
-    assert main(["plot", str(d / "a.h5"), "--movie", "m.gif"]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith("pdeflow: error:") and err.count("\n") == 1, err
-    assert "--movie of a 2D stored run is 1D only for now (issue 36)" in err
-    assert not list(tmp_path.iterdir())
+    runs = [open_run(d / "a.h5"), open_run(d / "a.single_layer.h5")]
+    assert main(["plot", str(d / "a.h5"), str(d / "a.single_layer.h5"), "--movie",
+                 "m.gif"]) == 0
+    assert "wrote m.gif" in capsys.readouterr().out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.gif"]
+    with Image.open("m.gif") as im:
+        assert im.n_frames == len(runs[0].times) == len(drawn)
+    for (t, states), t0 in zip(drawn, runs[0].times, strict=True):
+        assert t == t0
+        for run, state in zip(runs, states, strict=True):
+            np.testing.assert_array_equal(state, run.data[run.index(min(t, run.times[-1]))])
+    assert main(["plot", str(d / "a.h5"), "--movie", "one.gif", "--out", "one.png",
+                 "-q"]) == 0
+    assert (tmp_path / "one.png").read_bytes().startswith(b"\x89PNG")
+    assert_no_temporaries(tmp_path)
 
 
 @pytest.mark.parametrize("option, words", [

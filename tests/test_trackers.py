@@ -107,14 +107,19 @@ def _pdeflow_imports(path: Path) -> set[str]:
 
 def test_trackers_sit_below_models_solvers_and_storage():
     """As in py-pde (a PDE's solve makes its trackers), pdeflow's trackers import only
-    the numerics, io, plotting and the systems registry, never the models, solvers,
-    storage or what is above."""
+    the numerics, io, plotting (the 2D plan view's figures and measures too) and the
+    systems registry, never the models, solvers, storage or what is above."""
     allowed = ("pdeflow.numerics", "pdeflow.io", "pdeflow.plotting", "pdeflow.trackers",
-               "pdeflow.systems")
+               "pdeflow.systems", "pdeflow.plan_view")
     for path in sorted((ROOT / "pdeflow" / "trackers").glob("*.py")):
         bad = [n for n in _pdeflow_imports(path) if not n.startswith(allowed)]
         assert not bad, f"{path.name} imports {bad}"
-    for name in ("io.py", "plotting.py"):
+    figures = ("pdeflow.numerics", "pdeflow.io", "pdeflow.systems")
+    for name, more in (("io.py", ()), ("plotting.py", ()),
+                       ("plan_view.py", ("pdeflow.plotting", "pdeflow.figures_2d",
+                                         "pdeflow.metrics_2d")),
+                       ("figures_2d.py", ("pdeflow.plotting", "pdeflow.metrics_2d")),
+                       ("metrics_2d.py", ("pdeflow.metrics",)), ("metrics.py", ())):
         bad = [n for n in _pdeflow_imports(ROOT / "pdeflow" / name)
-               if not n.startswith(("pdeflow.numerics", "pdeflow.io", "pdeflow.systems"))]
+               if not n.startswith((*figures, *more))]
         assert not bad, f"{name} imports {bad}"

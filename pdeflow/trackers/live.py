@@ -3,7 +3,9 @@
 :class:`LayersPlotTracker` redraws, at its interrupts in *simulation* time, the two layers
 stacked on the bed (lower layer, upper layer, interface and free surface, filled), both
 velocities and F_extra/rho1, with the simulation time in the title (the figure is a
-:class:`pdeflow.plotting.RunFigure`). Where it shows the figure:
+:class:`pdeflow.plotting.RunFigure`); on a 2D grid the plan view of the total depth
+with the deposit outline (a :class:`pdeflow.plan_view.PlanFigure`). Where it shows the
+figure:
 
 * ``display="window"``: a desktop window (an interactive matplotlib backend such as
   TkAgg or QtAgg), updated while the run goes (``pdeflow run CASE --live``);
@@ -44,7 +46,8 @@ from pde.trackers.base import InfoDict, TrackerBase
 
 from ..io import PendingDir, PendingFile
 from ..numerics.geometry import COORDINATES, geometry_of
-from ..plotting import RunFigure, Series
+from ..plan_view import DEPOSIT_THRESHOLD, PlanFigure, frames_box
+from ..plotting import RedrawnFigure, RunFigure, Series
 from ..systems import of_fields
 from .frames import fextra_over_rho1, show_final_state, state_labels
 
@@ -52,6 +55,18 @@ from .frames import fextra_over_rho1, show_final_state, state_labels
 FFMPEG_SUFFIXES = (".mp4", ".m4v", ".mov", ".mkv", ".avi")
 #: matplotlib backends that cannot show a window
 HEADLESS_BACKENDS = ("agg", "pdf", "ps", "svg", "pgf", "cairo", "template")
+
+
+def figure_of(series: list[Series], *, title: str = "", depth_max: float | None = None,
+              pyplot: bool = False, threshold: float = DEPOSIT_THRESHOLD,
+              box: Any = None) -> RedrawnFigure:
+    """The figure redrawn in place for ``series``: a :class:`~pdeflow.plotting.RunFigure`
+    of 1D runs, a :class:`~pdeflow.plan_view.PlanFigure` (with the deposit outline at
+    ``threshold`` [m] and the ranges ``box``) of runs on 2D grids."""
+    if series[0].y is None:
+        return RunFigure(series, title=title, depth_max=depth_max, pyplot=pyplot)
+    return PlanFigure(series, title=title, depth_max=depth_max, pyplot=pyplot,
+                      threshold=threshold, box=box)
 
 
 class MovieError(ValueError):
@@ -173,6 +188,8 @@ class LayersPlotTracker(TrackerBase):
         fps: frames per second of the movie.
         dpi: resolution of movie frames and PNG frames.
         depth_max: upper depth limit of the plot [m] (default: from the initial state).
+        threshold: on a 2D grid the deposit outline's total depth [m] (``pdeflow run``
+            passes the case's ``output.front_threshold``, whose default this is).
         pause: seconds the window's event loop runs per frame (window display only).
         model: the registered name of the run's model (default: the first model whose
             state has the run's field labels, see :func:`pdeflow.systems.of_fields`).
@@ -184,7 +201,8 @@ class LayersPlotTracker(TrackerBase):
                  display: str = "auto", movie: str | Path | None = None,
                  frames: str | Path | None = None, fps: float = 10, dpi: int = 100,
                  depth_max: float | None = None, pause: float = 1e-3,
-                 model: str | None = None, autocommit: bool = True):
+                 model: str | None = None, autocommit: bool = True,
+                 threshold: float = DEPOSIT_THRESHOLD):
         super().__init__(interrupts=interrupts)
         self.autocommit = autocommit
         self.model = model
@@ -197,8 +215,9 @@ class LayersPlotTracker(TrackerBase):
         self.fps = float(fps)
         self.dpi = int(dpi)
         self.depth_max = depth_max
+        self.threshold = float(threshold)
         self.pause = float(pause)
-        self.figure: RunFigure | None = None
+        self.figure: RedrawnFigure | None = None
         self.times: list[float] = []
         self.frame_paths: list[Path] = []
         self.movie: MovieFile | None = None
@@ -213,10 +232,13 @@ class LayersPlotTracker(TrackerBase):
         self._info = info
         self._field = field
         model = self.model or of_fields(state_labels(field)).name
-        series = [Series(np.asarray(field.grid.axes_coords[0]), model,
-                         coordinate=COORDINATES[geometry_of(field.grid)])]
-        self.figure = RunFigure(series, title=self.title, depth_max=self.depth_max,
-                                pyplot=self.display == "window")
+        grid = field.grid
+        y = np.asarray(grid.axes_coords[1]) if grid.num_axes == 2 else None
+        series = [Series(np.asarray(grid.axes_coords[0]), model,
+                         coordinate=COORDINATES[geometry_of(grid, two_d=True)], y=y)]
+        self.figure = figure_of(series, title=self.title, depth_max=self.depth_max,
+                                pyplot=self.display == "window",
+                                threshold=self.threshold)
         if self.frames_dir is not None:
             self._frames = PendingDir(self.frames_dir)
         if self.movie_path is not None:
@@ -230,8 +252,7 @@ class LayersPlotTracker(TrackerBase):
 
     def handle(self, field: Any, t: float) -> None:
         self._field = field
-        self.draw(field.data, float(t),
-                  fextra_over_rho1(self._info, field.grid.shape[0]))
+        self.draw(field.data, float(t), fextra_over_rho1(self._info, field.grid.shape))
 
     def finalize(self, info: InfoDict | None = None) -> None:
         super().finalize(info)
@@ -300,13 +321,17 @@ class LayersPlotTracker(TrackerBase):
 
 def replay(frames: list[tuple[float, list[np.ndarray | None], list[np.ndarray | None]]],
            series: list[Series], path: str | Path, *, title: str = "", fps: float = 10,
-           dpi: int = 100, progress: bool = False) -> Path:
+           dpi: int = 100, progress: bool = False,
+           threshold: float = DEPOSIT_THRESHOLD) -> Path:
     """Write a movie of given frames (t, states, fextras) of one or more runs; with
     ``progress`` a bar on stderr counts the frames (tqdm, as py-pde's progress bar:
-    drawing takes tens of milliseconds per frame)."""
+    drawing takes tens of milliseconds per frame). Runs on 2D grids are drawn in plan
+    view (:func:`figure_of`), zoomed to the material of all frames, with the deposit
+    outline at ``threshold`` [m]."""
     from tqdm.auto import tqdm
 
-    fig = RunFigure(series, title=title)
+    box = None if series[0].y is None else frames_box(series, [f[1] for f in frames])
+    fig = figure_of(series, title=title, threshold=threshold, box=box)
     movie = MovieFile(path, fig.fig, fps=fps, dpi=dpi)
     bar = tqdm(total=len(frames), desc=f"drawing {Path(path).name}", unit="frame",
                disable=not progress, leave=True)
@@ -326,4 +351,4 @@ def replay(frames: list[tuple[float, list[np.ndarray | None], list[np.ndarray | 
 
 
 __all__ = ["LayersPlotTracker", "MovieError", "MovieFile", "check_movie_path",
-           "display_mode", "ffmpeg_path", "replay"]
+           "display_mode", "ffmpeg_path", "figure_of", "replay"]
