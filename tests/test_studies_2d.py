@@ -191,3 +191,23 @@ def test_compare_refuses_mol_rk_and_hyperbolicity_on_a_2d_case(tmp_path, capsys)
         assert err.startswith("pdeflow compare: error:") and err.count("\n") == 1, err
         assert words in err and "1D only for now (issue 36)" in err
         assert not (tmp_path / "o").exists()
+
+
+def test_a_2d_study_runs_on_dask_and_resumes(tmp_path, capsys):
+    """The whole pipeline on a 2D case (one local worker): the table has the 2D
+    quantities of both points; run again, it computes nothing and keeps the rows."""
+    pytest.importorskip("distributed")
+    import pandas as pd
+
+    study = _study_file(tmp_path, '["single_layer.mass_radius", "single_layer.lateral_spread"]')
+    out = tmp_path / "o"
+    cmd = ["study", str(study), "--out", str(out), "--workers", "1"]
+    assert main(cmd) == 0
+    first = pd.read_csv(out / "results.csv")
+    assert list(first["status"]) == ["ok", "ok"]
+    assert first["single_layer.mass_radius"].notna().all()
+    capsys.readouterr()
+    assert main(cmd) == 0
+    assert "all 2 evaluations done" in capsys.readouterr().out
+    again = pd.read_csv(out / "results.csv")
+    pd.testing.assert_frame_equal(first, again)
