@@ -82,14 +82,12 @@ def _check_2d(case: Any) -> None:
 
 def _check_1d_only(case: Any) -> None:
     """What a 2D case may not ask for yet: snapshots and the erosion series (their
-    figures and trackers are 1D), a sweep, py-pde's solvers (not tested in 2D)."""
+    figures and trackers are 1D), py-pde's solvers (not tested in 2D)."""
     if case.snapshot_times:
         raise _err(case, f"output.snapshot_times {ISSUE}: a 2D run has no snapshot "
                          "figures yet; remove it (or --set output.snapshot_times=[])")
     if case.data.get("output", {}).get("erosion_series") == "on":
         raise _err(case, f"output.erosion_series = 'on' {ISSUE}")
-    if "sweep" in case.data:
-        raise _err(case, f"[sweep] {ISSUE}: a 2D case runs one release")
     if case.solver != "fv-split":
         raise _err(case, f"numerics.solver = {case.solver!r} {ISSUE}: a 2D case runs "
                          "with 'fv-split'")

@@ -50,7 +50,7 @@ from .numerics.state import velocity_profile
 from .numerics.warmup import prepare
 from .solvers.diagnostics import SplitDiagnostics
 from .solvers.fv_split import SimulationBlowUp, split_stepper
-from .summary_2d import summarize_2d
+from .summary_2d import COMMON_KEYS_2D, summarize_2d
 from .trackers import FextraStorageTracker
 from .trackers.peaks import PeakTracker
 from .trackers.series import SeriesTracker
@@ -315,15 +315,20 @@ _COMMON_KEYS = ("model", "solver", "geometry", "bed", "t_final", "at_rest", "fro
                 "mass_change", "runout_lower_bound", "domain_ends", "warnings")
 
 
-def summary_keys(model: str, series: bool = False) -> tuple[str, ...]:
+def summary_keys(model: str, series: bool = False,
+                 two_d: bool = False) -> tuple[str, ...]:
     """Keys of :func:`summarize` for ``model`` with the fv-split solver: the common ones
     and the system's own (other py-pde solvers give the common keys; stop times are
     then None); with ``series`` also those of a run that records the erosion series
-    (cases with a bed, :data:`SERIES_KEYS` and :data:`BED_KEYS`). ``domain_ends`` (a
-    table) and ``warnings`` (a list) are not numbers: a study records them as JSON
-    text."""
+    (cases with a bed, :data:`SERIES_KEYS` and :data:`BED_KEYS`); with ``two_d`` those
+    of a run on a 2D grid instead (:func:`pdeflow.summary_2d.summarize_2d`: no series,
+    no mass-quantile front). ``domain_ends`` (a table) and ``warnings`` (a list) are
+    not numbers: a study records them as JSON text."""
+    own = systems.get(model).summary_keys
+    if two_d:
+        return (*COMMON_KEYS_2D, "stop_time", "max_fextra_over_rho1", *own)
     extra = (*SERIES_KEYS, *BED_KEYS) if series else ()
-    return (*_COMMON_KEYS, *systems.get(model).summary_keys, *extra)
+    return (*_COMMON_KEYS, *own, *extra)
 
 
 _LENGTH_KEYS = ("front_position", "runout", "front_mass_quantile", "runout_mass_quantile",

@@ -34,6 +34,13 @@ SIDES_2D = ("left", "right", "y_low", "y_high")
 """the sides of a 2D domain: x low and high, y low and high"""
 KEYS_2D = ("lateral_spread", "deposit_area", "mass_radius", "max_depth", "max_speed")
 """the summary keys a 2D run adds to the 1D ones it shares"""
+COMMON_KEYS_2D = ("model", "solver", "geometry", "t_final", "at_rest", "front_position",
+                  "runout", *KEYS_2D, "runout_mass_fraction", "mass_relative_error",
+                  "mass_change", "steps", "wall_time_s", "stop_reason",
+                  "flux_fallback_steps", "positivity_retries", "domain_ends",
+                  "runout_lower_bound", "warnings")
+"""the keys of every 2D summary (:func:`summarize_2d`) besides the model's own
+(:func:`pdeflow.simulate.summary_keys` adds those)"""
 
 
 def sides_reached(depth: np.ndarray, threshold: float) -> list[str]:

@@ -257,23 +257,6 @@ def test_2d_keys_in_a_1d_case_ask_for_the_width(key, capsys):
     _one_line_error(capsys, "grid.width")
 
 
-@pytest.mark.parametrize("command", [["sweep"], ["converge"], ["compare"]])
-def test_commands_that_are_1d_only_refuse_a_2d_case(command, capsys, tmp_path):
-    assert main([*command, str(CYLINDER)]) == 2
-    _one_line_error(capsys, f"pdeflow {command[0]} is 1D only for now (issue 36)",
-                    prefix="pdeflow")  # 'pdeflow compare: error:' names its command
-
-
-def test_a_study_over_a_2d_case_is_refused(tmp_path, capsys):
-    study = tmp_path / "study.toml"
-    study.write_text(f'[study]\ncase = "{CYLINDER}"\nsamples = 2\ndesign = "lhs"\n'
-                     'quantities = ["single_layer.runout"]\n[parameters]\n'
-                     '"single_layer.phi_b_deg" = { range = [25, 30] }\n')
-    assert main(["study", str(study), "--out", str(tmp_path / "o")]) == 2
-    err = capsys.readouterr().err
-    assert "pdeflow study is 1D only for now (issue 36)" in err and err.count("\n") == 1
-
-
 def test_the_app_offers_1d_cases_only():
     """The teaching app draws 1D runs: it does not list the 2D case files."""
     pytest.importorskip("panel")

@@ -14,6 +14,12 @@ F_extra and wall time; ``--all`` every quantity, ``--summary`` writes all as JSO
 For sweep cases (with a ``[sweep]`` section) it refines the sweep and reports the
 fitted run-out prefactor and exponent per level.
 
+A 2D case (``grid.width``) is refined along x and y together (dx and dy halved:
+:func:`~pdeflow.analysis.points.refined`); its QoIs are the 2D summary's
+(:func:`pdeflow.summary_2d.summarize_2d`: stop times, run-out along x, lateral spread,
+deposit area, r99 about the release's centre, deepest cell, largest speed, F_extra),
+without the volumes V1(t) (a 2D run takes no snapshots yet).
+
 Both are :class:`~pdeflow.study.core.Study` definitions: points = the grid levels,
 measure = the quantities of one run (:func:`qoi_row`) or the fit of one sweep
 (:func:`fit_row`). ``python docs/generate/convergence.py`` regenerates
@@ -33,15 +39,17 @@ from typing import Any
 import numpy as np
 
 from .. import systems
-from ..case_validation_2d import require_1d
 from ..cases import PAPER_MODEL, Case, CaseError, load_case
 from ..numerics.warmup import prepare
 from ..simulate import case_steppers, summary_unit
 from ..study.core import Executor, Study, serial
+from ..summary_2d import KEYS_2D
 from .points import Point, refined
 
 QOI_KEYS = ("lower_stop_time", "upper_stop_time", "lower_slow_time", "upper_slow_time",
             "stop_time", "runout", "runout_mass_quantile", "max_fextra_over_rho1")
+QOI_KEYS_2D = (*QOI_KEYS[:5], "runout", "front_position", *KEYS_2D, "max_fextra_over_rho1")
+"""the QoIs of a 2D case: the stop times, the 2D summary's lengths, area and peaks"""
 
 
 def qoi_row(point: Point, volume_times: tuple[float, ...]) -> dict[str, Any]:
@@ -50,9 +58,10 @@ def qoi_row(point: Point, volume_times: tuple[float, ...]) -> dict[str, Any]:
     c = point.case
     res = point.run().execute()
     s = res.summary
-    row: dict[str, Any] = {"dx": c.dx, "cells": c.cells, "steps": s["steps"],
-                           "wall_time_s": s["wall_time_s"]}
-    for key in QOI_KEYS:
+    row: dict[str, Any] = {"dx": c.dx, "cells": c.cells,
+                           **({"cells_y": c.cells_y} if c.is_2d else {}),
+                           "steps": s["steps"], "wall_time_s": s["wall_time_s"]}
+    for key in QOI_KEYS_2D if c.is_2d else QOI_KEYS:
         row[key] = s.get(key)
     row["max_fextra_x"] = s.get("max_fextra_x")
     row["max_fextra_time"] = s.get("max_fextra_time")
@@ -74,8 +83,10 @@ def qoi_row(point: Point, volume_times: tuple[float, ...]) -> dict[str, Any]:
 def converge(case: Case, levels: int, model: str = PAPER_MODEL,
              volume_times: tuple[float, ...] = (0.01, 0.1, 0.25, 0.5, 1.0),
              executor: Executor = serial, progress: bool = False) -> dict[str, Any]:
-    """Run ``model`` of ``case`` on ``levels`` halvings of dx; QoIs per level
-    (``progress``: a bar over the levels on stderr)."""
+    """Run ``model`` of ``case`` on ``levels`` halvings of dx (2D: of dx and dy); QoIs
+    per level (``progress``: a bar over the levels on stderr)."""
+    if case.is_2d:
+        volume_times = ()  # V1(t) needs snapshots, which a 2D run does not take yet
     points = []
     for level in range(levels):
         c = refined(case, level)
@@ -84,8 +95,9 @@ def converge(case: Case, levels: int, model: str = PAPER_MODEL,
         points.append(Point(c, model))
     rows = Study(points, partial(qoi_row, volume_times=volume_times)).execute(
         executor, "grid levels" if progress else None)
-    qois = [k for k in rows[0] if k not in ("dx", "cells", "steps", "wall_time_s",
-                                             "max_fextra_x", "max_fextra_time")]
+    qois = [k for k in rows[0] if k not in ("dx", "cells", "cells_y", "steps",
+                                             "wall_time_s", "max_fextra_x",
+                                             "max_fextra_time")]
     return {"case": case.name, "model": model, "levels": rows,
             "analysis": {k: richardson([r[k] for r in rows]) for k in qois}}
 
@@ -188,6 +200,9 @@ def _fmt(v: Any) -> str:
 #: the columns ``pdeflow converge`` prints by default (``--all``: every quantity)
 SHORT_VIEW = ("dx", "cells", "stop_time", "lower_stop_time", "upper_stop_time", "runout",
               "runout_mass_quantile", "max_fextra_over_rho1", "wall_time_s")
+SHORT_VIEW_2D = ("dx", "cells", "cells_y", "stop_time", "lower_stop_time",
+                 "upper_stop_time", "runout", "lateral_spread", "mass_radius",
+                 "deposit_area", "max_depth", "wall_time_s")
 SWEEP_VIEW = ("dx", "prefactor", "exponent", "exponent_mass", "all_at_rest", "wall_time_s")
 
 
@@ -249,7 +264,6 @@ def cmd_converge(args: argparse.Namespace) -> int:
                         f"{args.levels}")
     check_file(args.summary, "--summary", (".json",))
     case = load_case(args.case, args.set)
-    require_1d(case, "pdeflow converge")
     if not case.data.get("sweep"):
         from ..sizecheck import check_size
 
@@ -268,11 +282,13 @@ def cmd_converge(args: argparse.Namespace) -> int:
         print(table(res, SWEEP_VIEW))
     else:
         res = converge(case, args.levels, args.model, progress=progress)
-        keys = None if args.all else [k for k in SHORT_VIEW if k in res["levels"][0]
+        view = SHORT_VIEW_2D if case.is_2d else SHORT_VIEW
+        keys = None if args.all else [k for k in view if k in res["levels"][0]
                                       and any(r[k] is not None for r in res["levels"])]
         print(table(res, keys))
         if not args.all:
-            print("(--all: every quantity, with the upper-layer volumes V1(t); "
+            volumes = "" if case.is_2d else ", with the upper-layer volumes V1(t)"
+            print(f"(--all: every quantity{volumes}; "
                   "--summary OUT.json: all of it as JSON)")
     if args.summary:
         write_json(args.summary, res)

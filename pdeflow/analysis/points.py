@@ -52,8 +52,18 @@ def on_grid(case: Case, *, cells: int | None = None, dx: float | None = None) ->
 
 
 def refined(case: Case, level: int) -> Case:
-    """Copy of ``case`` with dx = (the case's dx) / 2**level."""
-    return on_grid(case, dx=case.dx / 2**level)
+    """Copy of ``case`` with dx = (the case's dx) / 2**level; on a 2D grid dy too (a
+    ``grid.dy`` halved, ``grid.cells_y`` doubled, per level; a dy by default follows
+    dx), so that the cells keep their shape."""
+    c = case
+    grid = case.data.get("grid", {})
+    if case.is_2d and ("dy" in grid or "cells_y" in grid):
+        c = case.copy()
+        if "cells_y" in grid:
+            c.data["grid"]["cells_y"] = int(grid["cells_y"]) * 2**level
+        else:
+            c.data["grid"]["dy"] = case.dy / 2**level
+    return on_grid(c, dx=case.dx / 2**level)
 
 
 def with_sets(case: Case, items: Iterable[str], validate: bool = True) -> Case:
@@ -78,15 +88,19 @@ def case_on_grid(case: Case, grid: float | int, variant: Variant,
                  cfl: float | None = None) -> Case:
     """Copy of ``case`` on the grid ``grid`` (int: cells, float: dx [m], rounded to a
     whole number of cells) solved with ``variant`` (and ``cfl`` if given), without
-    snapshots."""
+    snapshots. On a 2D grid ``grid`` is along x; the cells along y scale with it (as
+    many per cell along x as the case has: the cells keep their shape)."""
     if isinstance(grid, (int, np.integer)) and not isinstance(grid, bool):
         cells = int(grid)
     else:  # nearest whole number of cells (case files require length/dx integral)
         cells = max(1, round(case.length / float(grid)))
     sets = [f"grid.cells={cells}", "output.snapshot_times=[]"]
+    if case.is_2d:
+        sets.append(f"grid.cells_y={max(1, round(cells * case.cells_y / case.cells))}")
     if cfl is not None:
         sets.append(f"numerics.cfl={float(cfl)!r}")
     c = with_sets(case, sets, validate=False)
     c.data["grid"].pop("dx", None)
+    c.data["grid"].pop("dy", None)  # a 2D grid's: cells_y says it
     c.data.get("numerics", {}).pop("dt", None)
     return c.with_variant(variant)  # validates once, with every change made

@@ -13,7 +13,9 @@ wall, or the axis, that holds ``output.runout_mass_fraction`` of the mass, 99 % 
 default; :func:`pdeflow.metrics.mass_quantile_position`), which converges with the grid
 where R follows a thin tail. A power law r = p a^e is fitted by least squares on log r
 against log a, for each measure (``prefactor``, ``exponent``; ``prefactor_mass``,
-``exponent_mass``). The paper reports
+``exponent_mass``). A 2D case (``grid.width``) sweeps its release in the same way
+(:mod:`pdeflow.analysis.sweep_2d`: L0 its extent along x, the 2D summary's numbers per
+row, no paper's law to compare). The paper reports
 r = 2.25 a^1.06 (single layer, phi_B = 30 deg) and r = 1.61 a^0.84 (two layers); the DEM
 of Lacaze et al. (2008) gives the exponent 0.83 +- 0.03.
 """
@@ -28,12 +30,12 @@ from typing import Any
 import numpy as np
 
 from .. import systems
-from ..case_validation_2d import require_1d
 from ..cases import PAPER_MODEL, Case, CaseError, load_case
 from ..numerics.warmup import prepare
 from ..simulate import case_steppers
 from ..study.core import Executor, Study, serial
 from .points import Point, with_sets
+from .sweep_2d import release_length, row_2d, runs_table
 
 DEM_EXPONENT = 0.83
 
@@ -72,6 +74,13 @@ def fit_power_law(a: np.ndarray, r: np.ndarray) -> tuple[float, float]:
     return float(np.exp(logp)), float(e)
 
 
+def sweep_length(case: Case) -> float | None:
+    """The length L0 [m] that H0 = a L0 scales: ``initial.L0`` (the column's), on a 2D
+    grid the release's extent along x (:func:`~pdeflow.analysis.sweep_2d.release_length`);
+    None for a 1D case without a column."""
+    return release_length(case) if case.is_2d else case.L0
+
+
 def sweep_ratios(case: Case) -> list[float]:
     """The case's ``sweep.aspect_ratios``; CaseError if it has none or no column."""
     ratios = case.data.get("sweep", {}).get("aspect_ratios", [])
@@ -83,7 +92,7 @@ def sweep_ratios(case: Case) -> list[float]:
            for a in ratios):
         raise CaseError(f"{case.source}: sweep.aspect_ratios must be numbers > 0, got "
                         f"{ratios!r}")
-    if case.L0 is None:
+    if sweep_length(case) is None:
         raise CaseError(f"{case.source}: a sweep needs initial.L0 (shape = 'column')")
     return [float(a) for a in ratios]
 
@@ -145,14 +154,16 @@ def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
 
     A :class:`~pdeflow.study.core.Study`: one point per model and aspect ratio a
     (the case with H0 = a L0, no snapshots), measured by :func:`runout_row` (on an
-    axisymmetric case by :func:`deposit_row`: the final height and arrest time too).
+    axisymmetric case by :func:`deposit_row`: the final height and arrest time too; on
+    a 2D case by :func:`~pdeflow.analysis.sweep_2d.row_2d`: the 2D summary's numbers).
     """
     ratios = aspect_ratios or sweep_ratios(case)
-    L0 = case.L0
+    L0 = sweep_length(case)
     if L0 is None:
         raise CaseError(f"{case.source}: a sweep needs initial.L0 (shape = 'column')")
     models = models or case.models
     out: dict[str, Any] = {"case": case.name, "L0": L0, "dx": case.dx,
+                           **({"dy": case.dy} if case.is_2d else {}),
                            "front_threshold": case.front_threshold,
                            "runout_mass_fraction": case.runout_mass_fraction, "models": {}}
     points = [Point(with_sets(case, [f"initial.H0={float(a) * L0!r}",
@@ -160,13 +171,15 @@ def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
                     labels={"model": model, "a": float(a)})
               for model in models for a in ratios]
     wall0 = time.perf_counter()
-    measure = deposit_row if case.geometry == "axisymmetric" else runout_row
+    measure = (row_2d if case.is_2d else
+               deposit_row if case.geometry == "axisymmetric" else runout_row)
     table = Study(points, measure).execute(executor, "sweep" if progress else None)
     for model in models:
         rows = [{k: v for k, v in row.items() if k != "model"} for row in table
                 if row["model"] == model]
         p, e = _fit(rows, "r")
         p_mass, e_mass = _fit(rows, "r_mass")
+        paper = systems.get(model).paper_runout_law or (None, None)
         out["models"][model] = {
             "points": [[row["a"], row["r"]] for row in rows],
             "points_mass": [[row["a"], row["r_mass"]] for row in rows],
@@ -175,8 +188,9 @@ def run_sweep(case: Case, aspect_ratios: list[float] | None = None,
             "exponent": e,
             "prefactor_mass": p_mass,
             "exponent_mass": e_mass,
-            "paper_prefactor": (systems.get(model).paper_runout_law or (None, None))[0],
-            "paper_exponent": (systems.get(model).paper_runout_law or (None, None))[1],
+            # the paper's laws are planar (1D); a 2D release has none to compare
+            "paper_prefactor": None if case.is_2d else paper[0],
+            "paper_exponent": None if case.is_2d else paper[1],
             "all_at_rest": all(row["at_rest"] for row in rows),
         }
     out["wall_time_s"] = time.perf_counter() - wall0
@@ -242,7 +256,8 @@ def sweep_figure(summary: dict[str, Any], path: str | Path) -> Path:
 
 def add_arguments(ap: Any) -> None:
     """The options of ``pdeflow sweep``."""
-    ap.add_argument("case", help="sweep case file (a column case with a [sweep] section)")
+    ap.add_argument("case", help="sweep case file (a column case, or a 2D release, with a "
+                    "[sweep] section)")
     ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                     help="override a case value (repeatable)")
     ap.add_argument("--summary", metavar="OUT.json", help="write the sweep summary here")
@@ -258,7 +273,6 @@ def cmd_sweep(args: Any) -> int:
     check_file(args.summary, "--summary", (".json",))
     check_file(args.plot, "--plot", FIGURE_SUFFIXES)
     case = load_case(args.case, args.set)
-    require_1d(case, "pdeflow sweep")
     sweep_ratios(case)  # before any run
     prepare(case_steppers(case), log=None if args.quiet else sys.stderr)
     summary = run_sweep(case, progress=not args.quiet and sys.stderr.isatty())
@@ -272,25 +286,31 @@ def cmd_sweep(args: Any) -> int:
             pts = ", ".join(f"{a:g}:{r:.3g}" if r else f"{a:g}:-" for a, r in res["points"])
             fit = (f"r = {res['prefactor']:.3g} a^{res['exponent']:.3f}"
                    if res["prefactor"] else "no fit")
-            print(f"{model:13} {fit}   (paper {res['paper_prefactor']} "
-                  f"a^{res['paper_exponent']})   a:r {pts}")
-            _print_mass_fit(model, res, summary["runout_mass_fraction"])
+            paper = ("" if case.is_2d else f"   (paper {res['paper_prefactor']} "
+                     f"a^{res['paper_exponent']})")
+            print(f"{model:13} {fit}{paper}   a:r {pts}")
+            _print_mass_fit(model, res, summary["runout_mass_fraction"],
+                            "radius about the centre" if case.is_2d else "front")
             if res["runs"] and "H_inf_over_L0" in res["runs"][0]:  # axisymmetric
                 print(f"{'':13} a:H_inf/R0 " + ", ".join(
                     f"{row['a']:g}:{row['H_inf_over_L0']:.3g}" for row in res["runs"])
                     + "   a:t_stop/(H0/g)^(1/2) " + ", ".join(
                     f"{row['a']:g}:{row['arrest_time_scaled']:.3g}" if row["arrest_time_scaled"]
                     else f"{row['a']:g}:-" for row in res["runs"]))
+            if case.is_2d:
+                print(runs_table(res["runs"]))
         print(f"wall time {summary['wall_time_s']:.2f} s")
         for path in written:
             print(f"wrote {path}")
     return 0
 
 
-def _print_mass_fit(model: str, res: dict[str, Any], fraction: float) -> None:
-    """The line of the mass-quantile run-outs of one model's sweep."""
+def _print_mass_fit(model: str, res: dict[str, Any], fraction: float,
+                    what: str = "front") -> None:
+    """The line of the mass-quantile run-outs of one model's sweep (``what``: the
+    measure holding the mass, a 1D front or a 2D radius)."""
     pts = ", ".join(f"{a:g}:{r:.3g}" if r else f"{a:g}:-" for a, r in res["points_mass"])
     fit = (f"r_mass = {res['prefactor_mass']:.3g} a^{res['exponent_mass']:.3f}"
            if res["prefactor_mass"] else "r_mass: no fit")
-    print(f"{'':13} {fit}   (front holding {100 * fraction:.4g}% of the mass)   "
+    print(f"{'':13} {fit}   ({what} holding {100 * fraction:.4g}% of the mass)   "
           f"a:r_mass {pts}")

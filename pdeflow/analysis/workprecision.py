@@ -36,7 +36,9 @@ Errors and timing
   [m^2], and of the momentum, sum_k sum_i |(hu)_k,i - (hu)_k,ref,i| dx [m^3/s] (k runs
   over the layers). Exact solutions are averaged over each cell (8-point midpoint rule);
   a fine-grid reference is restricted to the coarse grid by cell averaging (exact
-  integration of the piecewise-constant fine solution over each coarse cell).
+  integration of the piecewise-constant fine solution over each coarse cell). A 2D
+  case: over the area (dx dy; m^3 and m^4/s, hu and hv), against a fine 2D reference
+  averaged along y and x; no mol-rk (docs/two_d.md).
 * reference: ``exact`` for single-layer dam breaks onto a dry bed (Ritter with
   phi_B -> 0, Mangeney on a slope); otherwise ``fine``: the same variant and model on a
   grid with dx_ref = min(dx)/4 (``reference_dx``). ``fine:VARIANT`` uses one common
@@ -66,6 +68,7 @@ import numpy as np
 
 from ..case_validation_2d import require_1d
 from ..cases import Case, CaseError, load_case
+from ..metrics_2d import ROWS_PER_LAYER
 from ..study.core import Study
 from ..variant import MAX_CFL, Variant
 from .exact import exact_solution_for
@@ -98,17 +101,33 @@ def restrict(values: np.ndarray, fine_edges: np.ndarray,
     return out.reshape(*values.shape[:-1], coarse_edges.size - 1)
 
 
-def cell_edges(case: Case) -> np.ndarray:
-    """Cell faces [m] of the case's grid."""
-    return case.x_start + case.length * np.linspace(0.0, 1.0, case.cells + 1)
+def cell_edges(case: Case) -> Any:
+    """Cell faces [m] of the case's grid; a 2D grid's along x and along y (a pair)."""
+    x = case.x_start + case.length * np.linspace(0.0, 1.0, case.cells + 1)
+    if not case.is_2d:
+        return x
+    return x, case.y_start + case.width * np.linspace(0.0, 1.0, case.cells_y + 1)
+
+
+def restrict_grid(values: np.ndarray, fine_edges: Any, coarse_edges: Any) -> np.ndarray:
+    """:func:`restrict` on the grid of :func:`cell_edges`: a 2D grid's values (last
+    two axes: x, y) along y, then along x (the average over a coarse cell either way)."""
+    if not isinstance(fine_edges, tuple):
+        return restrict(values, fine_edges, coarse_edges)
+    (fx, fy), (cx, cy) = fine_edges, coarse_edges
+    along_y = restrict(values, fy, cy)
+    return np.swapaxes(restrict(np.swapaxes(along_y, -1, -2), fx, cx), -1, -2)
 
 
 # --- the harness -----------------------------------------------------------------------
 
-def _errors(data: np.ndarray, ref: np.ndarray, dx: float) -> tuple[float, float]:
-    depth = float(np.abs(data[::2] - ref[::2]).sum() * dx)
-    mom = float(np.abs(data[1::2] - ref[1::2]).sum() * dx)
-    return depth, mom
+def _errors(data: np.ndarray, ref: np.ndarray, cell: float,
+            rows: int = 2) -> tuple[float, float]:
+    """L1 errors of the depths and of the momenta (every row of a layer after its
+    depth: hu, and hv on a 2D grid) over cells of size ``cell`` [m, or m^2 in 2D]."""
+    depth = float(np.abs(data[::rows] - ref[::rows]).sum() * cell)
+    mom = sum(float(np.abs(data[k::rows] - ref[k::rows]).sum()) for k in range(1, rows))
+    return depth, mom * cell
 
 
 def compare(case_path: str | Path | Case, variants: Sequence[str] | None = None,
@@ -152,16 +171,33 @@ def compare(case_path: str | Path | Case, variants: Sequence[str] | None = None,
                          f"{reference!r}")
     grids = list(grids or [base.dx, base.dx / 2, base.dx / 4])
     _check_options(base, grids, repeats, cfl)
+    ref_dx = reference_dx or min(_dx_of(base, gr) for gr in grids) / 4
+    if base.is_2d:  # a fine 2D reference grows as 1/dx^2: estimated before any run
+        from ..sizecheck import check_size
+
+        check_size(case_on_grid(base, ref_dx, Variant()), False,
+                   f"the fine reference (dx = {ref_dx:.3g} m) is too fine: use coarser "
+                   "--grids or a larger --reference-dx")
     harness = _Harness(base, float(t if t is not None else base.t_end), reference,
-                       reference_dx or min(_dx_of(base, gr) for gr in grids) / 4,
-                       repeats, cfl, mol_cap, log)
-    parsed = [Variant.parse(v) for v in variants or DEFAULT_VARIANTS]
+                       ref_dx, repeats, cfl, mol_cap, log)
+    parsed = [Variant.parse(v) for v in variants or default_variants(base)]
+    if base.is_2d and any(v.is_mol for v in parsed):
+        raise CaseError(f"{base.source}: the variant mol-rk (py-pde's solver) is 1D only "
+                        "for now (issue 36): a 2D case runs with fv-split variants")
     rows = [row for model in models or base.models
             for row in harness.model_rows(model, parsed, grids)]
     result = CompareResult(label or base.name, harness.t, rows)
     if out_dir is not None:
         write_outputs(result, Path(out_dir))
     return result
+
+
+def default_variants(case: Case) -> tuple[str, ...]:
+    """:data:`DEFAULT_VARIANTS`; on a 2D grid without mol-rk (py-pde's solvers are
+    1D only for now)."""
+    if case.is_2d:
+        return tuple(v for v in DEFAULT_VARIANTS if not Variant.parse(v).is_mol)
+    return DEFAULT_VARIANTS
 
 
 def _check_options(case: Case, grids: list[float | int], repeats: int,
@@ -244,7 +280,7 @@ class _Harness:
     def timed(self, point: Point) -> dict[str, Any]:
         """Measure: the timing of one point, announced on the log."""
         self.say(f"{self.base.name} {point.model} {point.variant} "
-                 f"cells={point.case.cells}")
+                 f"cells={_cells(point.case)}")
         return timed(point, self.t, self.repeats, self.mol_cap)
 
     def reference_on(self, point: Point, exact: Any) -> tuple[np.ndarray, str]:
@@ -254,7 +290,7 @@ class _Harness:
             h, hu = exact.cell_averages(edges, self.t)
             return np.stack([h, hu]), f"exact {exact.name.capitalize()}"
         fdata, fedges, ref_name = self.fine_reference(point.model, point.variant)
-        return restrict(fdata, fedges, edges), ref_name
+        return restrict_grid(fdata, fedges, edges), ref_name
 
     def fine_reference(self, model: str, v: Variant) -> tuple[np.ndarray, np.ndarray, str]:
         """A fine-grid run (state, cell faces, name), computed once per model and
@@ -265,7 +301,7 @@ class _Harness:
         key = (model, rv.name)
         if key not in self.fine:
             fc = case_on_grid(self.base, self.ref_dx, rv, self.cfl_of(rv))
-            self.say(f"  reference {model} {rv.name} dx={self.ref_dx:g} ({fc.cells} cells)")
+            self.say(f"  reference {model} {rv.name} dx={self.ref_dx:g} ({_cells(fc)} cells)")
             run = run_variant(fc, model, rv, self.t, repeats=0)
             if run.status != "ok":
                 raise RuntimeError(f"fine reference {rv.name} failed: {run.note}")
@@ -280,17 +316,21 @@ class _Harness:
         c, v = point.case, point.variant
         assert v is not None
         dx = c.length / c.cells
-        eh, ehu = _errors(run.data, ref, dx) if run.status == "ok" else (math.nan,) * 2
-        norm = float(np.abs(ref[::2]).sum() * dx)
+        rows = ROWS_PER_LAYER if c.is_2d else 2
+        cell = dx * c.width / c.cells_y if c.is_2d else dx  # [m] or [m^2]
+        eh, ehu = (_errors(run.data, ref, cell, rows) if run.status == "ok"
+                   else (math.nan,) * 2)
+        norm = float(np.abs(ref[::rows]).sum() * cell)
         row = {
             "case": self.base.name, "model": point.model, "variant": v.name,
             "solver": v.solver, "splitting": None if v.is_mol else v.splitting,
-            "cells": c.cells, "dx": dx, "t": self.t,
+            "cells": c.cells, **({"cells_y": c.cells_y} if c.is_2d else {}),
+            "dx": dx, "t": self.t,
             "err_h": eh, "err_hu": ehu,
             "rel_err_h": eh / norm if norm > 0 else math.nan,
             "wall_s": statistics.median(run.wall_s), "walls": run.wall_s,
             "compile_s": run.compile_s, "steps": run.steps,
-            "cell_updates": run.steps * c.cells, "status": run.status,
+            "cell_updates": run.steps * c.total_cells, "status": run.status,
             "note": run.note, "reference": ref_name, "order_h": None,
         }
         if v.is_mol:
@@ -298,9 +338,15 @@ class _Harness:
         if (prev is not None and prev["status"] == "ok" and run.status == "ok"
                 and eh > 0 and prev["err_h"] > 0):
             row["order_h"] = math.log(prev["err_h"] / eh) / math.log(prev["dx"] / dx)
-        self.say(f"    err_h={eh:.3e} m^2 err_hu={ehu:.3e} m^3/s "
+        depth, momentum = ("m^3", "m^4/s") if c.is_2d else ("m^2", "m^3/s")
+        self.say(f"    err_h={eh:.3e} {depth} err_hu={ehu:.3e} {momentum} "
                  f"wall={row['wall_s'] * 1e3:.2f} ms {run.status} {run.note}")
         return row
+
+
+def _cells(case: Case) -> str:
+    """The cells of a case's grid: '200', a 2D grid's '40x20'."""
+    return f"{case.cells}x{case.cells_y}" if case.is_2d else str(case.cells)
 
 
 # --- command line ----------------------------------------------------------------------
@@ -362,7 +408,8 @@ def _cases_and_laws(args: argparse.Namespace) -> list[tuple[str, Case, str | Non
     out: list[tuple[str, Case, str | None]] = []
     for path in args.cases:
         case = load_case(path, args.set)
-        require_1d(case, "pdeflow compare")
+        if getattr(args, "hyperbolicity", False):
+            require_1d(case, "pdeflow compare --hyperbolicity")
         if not getattr(args, "laws", None):
             out.append((path, case, None))
             continue

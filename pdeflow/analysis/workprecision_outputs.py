@@ -32,15 +32,31 @@ def _fmt(v: Any, spec: str) -> str:
     return format(v, spec)
 
 
+def units(result: CompareResult, tex: bool = False) -> tuple[str, str]:
+    """The units of the L1 errors of depth and momentum: per unit width on a 1D grid
+    (m^2, m^3/s), over the area on a 2D one (m^3, m^4/s; its rows have ``cells_y``);
+    ``tex``: as matplotlib's mathtext."""
+    two_d = bool(result.rows) and "cells_y" in result.rows[0]
+    area, length = (3, 4) if two_d else (2, 3)
+    if tex:
+        return f"m$^{area}$", f"m$^{length}$/s"
+    return f"m^{area}", f"m^{length}/s"
+
+
+def _cells(row: dict[str, Any]) -> str:
+    return f"{row['cells']}x{row['cells_y']}" if "cells_y" in row else str(row["cells"])
+
+
 def markdown_table(result: CompareResult) -> str:
     """The rows of ``result`` as a Markdown table."""
-    lines = ["| model | variant | cells | L1 depth [m^2] | L1 momentum [m^3/s] | order | "
-             "wall [ms] | steps | status |",
+    depth, momentum = units(result)
+    lines = [f"| model | variant | cells | L1 depth [{depth}] | L1 momentum [{momentum}] | "
+             "order | wall [ms] | steps | status |",
              "|---|---|---:|---:|---:|---:|---:|---:|---|"]
     for r in result.rows:
         status = r["status"] if r["status"] == "ok" else f"{r['status']}: {r['note']}"
         lines.append(
-            f"| {r['model']} | {r['variant']} | {r['cells']} | {_fmt(r['err_h'], '.3e')} | "
+            f"| {r['model']} | {r['variant']} | {_cells(r)} | {_fmt(r['err_h'], '.3e')} | "
             f"{_fmt(r['err_hu'], '.3e')} | {_fmt(r['order_h'], '.2f')} | "
             f"{_fmt(r['wall_s'] * 1e3, '.3g')} | {r['steps']} | {status} |")
     return "\n".join(lines) + "\n"
@@ -58,9 +74,10 @@ def plot(result: CompareResult, path: str | Path) -> Path:
     variants = list(dict.fromkeys(r["variant"] for r in result.rows))
     fig, axes = plt.subplots(2, len(models), figsize=(5.5 * len(models), 8), squeeze=False)
     markers = "osD^v<>phX*"
+    depth, momentum = units(result, tex=True)
     for j, model in enumerate(models):
-        for i, (key, label) in enumerate((("err_h", "L1 depth error [m$^2$]"),
-                                          ("err_hu", "L1 momentum error [m$^3$/s]"))):
+        for i, (key, label) in enumerate((("err_h", f"L1 depth error [{depth}]"),
+                                          ("err_hu", f"L1 momentum error [{momentum}]"))):
             ax = axes[i, j]
             for k, v in enumerate(variants):
                 rs = [r for r in result.rows if r["model"] == model and r["variant"] == v

@@ -129,6 +129,9 @@ def warm(spec: StudySpec) -> float:
         grid = tiny.data.setdefault("grid", {})
         grid.pop("dx", None)
         grid["cells"] = 16
+        if tiny.is_2d:  # 16 x 16 cells
+            grid.pop("dy", None)
+            grid["cells_y"] = 16
         tiny.data.setdefault("case", {})["t_end"] = 0.01
         tiny.data.pop("sweep", None)
         for model in models:

@@ -45,7 +45,6 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from .. import systems
-from ..case_validation_2d import require_1d
 from ..cases import Case, CaseError, load_case, read_text
 from ..simulate import summary_keys
 from .expressions import Expression, StudyError
@@ -211,14 +210,14 @@ def _case(path: Path, raw: Any, overrides: list[str], key: str) -> Case:
     if not isinstance(raw, str):
         raise StudyError(f"study.{key} must be a case file name, got {raw!r}")
     try:
-        case = load_case(path.parent / raw, overrides)
-        require_1d(case, "pdeflow study")
-        return case
+        return load_case(path.parent / raw, overrides)
     except CaseError as err:
         raise StudyError(f"study.{key}: {err}") from None
 
 
-def _check_quantity(q: str, function: str | None) -> None:
+def _check_quantity(q: str, function: str | None, two_d: bool = False) -> None:
+    """A quantity the runs give (``two_d``: the base case is 2D, its runs have the 2D
+    summary's keys), else a StudyError naming the keys there are."""
     if function is not None:
         return
     parts = q.split(".")
@@ -228,10 +227,11 @@ def _check_quantity(q: str, function: str | None) -> None:
         raise StudyError(f"unknown quantity {q!r}: a sweep quantity is "
                          f"sweep.<{'|'.join(systems.names())}>.<{'|'.join(SWEEP_KEYS)}>")
     if len(parts) == 2 and parts[0] in systems.names():
-        if parts[1] in summary_keys(parts[0], series=True):
+        keys = summary_keys(parts[0], series=True, two_d=two_d)
+        if parts[1] in keys:
             return
-        raise StudyError(f"unknown quantity {q!r}: {parts[0]}'s run summary has "
-                         f"{', '.join(summary_keys(parts[0], series=True))}")
+        raise StudyError(f"unknown quantity {q!r}: {parts[0]}'s run summary"
+                         f"{' (2D)' if two_d else ''} has {', '.join(keys)}")
     raise StudyError(f"unknown quantity {q!r}: use <model>.<summary key> with model "
                      f"{' or '.join(systems.names())}, or sweep.<model>.exponent")
 
@@ -271,7 +271,8 @@ def _build(path: Path, text: str, data: dict[str, Any]) -> StudySpec:
                   for k, v in data.get("objectives", {}).items()}
     if design == "optimize" and not objectives:
         raise StudyError("the optimize design needs [objectives] (expressions to minimise)")
-    quantities = _quantity_names(st, derived, objectives, function)
+    quantities = _quantity_names(st, derived, objectives, function,
+                                 case is not None and case.is_2d)
     spec = StudySpec(
         path=path, text=text, name=str(st.get("name", path.stem)), design=design,
         parameters=parameters, quantities=tuple(quantities), derived=derived,
@@ -350,8 +351,10 @@ def _sources(path: Path, text: str, data: dict[str, Any], st: dict[str, Any],
 
 
 def _quantity_names(st: dict[str, Any], derived: dict[str, Expression],
-                    objectives: dict[str, Expression], function: str | None) -> list[str]:
-    """study.quantities and every quantity an expression reads, each checked."""
+                    objectives: dict[str, Expression], function: str | None,
+                    two_d: bool = False) -> list[str]:
+    """study.quantities and every quantity an expression reads, each checked (against
+    a 2D run's summary if ``two_d``)."""
     listed = st.get("quantities", [])
     if not isinstance(listed, list) or not all(isinstance(q, str) for q in listed):
         raise StudyError("study.quantities must be a list of names")
@@ -367,7 +370,7 @@ def _quantity_names(st: dict[str, Any], derived: dict[str, Expression],
                 quantities.append(n)
     for q in quantities:
         try:
-            _check_quantity(q, function)
+            _check_quantity(q, function, two_d)
         except StudyError as err:
             raise StudyError(f"study.quantities: {err}") from None
     if not quantities:
