@@ -114,7 +114,7 @@ def test_pyclaw_2d_solves_the_same_dam_break():
 
     if not pyclaw_run.available(pyclaw_2d.RIEMANN):
         pytest.skip("clawpack is not installed")
-    m = {n: pyclaw_2d.measure(n, repeats=1) for n in (32, 64)}
+    m = {n: pyclaw_2d.measure_grid(n, repeats=1) for n in (32, 64)}
     for n in (32, 64):
         steps = [r["steps"] for r in m[n]["rows"].values()]
         assert max(steps) <= 1.05 * min(steps), m[n]["rows"]
