@@ -213,7 +213,8 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool, width: int = 2,
     layer) and ``dry`` [m] are the model's. The model's kernels: ``advect`` (its
     advection stage), ``sources`` (its source stage), ``predictor`` (MUSCL, ``order``
     2: the friction predictor of the SSP-RK2/Heun integrator, see
-    :func:`~pdeflow.models.two_layer.friction.predictor_two_layer`; else None) and
+    :func:`~pdeflow.models.two_layer.friction.predictor_two_layer`; else None; on a 2D
+    grid both take the box, :func:`pdeflow.numerics.threads.box_kernels`) and
     ``fallback`` (``ifcp``: the HLL advection stage that redoes a step IFCP left
     negative; else None). ``strang`` applies half a source step before and after the
     advection (else Lie, as in the paper). With Strang, dt is chosen before the first
