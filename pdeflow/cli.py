@@ -14,7 +14,8 @@ from pathlib import Path
 from typing import Any
 
 from . import __version__
-from .cli_options import positive
+from .cli_options import positive, threads_option
+from .numerics.threads import DEFAULT_THREADS
 
 RUN_HELP = """Run every model listed in the case file (case.models) to rest or t_end.
 
@@ -151,7 +152,8 @@ def _run_models(args: argparse.Namespace, case: Any, outputs: Any) -> dict[str, 
         trackers = _run_trackers(args, case, model, first=i == 0)
         outputs.add(trackers)
         # a signal is handled within a second (observers do not change the run)
-        results[model] = run_model(case, model, tracker=[*trackers, SignalCheck()])
+        results[model] = run_model(case, model, tracker=[*trackers, SignalCheck()],
+                                   threads=args.threads)
     return results
 
 
@@ -276,6 +278,10 @@ def _add_run(sub: Any) -> None:
                        help="simulation time between live frames [s] (default t_end/100)")
     watch.add_argument("--fps", type=float, default=10.0,
                        help="frames per second of --movie (default 10)")
+    run.add_argument("--threads", type=threads_option, default=DEFAULT_THREADS,
+                     metavar="N", help="threads of a 2D run (1 to the cores; the same "
+                     "numbers for any N; default 1: runs in parallel processes do not "
+                     "crowd the cores; a 1D run uses one)")
     run.add_argument("--force", action="store_true",
                      help="run even if the run is estimated to take more than a day or "
                      "half the machine's memory (refused otherwise)")

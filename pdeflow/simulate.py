@@ -47,6 +47,7 @@ from .numerics import layout as L
 from .numerics.geometry import Metric
 from .numerics.splitting import Stepper
 from .numerics.state import velocity_profile
+from .numerics.threads import DEFAULT_THREADS, check_threads
 from .numerics.warmup import prepare
 from .solvers.diagnostics import SplitDiagnostics
 from .solvers.fv_split import SimulationBlowUp, split_stepper
@@ -143,6 +144,8 @@ class Run:
         model: the registered name of the model (:func:`pdeflow.systems.names`).
         variant: how to solve it; default: what the case file selects.
         backend: ``"numba"`` (compiled stepping loop) or ``"numpy"`` (fv-split only).
+        threads: numba threads of a 2D fv-split run (the ``fv-split`` solver's
+            ``threads``: 1..the cores, default 1; a 1D run runs on one).
 
     Attributes ``case``, ``variant``, ``pde`` (with the variant's scheme), ``state``
     (the initial state) and ``metric`` (of its grid: the geometry, derived from the grid
@@ -151,7 +154,8 @@ class Run:
     """
 
     def __init__(self, case: Case, model: str, variant: Variant | str | None = None, *,
-                 backend: str = "numba"):
+                 backend: str = "numba", threads: int = DEFAULT_THREADS):
+        self.threads = check_threads(threads)
         if isinstance(variant, str):
             variant = Variant.parse(variant)
         self.case = case if variant is None else case.with_variant(variant)
@@ -167,7 +171,8 @@ class Run:
             return {"solver": self.variant.solver,
                     "dt": float(self.case.data.get("numerics", {}).get("dt", 1e-4))}
         return {"solver": "fv-split", "cfl": self.case.cfl, "backend": self.backend,
-                "outputs": self.case.frames}  # the scheme is the PDE's
+                "outputs": self.case.frames,  # the scheme is the PDE's
+                "threads": self.threads}
 
     def make_solver(self) -> Any:
         """The py-pde solver of this run (for timing the bare stepper, as the
@@ -300,11 +305,11 @@ def run_series(res: RunResult, tracker: SeriesTracker) -> ErosionSeries:
                           bed_row=2 * (layer or 0), booked=booked)
 
 
-def run_model(case: Case, model: str, *, tracker: Any = None,
-              backend: str = "numba") -> RunResult:
+def run_model(case: Case, model: str, *, tracker: Any = None, backend: str = "numba",
+              threads: int = DEFAULT_THREADS) -> RunResult:
     """Run ``model`` (a registered name) of ``case`` to rest or t_end:
-    ``Run(case, model, backend=backend).execute(tracker)``."""
-    return Run(case, model, backend=backend).execute(tracker)
+    ``Run(case, model, backend=backend, threads=threads).execute(tracker)``."""
+    return Run(case, model, backend=backend, threads=threads).execute(tracker)
 
 
 _COMMON_KEYS = ("model", "solver", "geometry", "bed", "t_final", "at_rest", "front_position",

@@ -62,7 +62,7 @@ BOTH_PATHS = {"numba.core.dispatcher.Dispatcher.compile",
 
 ATTRIBUTES = {
     "numba.core.cpu.CPUTargetOptions": ["no_cpython_wrapper", "no_cfunc_wrapper",
-                                        "inline", "boundscheck"],
+                                        "inline", "boundscheck", "parallel"],
     "numba.core.dispatcher.Dispatcher": ["signatures", "stats"],
     "numba.core.caching.FunctionCache": ["_guard_against_spurious_io_errors"],
     "numba.extending.typeof_impl": ["register"],

@@ -10,6 +10,7 @@ with an instrumented one).
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -17,16 +18,9 @@ import numpy as np
 from numba import njit
 
 from . import layout as L
-from .boxes import (
-    box_join,
-    box_meet,
-    clear_outside,
-    copy_box,
-    copy_box1,
-    row_calls,
-    update_in_box_function,
-)
+from .boxes import box_join, box_meet, row_calls, update_in_box_function
 from .compiled import cached
+from .threads import box_passes, update_on_rows
 
 
 def update_function(width: int) -> Any:
@@ -61,6 +55,7 @@ update = cached(inline="always")(update_function(2))
 """the state update of the one-axis models (two rows per layer)"""
 
 
+@functools.cache
 def update_kernel(width: int) -> Any:
     """The compiled state update for ``width`` rows per layer (:data:`update` for 2)."""
     return update if width == 2 else njit(inline="always")(update_function(width))
@@ -108,10 +103,14 @@ def advect_step_function(order: int, strang: bool, update: Any = None, width: in
     muscl = order == 2
     compiled = update is None
     update = update or update_kernel(width)
-    update_box = update_in_box_function(update)
-    if compiled:
-        update_box = njit(inline="always")(update_box)
-    sources_box, predictor_box = row_calls(compiled)
+    if compiled and two_d:  # its rows on numba's threads (pdeflow.numerics.threads)
+        update_box = update_on_rows(update)
+    else:
+        update_box = update_in_box_function(update)
+        if compiled:
+            update_box = njit(inline="always")(update_box)
+    sources_box, predictor_box = row_calls(compiled, two_d)
+    copy_box, copy_box1, clear_outside, _, _ = box_passes(compiled and two_d)
 
     def advect_step(advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
                     P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep,

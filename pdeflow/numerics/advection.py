@@ -38,11 +38,12 @@ import functools
 from typing import Any
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from . import layout as L
 from .boxes import box_grow, box_of, rows_of, zero_box
 from .compiled import FIELDS, METRIC, STATE, WORK, cached, f8, i8, kernel, specialise
+from .geometry import area_change, area_change_muscl
 from .model_kernels import ModelKernels, check_flux
 from .state import velocity
 
@@ -171,8 +172,11 @@ def wet_box(q: np.ndarray, dry: float, lo: int, hi: int, width: int,
     grid of ``line`` cells a row (:mod:`pdeflow.numerics.boxes`); ``(1, 0)`` if none."""
     x0, x1, y0, y1 = rows_of(lo, hi, line)
     a0, a1, b0, b1 = x1 + 1, x0 - 1, y1 + 1, y0 - 1  # an empty box
-    for x in range(x0, x1 + 1):
-        klo, khi = line_wet(q, dry, width, x * line, 1, y0, y1)
+    wet = np.empty((max(x1 - x0 + 1, 0), 2), np.int64)
+    for k in prange(x1 - x0 + 1):  # the rows on threads in a parallel kernel
+        wet[k, 0], wet[k, 1] = line_wet(q, dry, width, (x0 + k) * line, 1, y0, y1)
+    for x in range(x0, x1 + 1):  # (min and max: the same box whatever the threads)
+        klo, khi = wet[x - x0, 0], wet[x - x0, 1]
         if klo <= khi:
             a0 = min(a0, x)
             a1 = x
@@ -249,14 +253,14 @@ def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, ax
             l0, l1, step, k0, k1 = x0, x1, per_row, y0, y1
         else:  # lines of the first axis: the box's columns
             l0, l1, step, k0, k1 = y0, y1, 1, x0, x1
-        smax = 0.0
-        for m in range(l0, l1 + 1):
+        speeds = np.zeros(l1 - l0 + 1)
+        for m in prange(l0, l1 + 1):  # lines on threads: each writes its own cells
             base = m * step  # the line of cells base + k stride, k = 0..count - 1
             klo, khi = line_wet(q, dry, width, base, stride, k0, k1)
             if klo <= khi:
-                smax = max(smax, line(qm, qp, rate, metric, base, stride, count, klo, khi,
-                                      inv_dx, s_lo, s_hi, g, r, dry))
-        return smax
+                speeds[m - l0] = line(qm, qp, rate, metric, base, stride, count, klo, khi,
+                                      inv_dx, s_lo, s_hi, g, r, dry)
+        return speeds.max()
 
     return faces
 
@@ -283,7 +287,7 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
               bc_hi, g, r, dry, per_row):
         x0, x1, y0, y1 = rows_of(r_lo, r_hi, per_row) if lines else (0, 0, r_lo, r_hi)
         if muscl:
-            for x in range(x0, x1 + 1):  # a 2D grid's box row by row
+            for x in prange(x0, x1 + 1):  # a 2D grid's box row by row, on threads
                 reconstruct(q, work, x * per_row + y0, x * per_row + y1, stride, count,
                             bc_lo, bc_hi, dry, limiter)
             qm = work[0]
@@ -298,7 +302,7 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
                      r, dry, per_row)
         if muscl:
             # axisymmetric too: the mean face area over the volume is 1/dr exactly
-            for x in range(x0, x1 + 1):
+            for x in prange(x0, x1 + 1):
                 cell_jump(qm, qp, rate, x * per_row + y0, x * per_row + y1, inv_dx, g, r,
                           dry, axis)
         return smax
@@ -369,7 +373,7 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
                                                    axisymmetric, two_d))
     along_y = njit(inline="always")(_axis_function(model, flux, muscl, limiter, 1, False,
                                                    True)) if two_d else None
-    area_change = (_area_change_muscl if muscl else _area_change) if axisymmetric else None
+    area = (area_change_muscl if muscl else area_change) if axisymmetric else None
 
     def advect(q, rate, work, dx, metric, bc_left, bc_right, g, r, dry, start, stop):
         n = q.shape[1]
@@ -383,9 +387,9 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
             smax = along_x(q, rate, work, metric, lo, hi, r_lo, r_hi, 1, n, 1.0 / dx,
                            bc_left, bc_right, g, r, dry, n)
             if axisymmetric and muscl:
-                area_change(work[0], work[1], rate, r_lo, r_hi, metric, dry, width)
+                area(work[0], work[1], rate, r_lo, r_hi, metric, dry, width)
             elif axisymmetric:
-                area_change(q, q, rate, r_lo, r_hi, metric, dry, width)
+                area(q, q, rate, r_lo, r_hi, metric, dry, width)
             return smax, r_lo, r_hi
         # a 2D grid: start, stop and what is returned are boxes, the wet cells' widened
         # by one cell along both axes: the cells their faces write to
@@ -404,34 +408,7 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
                             per_row)
         return max(smax, s), r_lo, r_hi
 
-    return specialise(advect, *ADVECT_SIGNATURE)
-
-
-@cached
-def _area_change(q, unused, rate, lo, hi, metric, dry, width):
-    """Subtract (A_{i+1/2} - A_{i-1/2}) / V_i F^adv(q_i) in the cells lo..hi, F^adv =
-    (h u, h u^2) of each layer (first order: the cell averages)."""
-    for i in range(lo, hi + 1):
-        c = metric[L.M_AREA_CHANGE, i]
-        for k in range(0, q.shape[0], width):
-            h = q[k, i]
-            u = velocity(h, q[k + 1, i], dry)  # as the fluctuations: 0 in a dry layer
-            rate[k, i] -= c * (u * h)
-            rate[k + 1, i] -= c * (u * u * h)
-
-
-@cached
-def _area_change_muscl(qm, qp, rate, lo, hi, metric, dry, width):
-    """:func:`_area_change` with F^adv averaged over the cell's face values qm, qp."""
-    for i in range(lo, hi + 1):
-        c = metric[L.M_AREA_CHANGE, i]
-        for k in range(0, qm.shape[0], width):
-            hm = qm[k, i]
-            hp = qp[k, i]
-            um = velocity(hm, qm[k + 1, i], dry)
-            up = velocity(hp, qp[k + 1, i], dry)
-            rate[k, i] -= c * 0.5 * (um * hm + up * hp)
-            rate[k + 1, i] -= c * 0.5 * (um * um * hm + up * up * hp)
+    return specialise(advect, *ADVECT_SIGNATURE, parallel=two_d)
 
 
 @functools.cache

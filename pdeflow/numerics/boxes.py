@@ -22,7 +22,7 @@ import functools
 from typing import Any
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from . import layout as L
 from .compiled import cached
@@ -98,10 +98,11 @@ def copy_box(dst: np.ndarray, src: np.ndarray, lo: int, hi: int, line: int) -> N
 
 @cached(inline="always")
 def zero_box(a: np.ndarray, lo: int, hi: int, line: int) -> None:
-    """a[:, cells of the box] = 0 for 2D arrays."""
+    """a[:, cells of the box] = 0 for 2D arrays (its rows on threads in a parallel
+    kernel)."""
     x0, x1, y0, y1 = rows_of(lo, hi, line)
-    for k in range(a.shape[0]):
-        for x in range(x0, x1 + 1):
+    for x in prange(x0, x1 + 1):
+        for k in range(a.shape[0]):
             for i in range(x * line + y0, x * line + y1 + 1):
                 a[k, i] = 0.0
 
@@ -194,12 +195,26 @@ def update_in_box_function(update: Any) -> Any:
     return update_in_box
 
 
+def _sources_of_box(sources, q, dt, t, P, diag, lo, hi, line):
+    """A 2D grid's source stage, which takes the box itself
+    (:func:`pdeflow.numerics.threads.box_kernels`: its rows on numba's threads)."""
+    sources(q, dt, t, P, diag, lo, hi, line)
+
+
+def _predictor_of_box(predictor, q, dt, P, lo, hi, line):
+    """A 2D grid's MUSCL predictor, which takes the box itself."""
+    predictor(q, dt, P, lo, hi, line)
+
+
 @functools.cache
-def row_calls(compiled: bool) -> tuple[Any, Any]:
+def row_calls(compiled: bool, two_d: bool = False) -> tuple[Any, Any]:
     """The source stage and the predictor on a box, :func:`_sources_in_box` and
-    :func:`_predictor_in_box`: inlined into a compiled loop (``compiled``), else plain
-    Python (the loop run in Python, see ``splitting.python_stepping``), since they take
-    the model's kernels as arguments."""
+    :func:`_predictor_in_box` (``two_d``: the 2D kernels take the box themselves):
+    inlined into a compiled loop (``compiled``), else plain Python (the loop run in
+    Python, see ``splitting.python_stepping``), since they take the model's kernels as
+    arguments."""
+    calls = (_sources_of_box, _predictor_of_box) if two_d else \
+        (_sources_in_box, _predictor_in_box)
     if not compiled:
-        return _sources_in_box, _predictor_in_box
-    return njit(inline="always")(_sources_in_box), njit(inline="always")(_predictor_in_box)
+        return calls
+    return njit(inline="always")(calls[0]), njit(inline="always")(calls[1])

@@ -117,7 +117,8 @@ def cached(func: Callable | None = None, *, inline: str = "never") -> Any:
 
 
 def specialise(func: Callable, *arg_types: Any, helper: bool = False,
-               pointer: bool = True, inline: str = "never", name: str | None = None) -> Any:
+               pointer: bool = True, inline: str = "never", name: str | None = None,
+               parallel: bool = False) -> Any:
     """A numba kernel of the closure ``func`` with the one signature ``arg_types``,
     disk-cached (see the module docstring); compiled by :func:`ready`. ``helper``: only
     other kernels call it (see :func:`cached`);
@@ -126,7 +127,8 @@ def specialise(func: Callable, *arg_types: Any, helper: bool = False,
     and is compiled by the kernels that call it, as :func:`cached` helpers are.
     ``name``: the module-level name the caller binds it to (one closure of its
     factory), so that a new interpreter finds it by name
-    (:mod:`pdeflow.numerics.compile_parallel`)."""
+    (:mod:`pdeflow.numerics.compile_parallel`). ``parallel``: its ``prange`` loops run on
+    numba's threads (:mod:`pdeflow.numerics.threads`; a 2D grid's passes only)."""
     if config.DISABLE_JIT:
         return func
     # numba names compiled code after the function's qualified name and a per-process
@@ -135,7 +137,7 @@ def specialise(func: Callable, *arg_types: Any, helper: bool = False,
     # from the disk cache may run one's code for the other (numba issue #10486). Here
     # the name carries what the closure is made of, or is a module-level name.
     func.__qualname__ = name or func.__qualname__ + "_" + digest(func)[:12]
-    compiled = _jit(func, helper=helper, pointer=pointer, inline=inline)
+    compiled = _jit(func, helper=helper, pointer=pointer, inline=inline, parallel=parallel)
     if arg_types:
         _SIGNATURES[compiled] = tuple(arg_types)
     _SPECIALISED.append(compiled)
@@ -143,18 +145,19 @@ def specialise(func: Callable, *arg_types: Any, helper: bool = False,
 
 
 def _jit(func: Callable, *, helper: bool = False, pointer: bool = True,
-         inline: str = "never") -> Any:
+         inline: str = "never", parallel: bool = False) -> Any:
     """``numba.njit(func)``, disk-cached; with :data:`HOOKS`, ``helper``: without entry
     points for Python and function pointers, not ``pointer``: without the latter
-    (:func:`pdeflow.numerics.numba_hooks.jit`)."""
+    (:func:`pdeflow.numerics.numba_hooks.jit`); ``parallel``: numba's ``parallel=True``."""
     if config.DISABLE_JIT:
         return func
     if HOOKS is not None:
-        return HOOKS.jit(func, helper=helper, pointer=pointer, inline=inline)
+        return HOOKS.jit(func, helper=helper, pointer=pointer, inline=inline,
+                         parallel=parallel)
     # numba's own cache key pickles what a closure closes over, and a kernel pickles
     # differently in every process: such a closure would be compiled in every process
     # and leave a cache entry each time, so it is not cached
-    return njit(inline=inline, cache=not closes_over_kernels(func))(func)
+    return njit(inline=inline, cache=not closes_over_kernels(func), parallel=parallel)(func)
 
 
 def entry(*kernels: Any) -> None:

@@ -29,6 +29,8 @@ from typing import Any
 import numpy as np
 
 from . import layout as L
+from .compiled import cached
+from .state import velocity
 
 COORDINATES = {"planar": "x", "axisymmetric": "r", "planar-2d": "x"}
 """the name of each geometry's coordinate [m]"""
@@ -143,3 +145,30 @@ def metric_of(grid: Any) -> Metric:
     return Metric(geometry, COORDINATES[geometry], dx, np.linspace(x0, x1, n + 1),
                   np.ones(n + 1),
                   np.full(n, dx))
+
+
+@cached
+def area_change(q, unused, rate, lo, hi, metric, dry, width):
+    """Subtract (A_{i+1/2} - A_{i-1/2}) / V_i F^adv(q_i) in the cells lo..hi, F^adv =
+    (h u, h u^2) of each layer (first order: the cell averages)."""
+    for i in range(lo, hi + 1):
+        c = metric[L.M_AREA_CHANGE, i]
+        for k in range(0, q.shape[0], width):
+            h = q[k, i]
+            u = velocity(h, q[k + 1, i], dry)  # as the fluctuations: 0 in a dry layer
+            rate[k, i] -= c * (u * h)
+            rate[k + 1, i] -= c * (u * u * h)
+
+
+@cached
+def area_change_muscl(qm, qp, rate, lo, hi, metric, dry, width):
+    """:func:`area_change` with F^adv averaged over the cell's face values qm, qp."""
+    for i in range(lo, hi + 1):
+        c = metric[L.M_AREA_CHANGE, i]
+        for k in range(0, qm.shape[0], width):
+            hm = qm[k, i]
+            hp = qp[k, i]
+            um = velocity(hm, qm[k + 1, i], dry)
+            up = velocity(hp, qp[k + 1, i], dry)
+            rate[k, i] -= c * 0.5 * (um * hm + up * hp)
+            rate[k + 1, i] -= c * 0.5 * (um * um * hm + up * up * hp)

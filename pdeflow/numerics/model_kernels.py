@@ -43,7 +43,9 @@ class ModelKernels:
     """MUSCL: ``cell_jump(qm, qp, rate, lo, hi, inv_dx, g, r, dry, axis)`` subtracts the
     flux difference along ``axis`` across the reconstruction inside cells lo..hi"""
     sources: Any
-    """source stage on cells lo..hi: ``sources(q, dt, t, P, diag, lo, hi)``"""
+    """source stage on cells lo..hi: ``sources(q, dt, t, P, diag, lo, hi)``; on a 2D
+    grid ``sources(q, dt, t, P, book, fex, lo, hi)``: its bookkeeping into ``book`` (a
+    row's, :mod:`.threads`), its per-cell diagnostic into ``fex``"""
     source_stage: Any
     """the same on every cell, ``(q, dt, t, P, diag)``: the post-step hook's kernel"""
     predictor: Any
@@ -57,6 +59,9 @@ class ModelKernels:
     constants: Callable[[np.ndarray], tuple[float, float, float]]
     """``P -> (g_z [m/s^2], coupling r [-] (0 without), dry tolerance [m])``: the
     scalars the advection kernels take"""
+    fold: Any = None
+    """2D: ``fold(diag, book)`` adds a row's booking (:attr:`sources` from zeros) to
+    ``diag``'s model slots, called in row order (:func:`.threads.box_kernels`)"""
     layer_rows: int = 2
     """rows per layer: its depth, then its discharge along each axis"""
     rows: tuple[tuple[int, ...], ...] = ()

@@ -36,12 +36,14 @@ from .kernel_identity import code_digest, describe_function
 
 
 def jit(func: Callable, *, helper: bool = False, pointer: bool = True,
-        inline: str = "never", python_twin: bool = False) -> Any:
+        inline: str = "never", python_twin: bool = False, parallel: bool = False) -> Any:
     """``numba.njit(func)`` with the disk cache of :class:`_CodeKeyedCache`; ``helper``:
     a :class:`HelperKernel`; not ``pointer``: without the entry point for a function
-    pointer."""
+    pointer; ``parallel``: its ``prange`` loops run on numba's threads."""
     options = {"nopython": True, "boundscheck": None, "inline": inline,
                "no_cpython_wrapper": helper, "no_cfunc_wrapper": helper or not pointer}
+    if parallel:  # (only then: the options are part of every kernel's cache key)
+        options["parallel"] = True
     compiled = (HelperKernel if helper else CPUDispatcher)(
         py_func=func, locals={}, targetoptions=options)
     compiled._cache = _CodeKeyedCache(func, python_twin, options)
@@ -62,7 +64,9 @@ class HelperKernel(CPUDispatcher):
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
         twin = self.__dict__.get("_python_twin")
         if twin is None:
-            twin = self._python_twin = jit(self.py_func, python_twin=True)
+            twin = self._python_twin = jit(
+                self.py_func, python_twin=True,
+                parallel=bool(self.targetoptions.get("parallel")))
         return twin(*args, **kwargs)
 
 

@@ -31,7 +31,7 @@ from numba import njit, types
 from . import layout as L
 from .advect_step import _copy_range, advect_step_function, speed_scale
 from .advection import ADVECT_SIGNATURE, advection_kernel
-from .boxes import box_grow, clear_outside1, copy_box, copy_box1, row_calls
+from .boxes import box_grow, row_calls
 from .compiled import (
     FIELDS,
     METRIC,
@@ -48,8 +48,9 @@ from .compiled import (
     specialise,
 )
 from .model_kernels import ModelKernels
-from .resting import live_box, rest_changed, rest_maxima, rest_outside
 from .resting import reach as reach_of
+from .resting import rest_changed, rest_maxima, rest_outside
+from .threads import BOX_PREDICTOR, BOX_SOURCES, box_kernels, box_passes
 
 STATUS_END = 0  #: reached t_end
 STATUS_REST = 1  #: everything at rest: nothing will change any more
@@ -70,7 +71,9 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
     grid the dry (or resting) cells beside a flow in y are skipped as well as those
     ahead of it in x; on a 1D grid a box is a range of cells.
     """
-    sources_box = row_calls(compiled)[0]
+    sources_box = row_calls(compiled, two_d)[0]
+    # a compiled 2D loop's passes over its box run row by row on numba's threads
+    copy_box, copy_box1, _, clear_outside1, live_box = box_passes(compiled and two_d)
 
     def advance(q, t, t_pause, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag,
                 rate, backup, diag_backup, work, prev, max_steps, stop_at_rest, advect, sources,
@@ -210,7 +213,8 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool, width: int = 2,
     layer) and ``dry`` [m] are the model's. The model's kernels: ``advect`` (its
     advection stage), ``sources`` (its source stage), ``predictor`` (MUSCL, ``order``
     2: the friction predictor of the SSP-RK2/Heun integrator, see
-    :func:`~pdeflow.models.two_layer.friction.predictor_two_layer`; else None) and
+    :func:`~pdeflow.models.two_layer.friction.predictor_two_layer`; else None; on a 2D
+    grid both take the box, :func:`pdeflow.numerics.threads.box_kernels`) and
     ``fallback`` (``ifcp``: the HLL advection stage that redoes a step IFCP left
     negative; else None). ``strang`` applies half a source step before and after the
     advection (else Lie, as in the paper). With Strang, dt is chosen before the first
@@ -231,7 +235,8 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool, width: int = 2,
     return specialise(loop, STATE, f8, f8, f8, f8,
                       METRIC, i8, i8, PARAMS, f8, f8, f8, f8, VECTOR, FIELDS, FIELDS, VECTOR,
                       WORK, FIELDS, i8, flag,
-                      ADVECT, SOURCES, PREDICTOR if order == 2 else types.none,
+                      ADVECT, BOX_SOURCES if two_d else SOURCES,
+                      (BOX_PREDICTOR if two_d else PREDICTOR) if order == 2 else types.none,
                       ADVECT if ifcp else types.none, pointer=False)
 
 
@@ -248,8 +253,11 @@ class Stepper:
         self.two_d = geometry == L.GEOMETRY_PLANAR_2D
         self.loop = stepping_kernel(order, strang, self.ifcp, model.layer_rows, self.two_d)
         self.advect = advection_kernel(model, flux, order, limiter, geometry)
-        self.sources = model.sources
-        self.predictor = model.predictor if order == 2 else None
+        # on a 2D grid the stage and the predictor take a box, its rows on threads
+        sources, predictor = box_kernels(model) if self.two_d else \
+            (model.sources, model.predictor)
+        self.sources = sources
+        self.predictor = predictor if order == 2 else None
         self.fallback = advection_kernel(model, L.FLUX_HLL, order, limiter, geometry) \
             if self.ifcp else None
         self.kernels = [k for k in (self.loop, self.advect, self.sources, self.predictor,

@@ -37,6 +37,7 @@ from ..numerics.splitting import (
     python_stepping,
     scheme_stepper,
 )
+from ..numerics.threads import DEFAULT_THREADS, check_threads, on_threads
 from .blowup import SimulationBlowUp, cell_values, diagnose_blowup, fmt_values
 from .outputs import StepAhead, pending_output
 
@@ -118,7 +119,7 @@ class FVSplitSolver(SolverBase):
     def __init__(self, pde: GranularPDE, *, backend: str = "numba", cfl: float = 0.3,
                  splitting: str | None = None, stop_at_rest: bool = True,
                  max_steps: int = 100_000_000, t_end: float | None = None,
-                 outputs: str = "interpolate"):
+                 outputs: str = "interpolate", threads: int = DEFAULT_THREADS):
         """
         Args:
             pde: a :class:`~pdeflow.models.TwoLayerGranular` or
@@ -144,6 +145,11 @@ class FVSplitSolver(SolverBase):
                 (the state after the first step that reaches it, at its true time: a
                 state of the scheme, with every property the scheme gives its states,
                 e.g. hyperbolicity after the restoration). Neither changes the steps.
+            threads: numba threads of a run on a 2D grid, 1..the cores (its passes over
+                the cells run row by row on them, :mod:`pdeflow.numerics.threads`; the
+                same numbers for any count); default 1, so that runs in parallel
+                processes (sweeps, studies) do not oversubscribe the cores. A 1D run
+                checks it and runs on one.
         """
         if not isinstance(pde, GranularPDE):
             raise TypeError("fv-split solves pdeflow's granular models only")
@@ -167,6 +173,7 @@ class FVSplitSolver(SolverBase):
         if outputs not in ("interpolate", "step"):
             raise ValueError(f"outputs must be 'interpolate' or 'step', got {outputs!r}")
         self.outputs = outputs
+        self.threads = check_threads(threads)
         self.diagnostics: np.ndarray | None = None
 
     def make_stepper(self, state: Any, dt: float | None = None):
@@ -199,6 +206,8 @@ class FVSplitSolver(SolverBase):
         if self.backend_name == "numba":
             advance = self._compiled_loop(scheme_stepper(*scheme), run_kernel, diag, rate,
                                           backup, work)
+            if len(metric.axes) > 1:  # only a 2D run starts numba's threads
+                advance = on_threads(advance, self.threads)
         else:
             advance = self._numpy_loop(state, dx, P, hook, diag, prev)
 

@@ -35,8 +35,8 @@ from pdeflow.numerics.state import velocity
 from . import layout as W
 
 
-@kernel(STATE, f8, f8, PARAMS, VECTOR, i8, i8)
-def sources(q, dt, t, P, diag, lo, hi):  # pragma: no cover - compiled
+@kernel(STATE, f8, f8, PARAMS, VECTOR, VECTOR, i8, i8)
+def sources(q, dt, t, P, diag, fex, lo, hi):  # pragma: no cover - compiled
     """h u <- h (u + dt g_x), h v <- h v in the wet cells lo..hi (the arithmetic of
     :func:`tests.shallow_water.sources.sw_sources`); dry cells lose their momentum."""
     moving = False
@@ -61,7 +61,13 @@ def sources(q, dt, t, P, diag, lo, hi):  # pragma: no cover - compiled
 
 @kernel(STATE, f8, f8, PARAMS, VECTOR)
 def source_stage(q, dt, t, P, diag):  # pragma: no cover - compiled
-    sources(q, dt, t, P, diag, 0, q.shape[1] - 1)
+    sources(q, dt, t, P, diag, diag[L.N_DIAG:], 0, q.shape[1] - 1)
+
+
+@kernel(VECTOR, VECTOR)
+def fold(diag, book):  # pragma: no cover - compiled
+    """A row's booking (the time of the last motion) added to ``diag``."""
+    diag[W.D_MOVE] = max(diag[W.D_MOVE], book[W.D_MOVE])
 
 
 @kernel(STATE, f8, PARAMS, i8, i8)
@@ -86,7 +92,8 @@ KERNELS = ModelKernels(
     fields=3, face=face, fluctuations=fluctuations, cell_jump=cell_jump, sources=sources,
     source_stage=source_stage, predictor=predictor, mol_sources=mol_sources,
     numpy_advection=_no_numpy_twin, numpy_sources=_no_numpy_twin,
-    constants=lambda P: (float(P[W.G_Z]), 0.0, float(P[W.DRY])), layer_rows=3, rows=ROWS)
+    constants=lambda P: (float(P[W.G_Z]), 0.0, float(P[W.DRY])), fold=fold, layer_rows=3,
+    rows=ROWS)
 """the 2D shallow water's kernels (the parameter vector of :mod:`.layout`)"""
 
 

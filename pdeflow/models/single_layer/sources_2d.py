@@ -20,7 +20,10 @@ import functools
 import math
 from typing import Any
 
-from ...numerics.compiled import FIELDS, PARAMS, STATE, VECTOR, f8, i8, specialise
+import numpy as np
+
+from ...numerics import layout as L
+from ...numerics.compiled import FIELDS, PARAMS, STATE, VECTOR, f8, i8, kernel, specialise
 from ...numerics.rheology import BasalLaw, basal_accel, law_block
 from ...numerics.state import velocity
 from . import layout as S
@@ -46,14 +49,16 @@ def vector_step(after_friction: Any) -> Any:
 @functools.cache
 def stage_kernels_2d(law: BasalLaw | None) -> tuple[Any, Any, Any]:
     """The 2D source-stage kernels with the basal law ``law`` (None: Coulomb's): the
-    stage on cells lo..hi ``(q, dt, t, P, diag, lo, hi)``, the same on every cell
+    stage on cells lo..hi ``(q, dt, t, P, book, fex, lo, hi)`` (a row of the loop's
+    box, ``numerics.threads``), the same on every cell
     ``(q, dt, t, P, diag)`` and MUSCL's friction predictor ``(q, dt, P, lo, hi)``, as
     :func:`.sources.stage_kernels` gives them in 1D."""
     step_friction, after_friction, _ = friction_step(law)
     step = vector_step(after_friction)
 
-    def sources_single_2d(q, dt, t, P, diag, lo, hi):
-        """Gravity along x and implicit vector basal friction on the cells lo..hi."""
+    def sources_single_2d(q, dt, t, P, book, fex, lo, hi):
+        """Gravity along x and implicit vector basal friction on the cells lo..hi,
+        booked in ``book`` (no per-cell diagnostic: ``fex`` is not written)."""
         g = P[S.G_Z]
         gx = P[S.G_X]
         dry = P[S.DRY]
@@ -80,13 +85,13 @@ def stage_kernels_2d(law: BasalLaw | None) -> tuple[Any, Any, Any]:
             q[0, i] = h
             q[1, i] = m
             q[2, i] = n
-        _close_stage(diag, t, moving, fast)
+        _close_stage(book, t, moving, fast)
 
-    sources = specialise(sources_single_2d, STATE, f8, f8, PARAMS, VECTOR, i8, i8)
+    sources = specialise(sources_single_2d, STATE, f8, f8, PARAMS, VECTOR, VECTOR, i8, i8)
 
     def source_stage_single_2d(q, dt, t, P, diag):
         """:func:`sources_single_2d` on every cell."""
-        sources(q, dt, t, P, diag, 0, q.shape[1] - 1)
+        sources(q, dt, t, P, diag, diag[L.N_DIAG:], 0, q.shape[1] - 1)
 
     def predictor_single_2d(q, dt, P, lo, hi):
         """Zero the momenta of cells that the implicit friction would hold at rest, in
@@ -106,6 +111,14 @@ def stage_kernels_2d(law: BasalLaw | None) -> tuple[Any, Any, Any]:
 
     return (sources, specialise(source_stage_single_2d, STATE, f8, f8, PARAMS, VECTOR),
             specialise(predictor_single_2d, STATE, f8, PARAMS, i8, i8))
+
+
+@kernel(VECTOR, VECTOR)
+def fold_single_2d(diag: np.ndarray, book: np.ndarray) -> None:
+    """Add a row's booking of :func:`stage_kernels_2d`'s stage (from zeros) to
+    ``diag``: the times of the last motion [s] (the latest: never negative)."""
+    diag[S.D_MOVE] = max(diag[S.D_MOVE], book[S.D_MOVE])
+    diag[S.D_FAST] = max(diag[S.D_FAST], book[S.D_FAST])
 
 
 @functools.cache

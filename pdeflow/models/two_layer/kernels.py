@@ -17,7 +17,7 @@ from .flux import cell_jump, face, fluctuations
 from .rates import fluctuations_np, source_rate, source_rate_np
 from .rates_2d import source_rate_2d
 from .sources import stage_kernels
-from .sources_2d import stage_kernels_2d
+from .sources_2d import fold_two_layer_2d, stage_kernels_2d
 
 
 def _constants(P: np.ndarray) -> tuple[float, float, float]:
@@ -60,7 +60,7 @@ def kernels_2d(law: BasalLaw | None = None, directions: str = "all") -> ModelKer
         fields=6, face=two_d.face, fluctuations=two_d.fluctuations,
         cell_jump=two_d.cell_jump, sources=sources, source_stage=source_stage,
         predictor=predictor, mol_sources=source_rate_2d(law), numpy_advection=_no_numpy_twin,
-        numpy_sources=_no_numpy_twin, constants=_constants,
+        numpy_sources=_no_numpy_twin, constants=_constants, fold=fold_two_layer_2d,
         layer_rows=two_d.LAYER_ROWS, rows=two_d.ROWS)
 
 

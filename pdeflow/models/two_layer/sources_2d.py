@@ -25,8 +25,10 @@ import functools
 import math
 from typing import Any
 
+import numpy as np
+
 from ...numerics import layout as L
-from ...numerics.compiled import PARAMS, STATE, VECTOR, f8, i8, specialise
+from ...numerics.compiled import PARAMS, STATE, VECTOR, f8, i8, kernel, specialise
 from ...numerics.rheology import BasalLaw
 from ...numerics.state import velocity
 from . import layout as T
@@ -48,8 +50,9 @@ def stage_kernels_2d(law: BasalLaw | None = None,
     """The 2D source-stage kernels with the basal law ``law`` (None: the paper's
     Coulomb friction), compiled with its kernels as constants (as the 1D
     :func:`.sources.stage_kernels`): the stage on the cells lo..hi ``(q, dt, t, P,
-    diag, lo, hi)``, on every cell ``(q, dt, t, P, diag)`` and MUSCL's predictor
-    ``(q, dt, P, lo, hi)``; ``directions`` one of :data:`DIRECTIONS`."""
+    book, fex, lo, hi)`` (booked in ``book``, F_extra/rho1 per cell in ``fex``; a row
+    of the loop's box, ``numerics.threads``), on every cell ``(q, dt, t, P, diag)``
+    and MUSCL's predictor ``(q, dt, P, lo, hi)``; ``directions`` one of :data:`DIRECTIONS`."""
     if directions not in DIRECTIONS:
         raise ValueError(f"directions must be one of {list(DIRECTIONS)}, got "
                          f"{directions!r}")
@@ -58,10 +61,26 @@ def stage_kernels_2d(law: BasalLaw | None = None,
     sources = _sources_2d(fk, bed, directions == "all")
 
     def source_stage_two_layer_2d(q, dt, t, P, diag):
-        sources(q, dt, t, P, diag, 0, q.shape[1] - 1)
+        sources(q, dt, t, P, diag, diag[L.N_DIAG:], 0, q.shape[1] - 1)
 
     return (sources, specialise(source_stage_two_layer_2d, STATE, f8, f8, PARAMS, VECTOR),
             _predictor_2d(fk, bed))
+
+
+@kernel(VECTOR, VECTOR)
+def fold_two_layer_2d(diag: np.ndarray, book: np.ndarray) -> None:
+    """Add a row's booking of the 2D stage (from zeros) to ``diag``: the times of the
+    last motion [s] (the latest: never negative), the largest F_extra/rho1 with its cell
+    and time if the row's is larger (so the first cell in cell order wins, as in one
+    pass), the exchanged depths and the counts (summed)."""
+    for slot in (T.D_MOVE_UPPER, T.D_MOVE_LOWER, T.D_FAST_UPPER, T.D_FAST_LOWER):
+        diag[slot] = max(diag[slot], book[slot])
+    if book[T.D_FEXTRA_MAX] > diag[T.D_FEXTRA_MAX]:
+        diag[T.D_FEXTRA_MAX] = book[T.D_FEXTRA_MAX]
+        diag[T.D_FEXTRA_CELL] = book[T.D_FEXTRA_CELL]
+        diag[T.D_FEXTRA_TIME] = book[T.D_FEXTRA_TIME]
+    for slot in (T.D_DEPOSITED, T.D_ERODED, T.D_HYP_EVENTS, T.D_HYP_BISECTIONS):
+        diag[slot] += book[slot]
 
 
 def _exchange_2d(h1, h2, u1x, u1y, u2x, u2y, dt, P):
@@ -115,14 +134,13 @@ def _sources_2d(fk: Any, bed: Any, every_direction: bool) -> Any:
     exchange = specialise(_exchange_2d, helper=True)
     target = restoration_target_all if every_direction else restoration_target
 
-    def sources_two_layer_2d(q, dt, t, P, diag, lo, hi):
+    def sources_two_layer_2d(q, dt, t, P, book, fex, lo, hi):
         r = P[T.R]
         g = P[T.G_Z]
         gx = P[T.G_X]
         dry = P[T.DRY]
         mode = int(P[T.HYPERBOLICITY])
         moving1 = moving2 = fast1 = fast2 = changed = False
-        fex = diag[L.N_DIAG:]
         fp = friction_params(P)
         for i in range(lo, hi + 1):
             if fex[i] != 0.0:
@@ -148,9 +166,9 @@ def _sources_2d(fk: Any, bed: Any, every_direction: bool) -> Any:
                             c_eff = (1.0 - phi) * P[T.C]
                         changed = True
                         if dh1 < 0.0:
-                            diag[T.D_DEPOSITED] -= dh1
+                            book[T.D_DEPOSITED] -= dh1
                         else:
-                            diag[T.D_ERODED] += dh1
+                            book[T.D_ERODED] += dh1
                 b1x = u1x + dt * gx if h1 > dry else 0.0
                 b1y = u1y if h1 > dry else 0.0
                 b2x = u2x + dt * gx if h2 > dry else 0.0
@@ -166,13 +184,13 @@ def _sources_2d(fk: Any, bed: Any, every_direction: bool) -> Any:
                             b1x, b1y, b2x, b2y, h1, h2, v1x, v1y, v2x, v2y, dt, fp, k_eff,
                             c_eff, edge)
                         if bisected:
-                            diag[T.D_HYP_BISECTIONS] += 1.0
+                            book[T.D_HYP_BISECTIONS] += 1.0
                         fex[i] = f / r
-                        diag[T.D_HYP_EVENTS] += 1.0
-                        if fex[i] > diag[T.D_FEXTRA_MAX]:
-                            diag[T.D_FEXTRA_MAX] = fex[i]
-                            diag[T.D_FEXTRA_CELL] = i
-                            diag[T.D_FEXTRA_TIME] = t
+                        book[T.D_HYP_EVENTS] += 1.0
+                        if fex[i] > book[T.D_FEXTRA_MAX]:
+                            book[T.D_FEXTRA_MAX] = fex[i]
+                            book[T.D_FEXTRA_CELL] = i
+                            book[T.D_FEXTRA_TIME] = t
                 u1x, u1y, u2x, u2y = v1x, v1y, v2x, v2y
             wet1 = h1 > dry
             wet2 = h2 > dry
@@ -194,9 +212,9 @@ def _sources_2d(fk: Any, bed: Any, every_direction: bool) -> Any:
             q[3, i] = h2
             q[4, i] = m2x
             q[5, i] = m2y
-        _close_stage(diag, t, moving1, fast1, moving2, fast2, changed)
+        _close_stage(book, t, moving1, fast1, moving2, fast2, changed)
 
-    return specialise(sources_two_layer_2d, STATE, f8, f8, PARAMS, VECTOR, i8, i8)
+    return specialise(sources_two_layer_2d, STATE, f8, f8, PARAMS, VECTOR, VECTOR, i8, i8)
 
 
 def _predictor_2d(fk: Any, bed: Any) -> Any:
