@@ -9,6 +9,7 @@ import bed_cost
 import cold_start
 import geometry_cost
 import layer_cost
+import pyclaw_2d
 import start_up
 import study_scaling
 from doc_tables import conditions_text, fmt, verdict
@@ -20,6 +21,7 @@ SECTIONS: dict[str, tuple[Any, str, int]] = {
     "geometry": (geometry_cost, "geometry.json", 7),
     "bed": (bed_cost, "bed.json", 7),
     "layers": (layer_cost, "layers.json", 9),
+    "pyclaw2d": (pyclaw_2d, "pyclaw_2d.json", 5),
 }
 """the parts that are one module each: ``--only NAME`` -> (the module, with
 ``measure(repeats)`` and ``render(data)``; its stored results; the least repeats), in
@@ -72,7 +74,8 @@ def render(wp: dict[str, Any] | None, bench: dict[str, Any] | None,
     if wp:
         a(f"Work-precision conditions: {conditions_text(wp['conditions'])}.\n")
     if bench:
-        a(render_targets(bench, cold_runs=cold, start=start, layers=sections.get("layers")))
+        a(render_targets(bench, cold_runs=cold, start=start, layers=sections.get("layers"),
+                         pyclaw2d=sections.get("pyclaw2d")))
     if wp:
         a(render_wp(wp))
     if bench:
@@ -97,7 +100,8 @@ def most_signatures(sweep: dict[str, Any]) -> int:
 
 def render_targets(b: dict[str, Any], cold_runs: dict[str, Any] | None = None,
                     start: dict[str, Any] | None = None,
-                    layers: dict[str, Any] | None = None) -> str:
+                    layers: dict[str, Any] | None = None,
+                    pyclaw2d: dict[str, Any] | None = None) -> str:
     """The section "Targets": one row per target with the measured value and verdict."""
     s = b["sweep"]
     L = ["## Targets\n", "| target | measured | |", "|---|---|---|"]
@@ -113,6 +117,8 @@ def render_targets(b: dict[str, Any], cold_runs: dict[str, Any] | None = None,
     else:
         L.append("| single-layer sweep >= 6x faster than PyClaw | clawpack not installed "
                  "| n/a |")
+    if pyclaw2d:
+        L.append(pyclaw_2d.target_row(pyclaw2d))
     if layers:  # the section of its own (benchmarks/layer_cost.py) is the newer one
         L.append(layer_cost.target_row(layers))
     else:

@@ -21,6 +21,7 @@ import math
 import os
 import tempfile
 import time
+from typing import Any
 
 import numpy as np
 
@@ -28,8 +29,13 @@ FILM = 1e-6
 """depth of the film on dry cells [m] (PyClaw's solvers need h > 0)"""
 
 
-def available() -> bool:
-    """True if ``clawpack.pyclaw`` and its HLLE shallow-water solver import.
+NEEDS_CLAWPACK = "clawpack is not installed (pip install clawpack; needs gfortran)"
+"""the one line said where PyClaw is needed and cannot be imported"""
+
+
+def available(riemann_solver: str = "shallow_hlle_1D") -> bool:
+    """True if ``clawpack.pyclaw`` and the Riemann solver ``riemann_solver`` (a module of
+    ``clawpack.riemann``; by default the 1D HLLE shallow-water one) import.
 
     PyClaw's import opens a log file ``pyclaw.log`` in the working directory: it is
     imported from a temporary directory so that the file lands there.
@@ -37,13 +43,55 @@ def available() -> bool:
     cwd = os.getcwd()
     os.chdir(tempfile.mkdtemp(prefix="pyclaw-"))
     try:
+        import importlib
+
         from clawpack import pyclaw, riemann  # noqa: F401
-        from clawpack.riemann import shallow_hlle_1D  # noqa: F401
+        importlib.import_module(f"clawpack.riemann.{riemann_solver}")
     except Exception:  # pragma: no cover - depends on the machine
         return False
     finally:
         os.chdir(cwd)
     return True
+
+
+def first_order(solver: Any, cfl: float, cfl_max: float) -> None:
+    """Set a PyClaw classic ``solver`` to first order (Godunov, no limiter), Fortran
+    kernels, a variable time step aiming at Courant number ``cfl`` (steps above
+    ``cfl_max`` are redone), no step limit."""
+    from clawpack import pyclaw
+
+    solver.kernel_language = "Fortran"
+    solver.order = 1
+    solver.limiters = pyclaw.limiters.tvd.minmod  # unused at order 1
+    solver.cfl_desired = cfl
+    solver.cfl_max = cfl_max
+    solver.dt_variable = True
+    solver.max_steps = 10**8
+
+
+def run_controller(state: Any, domain: Any, solver: Any, t_end: float
+                   ) -> tuple[float, np.ndarray, int]:
+    """Run ``solver`` from ``state`` on ``domain`` to ``t_end`` [s] without output.
+
+    Returns (wall time of ``controller.run()`` [s], the final ``q``, number of steps).
+    """
+    from clawpack import pyclaw
+
+    claw = pyclaw.Controller()
+    claw.solution = pyclaw.Solution(state, domain)
+    claw.solver = solver
+    claw.tfinal = t_end
+    claw.num_output_times = 1
+    claw.keep_copy = False
+    claw.output_format = None
+    claw.verbosity = 0
+    w0 = time.perf_counter()
+    status = claw.run()
+    wall = time.perf_counter() - w0
+    steps = int(status.get("numsteps", 0)) if isinstance(status, dict) else 0
+    if not steps:
+        steps = int(getattr(solver.status, "get", lambda *_: 0)("numsteps", 0) or 0)
+    return wall, claw.solution.state.q.copy(), steps
 
 
 def collapse(L0: float, H0: float, length: float, dx: float, t_end: float,
@@ -54,17 +102,11 @@ def collapse(L0: float, H0: float, length: float, dx: float, t_end: float,
     Returns (wall time of ``controller.run()`` [s], final depth [m], number of steps).
     """
     if not available():
-        raise ImportError("clawpack is not installed (pip install clawpack; needs gfortran)")
+        raise ImportError(NEEDS_CLAWPACK)
     from clawpack import pyclaw, riemann
 
     solver = pyclaw.ClawSolver1D(riemann.shallow_hlle_1D)
-    solver.kernel_language = "Fortran"
-    solver.order = 1
-    solver.limiters = pyclaw.limiters.tvd.minmod  # unused at order 1
-    solver.cfl_desired = cfl
-    solver.cfl_max = min(1.0, 1.5 * cfl)
-    solver.dt_variable = True
-    solver.max_steps = 10**8
+    first_order(solver, cfl, min(1.0, 1.5 * cfl))
     solver.bc_lower[0] = pyclaw.BC.wall
     solver.bc_upper[0] = pyclaw.BC.extrap
     solver.source_split = 1
@@ -88,18 +130,5 @@ def collapse(L0: float, H0: float, length: float, dx: float, t_end: float,
     xc = state.grid.x.centers
     state.q[0, :] = np.where(xc < L0, H0, FILM)
     state.q[1, :] = 0.0
-    claw = pyclaw.Controller()
-    claw.solution = pyclaw.Solution(state, domain)
-    claw.solver = solver
-    claw.tfinal = t_end
-    claw.num_output_times = 1
-    claw.keep_copy = False
-    claw.output_format = None
-    claw.verbosity = 0
-    w0 = time.perf_counter()
-    status = claw.run()
-    wall = time.perf_counter() - w0
-    steps = int(status.get("numsteps", 0)) if isinstance(status, dict) else 0
-    if not steps:
-        steps = int(getattr(solver.status, "get", lambda *_: 0)("numsteps", 0) or 0)
-    return wall, claw.solution.state.q[0].copy(), steps
+    wall, q, steps = run_controller(state, domain, solver, t_end)
+    return wall, q[0], steps

@@ -9,6 +9,7 @@ Usage (from the repository root)::
     python benchmarks/run_benchmarks.py --only cold --label after  # cold first run (~3 min)
     python benchmarks/run_benchmarks.py --only bed      # a long erodible bed at rest
     python benchmarks/run_benchmarks.py --only start    # warm start, kernel load, app (~4 min)
+    python benchmarks/run_benchmarks.py --only pyclaw2d # 2D dam break against PyClaw (~3 min)
     python benchmarks/run_benchmarks.py --render        # re-render the doc from JSON
     python benchmarks/run_benchmarks.py --quick         # smoke run into TMPDIR, ~3 min
 
@@ -217,7 +218,7 @@ def main(argv: list[str] | None = None) -> int:
                                                log=sys.stderr, commit_id=args.commit)
             cold_path.write_text(json.dumps(c, indent=1, default=str))
         for name, (module, _, least) in SECTIONS.items():
-            if args.only in (None, name):
+            if args.only in (None, name) and not (name == "pyclaw2d" and args.no_pyclaw):
                 paths[name].write_text(json.dumps(module.measure(max(repeats, least)),
                                                   indent=1, default=str))
         if args.only in (None, "wp"):

@@ -53,18 +53,20 @@ def dam(r: np.ndarray) -> np.ndarray:
     return np.where(r < SIDE / 4, 1.0, 0.5)
 
 
-def stepper_run(eq: Any, state: Any) -> Callable[[], dict[str, Any]]:
-    """A callable running ``eq`` from ``state`` to T_END with fv-split's stepper."""
+def stepper_run(eq: Any, state: Any, t_end: float = T_END, cfl: float = CFL
+                ) -> Callable[[], dict[str, Any]]:
+    """A callable running ``eq`` from ``state`` to ``t_end`` [s] with fv-split's stepper
+    (Lie splitting) at Courant number ``cfl``."""
     from pde.trackers.base import FinishedSimulation
 
     from pdeflow import FVSplitSolver
 
     def run() -> dict[str, Any]:
-        solver = FVSplitSolver(eq, cfl=CFL, splitting="lie")
+        solver = FVSplitSolver(eq, cfl=cfl, splitting="lie")
         s = state.copy()
         try:
-            solver.make_stepper(s)(s, 0.0, T_END)
-        except FinishedSimulation:  # at rest before T_END (as the baseline stops)
+            solver.make_stepper(s)(s, 0.0, t_end)
+        except FinishedSimulation:  # at rest before t_end (as the baseline stops)
             pass
         return {"steps": int(solver.info["steps"]), "data": s.data,
                 "cells": s.data.shape[-1] if s.data.ndim == 2 else s.grid.num_cells}
