@@ -193,8 +193,8 @@ class RunStorageTracker(FextraStorageTracker):
                                    compression=self.compression)
         return super().initialize(field, info)
 
-    def handle(self, field: Any, t: float) -> None:
-        super().handle(field, t)
+    def keep(self, field: Any, t: float) -> None:
+        super().keep(field, t)
         self.frames += 1
 
     def finalize(self, info: InfoDict | None = None) -> None:

@@ -228,3 +228,20 @@ def test_cli_observers_do_not_change_a_2d_summary(tmp_path):
     assert set(models) == {"two_layer", "single_layer"}
     for model, s in models.items():
         assert numbers(s) == numbers(ref[model]), model
+
+
+def test_a_storage_that_meets_the_erosion_series_changes_no_number():
+    """An erodible bed with its erosion series every t_end/100 [s], and frames stored
+    every t_end/100 as --store does: their times meet to within round-off of each other
+    (py-pde hands a tracker the state at a time up to 1e-8 s before its own), which
+    changed the series' flow duration in its last digit (0.35000000000000003 against
+    0.35 s) before every frame and series tracker took the states at its own times
+    (:mod:`pdeflow.trackers.own_times`)."""
+    c = load_case(ROOT / "cases" / "erodible_bed.toml", ["output.erosion_series='on'"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        alone = numbers(Run(c, "two_layer").execute().summary)
+        watched = numbers(Run(c, "two_layer").execute(
+            [FextraStorageTracker(c.t_end / 100)]).summary)
+    assert watched == alone, {k: (alone[k], watched.get(k)) for k in alone
+                              if watched.get(k) != alone[k]}

@@ -25,6 +25,7 @@ from pde.storage.base import StorageBase, StorageTracker
 from pde.trackers.base import InfoDict
 
 from ..numerics import layout as L
+from .own_times import AtOwnTimes, OwnTimes
 
 FEXTRA_LABEL = "fextra_over_rho1"
 """Label of the F_extra/rho1 field [m^2/s^2] that follows the state in every frame."""
@@ -71,11 +72,13 @@ def show_final_state(tracker: Any, info: InfoDict | None) -> float | None:
     t_end = final_time(info)
     state = (info or {}).get("last_state", tracker._field)
     if state is not None and t_end is not None and t_end > tracker.last_time + 1e-12:
+        if isinstance(tracker, AtOwnTimes):
+            tracker.final_state_next()
         tracker.handle(state, t_end)
     return t_end
 
 
-class FextraStorageTracker(StorageTracker):
+class FextraStorageTracker(AtOwnTimes, StorageTracker):
     """py-pde's ``StorageTracker`` storing, at its interrupts, the state followed by
     F_extra/rho1 per cell (field ``fextra_over_rho1`` [m^2/s^2], see
     :func:`fextra_over_rho1`).
@@ -87,7 +90,8 @@ class FextraStorageTracker(StorageTracker):
     """
 
     def __init__(self, interrupts: Any = 1, *, storage: StorageBase | None = None):
-        super().__init__(MemoryStorage() if storage is None else storage, interrupts)
+        super().__init__(MemoryStorage() if storage is None else storage,
+                         OwnTimes(interrupts))
         self._info: InfoDict | None = None
         self._field: Any = None
         self._frame: FieldCollection | None = None
@@ -113,6 +117,12 @@ class FextraStorageTracker(StorageTracker):
         return self._frame
 
     def handle(self, field: Any, t: float) -> None:
+        if not self.handed_early(t):  # else at another tracker's time: not kept
+            self.keep(field, t)
+
+    def keep(self, field: Any, t: float) -> None:
+        """Store the frame of the state ``field`` at ``t`` [s] (subclasses add what
+        they keep with it)."""
         super().handle(field, t)
         self.last_time = float(t)
 

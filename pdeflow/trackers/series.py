@@ -37,8 +37,8 @@ class SeriesTracker(FextraStorageTracker):
         self._slots = ((slots["eroded"], slots["deposited"])
                        if "eroded" in slots and "deposited" in slots else None)
 
-    def handle(self, field: Any, t: float) -> None:
-        super().handle(field, t)
+    def keep(self, field: Any, t: float) -> None:
+        super().keep(field, t)
         diag = None if self._info is None else self._info.get("solver", {}).get(
             "post_step_data")
         if self._slots is not None and isinstance(diag, np.ndarray):
