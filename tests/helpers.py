@@ -111,3 +111,20 @@ def cli_warnings(case: Path, overrides: list[str], tmp_path: Path, capsys) -> li
     assert main(argv) == 0
     return [r for r in capsys.readouterr().err.splitlines()
             if r.startswith("pdeflow: warning:")]
+
+
+QUICK_2D = (("hll", 1, "minmod", False), ("rusanov", 2, "minmod", True),
+            ("ifcp", 2, "mc", False))
+"""The 2D schemes (flux, order, limiter, Strang?) of the default suite's runs over every
+scheme: each flux, reconstruction/limiter and splitting once. Each scheme compiles its
+own 2D stepping loop (10-100 s on a cold kernel cache), so the other 15 run with
+``-m slow``."""
+
+
+def schemes_2d(schemes: list[tuple]) -> list:
+    """``(scheme, strang)`` parameters for every scheme of ``schemes`` ((flux, order,
+    limiter)) with Lie and Strang: those of :data:`QUICK_2D` in the default suite, the
+    others marked slow; ids such as ``hll/2/mc-strang``."""
+    return [pytest.param(s, strang, id=f"{'/'.join(map(str, s))}-{('lie', 'strang')[strang]}",
+                         marks=() if (*s, strang) in QUICK_2D else pytest.mark.slow)
+            for s in schemes for strang in (False, True)]

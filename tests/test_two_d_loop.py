@@ -24,6 +24,7 @@ from pde import CartesianGrid
 from pdeflow.numerics import layout as L
 from pdeflow.numerics.geometry import metric_of
 from pdeflow.numerics.splitting import STATUS_END, scheme_stepper
+from tests.helpers import schemes_2d
 from tests.shallow_water import layout as W
 from tests.shallow_water import two_d
 from tests.shallow_water.model import KERNELS as ONE_D
@@ -69,8 +70,7 @@ def _profile() -> tuple[np.ndarray, np.ndarray]:
     return h, hu
 
 
-@pytest.mark.parametrize("strang", [False, True], ids=["lie", "strang"])
-@pytest.mark.parametrize("scheme", SCHEMES, ids=["/".join(map(str, s)) for s in SCHEMES])
+@pytest.mark.parametrize(("scheme", "strang"), schemes_2d(SCHEMES))
 def test_uniform_across_gives_the_1d_numbers(scheme, strang):
     """Uniform in y on an N x 3 grid (wall below, open above in y; on a 5 deg slope along
     x), and rotated, uniform in x on a 3 x N grid with the flow along y (horizontal: the

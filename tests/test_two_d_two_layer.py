@@ -24,6 +24,7 @@ from pdeflow.models.two_layer.laws_2d import law_bed_2d
 from pdeflow.numerics import layout as L
 from pdeflow.numerics.geometry import metric_of
 from pdeflow.numerics.splitting import STATUS_END, scheme_stepper
+from tests.helpers import schemes_2d
 from tests.test_two_d_hyperbolicity import (
     G,
     directions,
@@ -86,8 +87,7 @@ def grid_2d(rotated: bool) -> CartesianGrid:
     return CartesianGrid([[0, N * DX], [0, ACROSS * DX]], [N, ACROSS])
 
 
-@pytest.mark.parametrize("strang", [False, True], ids=["lie", "strang"])
-@pytest.mark.parametrize("scheme", SCHEMES, ids=["/".join(map(str, s)) for s in SCHEMES])
+@pytest.mark.parametrize(("scheme", "strang"), schemes_2d(SCHEMES))
 def test_uniform_across_gives_the_1d_numbers(scheme, strang):
     """5.1 coarsened to dx = 0.125 m (wall at the column's back, open ahead; t = 1 s),
     with the paper's exchange closure (Lie; Strang: the relaxed one, since the paper's,
