@@ -245,3 +245,20 @@ def test_a_storage_that_meets_the_erosion_series_changes_no_number():
             [FextraStorageTracker(c.t_end / 100)]).summary)
     assert watched == alone, {k: (alone[k], watched.get(k)) for k in alone
                               if watched.get(k) != alone[k]}
+
+
+
+def test_a_tracker_used_again_takes_its_own_times_again():
+    """The run's end lets a tracker take the final state whatever its time; initialised
+    for another run, it again skips states handed before its own times."""
+    from pdeflow.trackers.own_times import AtOwnTimes, OwnTimes
+
+    tracker = AtOwnTimes()
+    tracker.interrupt = OwnTimes(0.02)
+    for _ in range(2):  # two runs
+        tracker.interrupt.initialize(0.0)
+        assert tracker.interrupt.next(0.0) == pytest.approx(0.02)
+        assert tracker.handed_early(0.015)  # another tracker's time: skipped
+        assert tracker.interrupt.next(0.015) == pytest.approx(0.02)  # asked again
+        tracker.final_state_next()
+        assert not tracker.handed_early(0.015)  # the run's end: taken

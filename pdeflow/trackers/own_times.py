@@ -29,6 +29,7 @@ class OwnTimes(InterruptsBase):
     def __init__(self, interrupts: InterruptData):
         self.inner = parse_interrupt(interrupts)
         self.due: float | None = None
+        self.final = False  # the next state handed is the run's final one
         self._repeat = False
 
     def copy(self) -> OwnTimes:
@@ -42,7 +43,7 @@ class OwnTimes(InterruptsBase):
         return self.inner.dt
 
     def initialize(self, t: float) -> float:
-        self._repeat = False
+        self._repeat = self.final = False
         self.due = self.inner.initialize(t)
         return self.due
 
@@ -65,20 +66,20 @@ class AtOwnTimes:
     run's end, not at one of the tracker's times)."""
 
     interrupt: Any
-    _final = False
 
     def handed_early(self, t: float) -> bool:
         """True, and the tracker's time asked for again, when the state at ``t`` [s]
         comes before the tracker's due time (at another tracker's time)."""
         due = getattr(self.interrupt, "due", None)
-        if self._final or due is None or t >= due:
+        if getattr(self.interrupt, "final", False) or due is None or t >= due:
             return False
         self.interrupt.ask_again()
         return True
 
     def final_state_next(self) -> None:
-        """The next state handed is the run's final one: take it whatever its time."""
-        self._final = True
+        """The next state handed is the run's final one: take it whatever its time
+        (until the tracker is initialised for another run)."""
+        self.interrupt.final = True
 
 
 __all__ = ["AtOwnTimes", "OwnTimes"]
