@@ -28,44 +28,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from two_d_cost import CFL, PHI_B, SCHEME, SIDE, THETA, WALLS, dam  # noqa: E402
-
-
-def stepper_run(eq: Any, state: Any, t_end: float,
-                threads: int) -> Callable[[], dict[str, Any]]:
-    """A callable running ``eq`` from ``state`` to ``t_end`` [s] with fv-split's
-    stepper on ``threads`` threads."""
-    from pde.trackers.base import FinishedSimulation
-
-    from pdeflow import FVSplitSolver
-
-    def run() -> dict[str, Any]:
-        solver = FVSplitSolver(eq, cfl=CFL, splitting="lie", threads=threads)
-        s = state.copy()
-        try:
-            solver.make_stepper(s)(s, 0.0, t_end)
-        except FinishedSimulation:  # pragma: no cover - everything moves on the slope
-            pass
-        return {"steps": int(solver.info["steps"]), "data": s.data}
-
-    return run
+from two_d_cost import SCHEME, setups_2d, stepper_run  # noqa: E402
 
 
 def runs(n: int, t_end: float) -> dict[tuple[str, int], Callable[[], Any]]:
     """The timed runs on n x n cells: (model, threads) -> run."""
-    from pde import CartesianGrid
-
-    import pdeflow
-
-    grid = CartesianGrid([[0, SIDE], [0, SIDE]], [n, n])
-    x, y = np.meshgrid(*grid.axes_coords, indexing="ij")
-    h = dam(np.hypot(x - SIDE / 2, y - SIDE / 2))
-    one = pdeflow.SingleLayerGranular(theta_deg=THETA, phi_b_deg=PHI_B, scheme=SCHEME,
-                                      bc=WALLS)
-    two = pdeflow.TwoLayerGranular(theta_deg=THETA, scheme=SCHEME, bc=WALLS)
-    states = {"single layer": (one, one.make_state(grid, h=h)),
-              "two layers": (two, two.make_state(grid, h1=0.4 * h, h2=0.6 * h))}
-    return {(model, threads): stepper_run(eq, state, t_end, threads)
+    _, states = setups_2d(n)
+    return {(model, threads): stepper_run(eq, state, t_end, threads=threads)
             for model, (eq, state) in states.items() for threads in (1, 2)}
 
 

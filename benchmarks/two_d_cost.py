@@ -53,16 +53,16 @@ def dam(r: np.ndarray) -> np.ndarray:
     return np.where(r < SIDE / 4, 1.0, 0.5)
 
 
-def stepper_run(eq: Any, state: Any, t_end: float = T_END, cfl: float = CFL
-                ) -> Callable[[], dict[str, Any]]:
+def stepper_run(eq: Any, state: Any, t_end: float = T_END, cfl: float = CFL,
+                threads: int = 1) -> Callable[[], dict[str, Any]]:
     """A callable running ``eq`` from ``state`` to ``t_end`` [s] with fv-split's stepper
-    (Lie splitting) at Courant number ``cfl``."""
+    (Lie splitting) at Courant number ``cfl`` on ``threads`` threads."""
     from pde.trackers.base import FinishedSimulation
 
     from pdeflow import FVSplitSolver
 
     def run() -> dict[str, Any]:
-        solver = FVSplitSolver(eq, cfl=cfl, splitting="lie")
+        solver = FVSplitSolver(eq, cfl=cfl, splitting="lie", threads=threads)
         s = state.copy()
         try:
             solver.make_stepper(s)(s, 0.0, t_end)
@@ -74,9 +74,9 @@ def stepper_run(eq: Any, state: Any, t_end: float = T_END, cfl: float = CFL
     return run
 
 
-def runs(n: int) -> dict[str, Callable[[], Any]]:
-    """The timed runs on n x n cells (and the 1D one on n^2 cells)."""
-    import baseline_2d
+def setups_2d(n: int) -> tuple[np.ndarray, dict[str, tuple[Any, Any]]]:
+    """The dam's depth [m] on n x n cells and the two models' (PDE, initial state) on
+    it: "single layer", "two layers" (the material split 0.4 / 0.6 into h1 / h2)."""
     from pde import CartesianGrid
 
     import pdeflow
@@ -87,6 +87,19 @@ def runs(n: int) -> dict[str, Callable[[], Any]]:
     one = pdeflow.SingleLayerGranular(theta_deg=THETA, phi_b_deg=PHI_B, scheme=SCHEME,
                                       bc=WALLS)
     two = pdeflow.TwoLayerGranular(theta_deg=THETA, scheme=SCHEME, bc=WALLS)
+    return h, {"single layer": (one, one.make_state(grid, h=h)),
+               "two layers": (two, two.make_state(grid, h1=0.4 * h, h2=0.6 * h))}
+
+
+def runs(n: int) -> dict[str, Callable[[], Any]]:
+    """The timed runs on n x n cells (and the 1D one on n^2 cells)."""
+    import baseline_2d
+    from pde import CartesianGrid
+
+    import pdeflow
+
+    h, setups = setups_2d(n)
+    one = setups["single layer"][0]
     dx = SIDE / n
     line = CartesianGrid([[0, dx * n * n]], [n * n])
     h1d = dam(np.abs(line.axes_coords[0] - dx * n * n / 2))
@@ -105,11 +118,10 @@ def runs(n: int) -> dict[str, Callable[[], Any]]:
                                            np.ones(4, dtype=np.bool_), P.dry_tolerance)
         return {"steps": steps, "data": np.stack([hb, m, v]), "cells": n * n}
 
-    return {"single 2D": stepper_run(one, one.make_state(grid, h=h)),
+    return {"single 2D": stepper_run(*setups["single layer"]),
             "baseline 2D": base,
             "single 1D": stepper_run(one_1d, one_1d.make_state(line, h=h1d)),
-            "two layers 2D": stepper_run(two, two.make_state(grid, h1=0.4 * h,
-                                                             h2=0.6 * h)),
+            "two layers 2D": stepper_run(*setups["two layers"]),
             "two layers 1D": stepper_run(two_1d, two_1d.make_state(line, h1=0.4 * h1d,
                                                                    h2=0.6 * h1d))}
 
