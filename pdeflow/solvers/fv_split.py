@@ -38,7 +38,15 @@ from ..numerics.splitting import (
     scheme_stepper,
 )
 from ..numerics.threads import DEFAULT_THREADS, check_threads, on_threads
-from .blowup import SimulationBlowUp, cell_values, diagnose_blowup, fmt_values
+from .blowup import (
+    SimulationBlowUp,
+    bad_extent,
+    cell_position,
+    cell_values,
+    diagnose_blowup,
+    fmt_position,
+    fmt_values,
+)
 from .outputs import StepAhead, pending_output
 
 __all__ = ["FVSplitSolver", "SimulationBlowUp", "diagnose_blowup", "split_stepper",
@@ -62,19 +70,6 @@ def on_cells(step: Any, shape: tuple[int, int]) -> Any:
             state.data[...] = flat.reshape(state.data.shape)
 
     return stepper
-
-
-def _blowup_2d(state: Any, data: np.ndarray, entry: np.ndarray, t_start: float,
-               t: float, steps: int) -> None:
-    """Raise :class:`SimulationBlowUp` for a failed step on a grid of several axes:
-    the state at the start of this stepper call (``entry``, time ``t_start`` [s]) is
-    restored; the blow-up diagnosis of a cell (:func:`diagnose_blowup`) is 1D only."""
-    data[...] = entry
-    msg = (f"fv-split blew up in step {steps + 1} at t={t:.6g} s on a 2D grid (the "
-           f"diagnosis of the failed cell is 1D only). Nothing of the steps since "
-           f"t={t_start:.6g} s was kept: that state is the solver's state.")
-    raise SimulationBlowUp(msg, report={"t": t, "t_kept": t_start},
-                           state=state.data.copy())
 
 
 class _RestProfilerFilter(logging.Filter):
@@ -235,9 +230,7 @@ class FVSplitSolver(SolverBase):
             # the steps land on the output times (interpolated), no tolerance is needed
             self.info["last_dt"] = float(diag[L.D_DT]) or None
             if status == STATUS_FAIL:
-                if state.grid.num_axes > 1:
-                    _blowup_2d(state, data, entry, t_start, t, int(self.info["steps"]))
-                self._blowup(state, entry, t_start, t, t_run, replay)
+                self._blowup(state, data, entry, t_start, t, t_run, replay)
             if t_pause < t < t_run and self.outputs == "interpolate":
                 # the step went past the output time: output the state at that time,
                 # continue from the step's end at the next call
@@ -306,19 +299,20 @@ class FVSplitSolver(SolverBase):
         _RestProfilerFilter.ended_at_rest = True
         raise FinishedSimulation(f"everything at rest at t={t:.6g} s")
 
-    def _blowup(self, state: Any, entry: np.ndarray, t_start: float, t: float,
-                t_end: float, replay: Any) -> None:
+    def _blowup(self, state: Any, data: np.ndarray, entry: np.ndarray, t_start: float,
+                t: float, t_end: float, replay: Any) -> None:
         """Raise :class:`SimulationBlowUp` with the diagnostic of the failed step.
 
-        ``state.data`` holds the state before the failed step (time ``t``); if a source
-        stage had already spoiled it, the state at the start of this stepper call
-        (``entry``, time ``t_start``) is restored instead.
+        ``data`` (the kernels' ``q[field, cell]``, see :func:`on_cells`) holds the state
+        before the failed step (time ``t``); if a source stage had already spoiled it,
+        the state at the start of this stepper call (``entry``, time ``t_start``) is
+        restored instead.
         """
         pde: GranularPDE = self.pde
-        report = diagnose_blowup(pde, state.data, t, t_end, replay)
+        report = diagnose_blowup(pde, data, t, t_end, replay)
         t_kept = t
         if report.get("stage") == 0:
-            state.data[...] = entry
+            data[...] = entry
             t_kept = t_start
         step = int(self.info["steps"]) + 1
         mode = getattr(getattr(pde, "parameters", None), "hyperbolicity", None)
@@ -326,20 +320,16 @@ class FVSplitSolver(SolverBase):
                    f"{self.scheme.splitting} "
                    f"splitting" + (f", hyperbolicity {mode!r}" if mode else "")
                    + f", cfl={self.cfl}")
-        x_c = state.grid.axes_coords[0]
         cell = report.get("cell")
         report.update(t=t, t_kept=t_kept, step=step, variant=variant)
         where = ""
         if cell is not None:
-            report["x"] = float(x_c[cell])
-            report["cell_state"] = cell_values(pde, state.data if t_kept == t else
-                                                entry, cell)
-            bad = report.get("bad_cells", [cell])
-            where = (f": cell {cell} (x={x_c[cell]:.6g} m) went to "
+            report.update(cell_position(state.grid, cell))
+            report["cell_state"] = cell_values(pde, data, cell)
+            where = (f": cell {report['cell_index']} ({fmt_position(report)}) went to "
                      f"{fmt_values(report['failed'])} from "
                      f"{fmt_values(report['cell_state'])} (depths m, velocities m/s); "
-                     f"{len(bad)} bad cell(s) in x=[{x_c[min(bad)]:.6g}, "
-                     f"{x_c[max(bad)]:.6g}] m")
+                     + bad_extent(state.grid, report.get("bad_cells", [cell])))
         dt = report.get("dt")
         stage = {1: "update", 2: "corrector (SSP-RK2 stage 2)"}.get(report.get("stage"),
                                                                     "source stage")
@@ -350,7 +340,8 @@ class FVSplitSolver(SolverBase):
                f"(t={t_kept:.6g} s) is the solver's state, SimulationBlowUp.state and "
                "pde.diagnostics['last_state'].")
         self.info["blowup"] = report
-        raise SimulationBlowUp(msg, report=report, state=state.data.copy())
+        raise SimulationBlowUp(msg, report=report,
+                               state=data.reshape(state.data.shape).copy())
 
     def _compiled_loop(self, kernel: Any, run_kernel: Any, diag: np.ndarray,
                        rate: np.ndarray, backup: np.ndarray, work: np.ndarray) -> Any:
