@@ -241,18 +241,21 @@ def run_figure_jobs(results: dict[str, Any], outdir: str | Path | None = None,
 
 def _run_figure_jobs_2d(results: dict[str, Any], outdir: str | Path | None,
                         plot: str | Path | None) -> list[Job]:
-    """:func:`run_figure_jobs` of a 2D case: its one figure
+    """:func:`run_figure_jobs` of a 2D case: its final-state figure
     (:func:`pdeflow.figures_2d.final_figure_2d`) at ``plot`` and as
-    ``final_deposits.png`` in ``outdir`` (the 1D folder's name for the final state; a
-    2D run has no snapshots or bed figures yet)."""
-    from .figures_2d import final_figure_job
+    ``final_deposits.png`` in ``outdir`` (the 1D folder's name for the final state),
+    and in ``outdir`` the same figure of each snapshot, ``snapshot_t<t>.png`` (a 2D
+    run has no bed figures yet)."""
+    from .figures_2d import final_figure_job, snapshot_figure_jobs
 
     stops = _stops(list(results.values()))
     targets = [Path(plot)] if plot else []
+    jobs: list[Job] = []
     if outdir:
         Path(outdir).mkdir(parents=True, exist_ok=True)
+        jobs.extend(snapshot_figure_jobs(results, Path(outdir)))
         targets.append(Path(outdir) / "final_deposits.png")
-    return [final_figure_job(results, path, stops) for path in targets]
+    return [final_figure_job(results, path, stops) for path in targets] + jobs
 
 
 def figure_jobs(results: dict[str, Any], outdir: str | Path,

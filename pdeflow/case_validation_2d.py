@@ -81,11 +81,8 @@ def _check_2d(case: Any) -> None:
 
 
 def _check_1d_only(case: Any) -> None:
-    """What a 2D case may not ask for yet: snapshots and the erosion series (their
-    figures and trackers are 1D), py-pde's solvers (not tested in 2D)."""
-    if case.snapshot_times:
-        raise _err(case, f"output.snapshot_times {ISSUE}: a 2D run has no snapshot "
-                         "figures yet; remove it (or --set output.snapshot_times=[])")
+    """What a 2D case may not ask for yet: the erosion series (its figures and
+    trackers are 1D), py-pde's solvers (not tested in 2D)."""
     if case.data.get("output", {}).get("erosion_series") == "on":
         raise _err(case, f"output.erosion_series = 'on' {ISSUE}")
     if case.solver != "fv-split":

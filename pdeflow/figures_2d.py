@@ -200,16 +200,17 @@ def cross_sections(ax_x: Any, ax_y: Any, x: np.ndarray, y: np.ndarray,
 def final_figure_2d(x: np.ndarray, y: np.ndarray, runs: Sequence[Run2D],
                     times: Sequence[float], threshold: float, initial: np.ndarray,
                     y0: float, title: str = "", stops: str = "",
-                    state: str = "final state") -> Any:
+                    state: str = "final state", also: Sequence[np.ndarray] = ()) -> Any:
     """The final state of a 2D case's runs (model name, state data) at ``times`` [s]:
     per run a row of maps (:func:`model_row`), then the cross-sections
     (:func:`cross_sections`); ``x``, ``y`` the cell centres [m], ``threshold`` the
     deposit outline's depth [m], ``initial`` the released total depth [m], ``y0`` the
     release centre's y [m]; the title: the case's ``title``, ``state`` (what is drawn)
-    and ``stops``."""
+    and ``stops``; the maps cover the material of the runs, the release and ``also``
+    (other total depths [m]: a case's snapshots share one extent)."""
     maps = [2 * len(systems.get(model).layers) for model, _ in runs]
     ncols = max(maps)
-    box = plan_box(x, y, [*(m2.total_depth(d) for _, d in runs), initial])
+    box = plan_box(x, y, [*(m2.total_depth(d) for _, d in runs), initial, *also])
     ratio = (box[1][1] - box[1][0]) / (box[0][1] - box[0][0])
     # a map's height for its width at equal aspect, within bounds (a long, narrow
     # domain keeps a readable height; equal aspect then shrinks the map inside it)
@@ -264,3 +265,26 @@ def final_figure_job(results: dict[str, Any], path: str | Path, stops: str) -> t
             case.front_threshold, _initial_total(first), y0, display_name(case.name),
             stops)
     return (final_figure_2d, args, Path(path))
+
+
+def snapshot_figure_jobs(results: dict[str, Any], outdir: Path) -> list[tuple]:
+    """The jobs of :func:`final_figure_2d` for each snapshot time of a 2D case's runs
+    (``output.snapshot_times``), the runs that have a snapshot then, saved as
+    ``snapshot_t<t>.png`` in ``outdir``."""
+    runs = list(results.values())
+    first = runs[0]
+    case = first.case
+    x, y = first.state.grid.axes_coords
+    initial = _initial_total(first)
+    times = sorted(set().union(*(r.snapshots for r in runs)))
+    # every snapshot on the extent the material reached at any of them or at the end
+    reached = [m2.total_depth(s[0]) for r in runs for s in r.snapshots.values()]
+    reached += [m2.total_depth(r.state.data) for r in runs]
+    jobs = []
+    for t in times:
+        shown = [(r.model, r.snapshots[t][0]) for r in runs if t in r.snapshots]
+        args = (x, y, shown, [t] * len(shown), case.front_threshold, initial,
+                case.release_centre[1], display_name(case.name), "", f"t = {t:g} s",
+                reached)
+        jobs.append((final_figure_2d, args, outdir / f"snapshot_t{t:g}.png"))
+    return jobs

@@ -224,7 +224,7 @@ def test_the_slope_case_runs_down_x(tmp_path):
     (["initial.shape='polygon'", "initial.vertices=[[1, 1], [2, 2], [3, 3]]"],
      ["initial.x0 is not a key of shape 'polygon'"]),
 
-    (["output.snapshot_times=[0.1]"], ["output.snapshot_times", "1D only"]),
+    (["output.snapshot_times=[-0.1]"], ["output.snapshot_times", "[0, inf] s"]),
     (["numerics.solver='euler'"], ["numerics.solver", "1D only", "fv-split"]),
     (["grid.dx=1e-4", "grid.length=1000", "grid.width=1000"],
      ["cells", "memory", "grid.dx and grid.dy >="]),

@@ -230,3 +230,54 @@ def test_the_maps_are_the_final_depths_and_speeds_of_a_moving_run():
         assert moving.any() and np.nanmax(speed) > 0.5
         np.testing.assert_allclose(speed[moving], np.hypot(hu, hv)[moving] / h[moving])
         assert not [t for t in panels[2 * k + 1].texts if t.get_text() == "at rest"]
+
+
+def _summary(path: Path) -> dict:
+    """A summary file's models without their wall times."""
+    import json
+
+    models = json.loads(path.read_text())["models"]
+    for m in models.values():
+        m.pop("wall_time_s")
+    return models
+
+
+def test_the_snapshots_of_a_2d_case_are_figures_beside_the_final_state(tmp_path):
+    """output.snapshot_times on a 2D case: snapshot_t<t>.png in the run's folder, and
+    the summary is the one of the run without snapshots."""
+    folder = tmp_path / "od"
+    snaps = "output.snapshot_times=[0.1, 0.3]"
+    assert main(["run", str(CYLINDER), "-q", *[f"--set={s}" for s in (*COARSE, snaps)],
+                 "--outdir", str(folder), "--summary", str(tmp_path / "with.json")]) == 0
+    assert sorted(p.name for p in folder.iterdir()) == [
+        "final_deposits.png", "snapshot_t0.1.png", "snapshot_t0.3.png", "summary.json"]
+    assert (folder / "snapshot_t0.3.png").read_bytes().startswith(PNG)
+    assert main(["run", str(CYLINDER), "-q", *[f"--set={s}" for s in COARSE],
+                 "--summary", str(tmp_path / "without.json")]) == 0
+    assert _summary(tmp_path / "with.json") == _summary(tmp_path / "without.json")
+
+
+def test_a_snapshot_figure_maps_the_state_at_its_time_on_one_extent():
+    """Each snapshot's depth maps are its stored state's depths; every snapshot of the
+    case is drawn on the same extent (that of the material at any time)."""
+    from pdeflow.figures_2d import snapshot_figure_jobs
+
+    case = load_case(CYLINDER, [*COARSE, "output.snapshot_times=[0.05, 0.3]",
+                                "case.models=['single_layer']"])
+    res = run_model(case, "single_layer")
+    jobs = snapshot_figure_jobs({"single_layer": res}, Path("unused"))
+    assert [path.name for _, _, path in jobs] == ["snapshot_t0.05.png", "snapshot_t0.3.png"]
+    limits = []
+    for (make, args, _), t in zip(jobs, (0.05, 0.3), strict=True):
+        fig = make(*args)
+        panels = _panels(fig)
+        assert panels[0].get_title().startswith(f"single layer, t = {t:g} s")
+        assert fig._suptitle.get_text().startswith(f"cylinder 2d: t = {t:g} s")
+        h = res.snapshots[t][0][0]
+        wet = h > 1e-9
+        depth = panels[0].collections[0].get_array().reshape(h.T.shape).T
+        np.testing.assert_array_equal(depth[wet], h[wet])
+        limits.append((panels[0].get_xlim(), panels[0].get_ylim()))
+    assert limits[0] == limits[1]
+    early, late = (metrics_2d.total_depth(res.snapshots[t][0]) for t in (0.05, 0.3))
+    assert np.count_nonzero(late > 1e-3) > np.count_nonzero(early > 1e-3)  # it spread
