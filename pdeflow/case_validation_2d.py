@@ -85,9 +85,6 @@ def _check_1d_only(case: Any) -> None:
     trackers are 1D), py-pde's solvers (not tested in 2D)."""
     if case.data.get("output", {}).get("erosion_series") == "on":
         raise _err(case, f"output.erosion_series = 'on' {ISSUE}")
-    if case.solver != "fv-split":
-        raise _err(case, f"numerics.solver = {case.solver!r} {ISSUE}: a 2D case runs "
-                         "with 'fv-split'")
 
 
 def check_shape_2d(case: Any) -> None:
