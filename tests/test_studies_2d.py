@@ -183,14 +183,31 @@ def test_compare_over_a_2d_case_uniform_across_gives_the_1d_errors_times_the_wid
         assert r2["cell_updates"] == r1["cell_updates"] * r2["cells_y"]
 
 
-def test_compare_refuses_mol_rk_and_hyperbolicity_on_a_2d_case(tmp_path, capsys):
-    for extra, words in ((["--variants", "mol-rk"], "mol-rk"),
-                         (["--hyperbolicity"], "--hyperbolicity")):
-        assert main(["compare", str(CYLINDER), *extra, "--out-dir", str(tmp_path / "o")]) == 2
-        err = capsys.readouterr().err
-        assert err.startswith("pdeflow compare: error:") and err.count("\n") == 1, err
-        assert words in err and "1D only for now (issue 36)" in err
-        assert not (tmp_path / "o").exists()
+def test_compare_refuses_hyperbolicity_on_a_2d_case(tmp_path, capsys):
+    assert main(["compare", str(CYLINDER), "--hyperbolicity",
+                 "--out-dir", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pdeflow compare: error:") and err.count("\n") == 1, err
+    assert "--hyperbolicity" in err and "1D only for now (issue 36)" in err
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.slow  # py-pde compiles its Runge-Kutta stepper for each grid: ~1 min each
+def test_compare_mol_rk_over_a_2d_case_uniform_across_gives_the_1d_errors_times_width():
+    """mol-rk (py-pde's Runge-Kutta on the method-of-lines rate) on the column uniform
+    across: the 2D rate of such a state is the 1D rate, so the errors over the area are
+    the 1D errors per unit width times the width (1e-12 relative, as for fv-split
+    above), and so are its steps."""
+    from pdeflow.analysis.workprecision import compare
+
+    kw = {"variants": ["mol-rk"], "grids": [8, 16], "out_dir": None, "repeats": 1,
+          "reference": "fine:hll/first-order"}
+    one, two = compare(_column(False), **kw), compare(_column(True), **kw)
+    assert [r["variant"] for r in two.rows] == ["mol-rk", "mol-rk"]
+    for r1, r2 in zip(one.rows, two.rows, strict=True):
+        assert r1["status"] == r2["status"] == "ok" and r1["steps"] == r2["steps"]
+        assert r2["err_h"] == pytest.approx(0.5 * r1["err_h"], rel=1e-12)
+        assert r2["rel_err_h"] == pytest.approx(r1["rel_err_h"], rel=1e-12)
 
 
 def test_a_2d_study_runs_on_dask_and_resumes(tmp_path, capsys):

@@ -75,39 +75,58 @@ def _fv_split_run(run: Run, t: float, repeats: int) -> RunTiming:
     return RunTiming(data, t, walls, max(warm - med, 0.0), steps, info=info)
 
 
+def _layers(run: Run, d: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Each layer's depth [m] and speed |u| [m/s] (0 where thinner than 1e-6 m) in
+    the state data ``d`` of ``run`` (a 2D grid's layers have hv too)."""
+    rows = d.shape[0] // len(run.pde.system.layers)
+    out = []
+    for k in range(0, d.shape[0], rows):
+        h = d[k]
+        wet = np.where(h > 1e-6, h, 1.0)
+        momentum = np.sqrt(sum(d[k + m] ** 2 for m in range(1, rows)))
+        out.append((h, np.where(h > 1e-6, momentum / wet, 0.0)))
+    return out
+
+
+def _courant_length(case: Any) -> float:
+    """dx [m]; on a 2D grid 1 / (1/dx + 1/dy): the Courant numbers of both axes summed,
+    as fv-split bounds them."""
+    return 1.0 / (1.0 / case.dx + 1.0 / case.dy) if case.is_2d else case.dx
+
+
 def mol_time_step(run: Run, t: float) -> float:
-    """Fixed RK4 step [s]: CFL dx / s_est, s_est = 2 max(|u| + sqrt(g_z H)) + g_x t
-    over the initial state, shortened so that a whole number of steps reaches ``t``."""
+    """Fixed RK4 step [s]: CFL L / s_est (L: :func:`_courant_length`), s_est = 2 max(|u|
+    + sqrt(g_z H)) + g_x t over the initial state, shortened so that a whole number of
+    steps reaches ``t``."""
     P = run.pde.parameter_array()
     gz, gx = float(P[0]), float(P[1])  # G_Z, G_X come first in both layouts
-    d = run.state.data
-    H = np.maximum(d[::2], 0.0).sum(axis=0)
-    speed = 0.0
-    for k in range(0, d.shape[0], 2):
-        h = d[k]
-        u = np.where(h > 1e-6, d[k + 1] / np.where(h > 1e-6, h, 1.0), 0.0)
-        speed = max(speed, float(np.max(np.abs(u) + np.sqrt(gz * H))))
+    layers = _layers(run, run.state.data)
+    H = sum(np.maximum(h, 0.0) for h, _ in layers)
+    speed = max(float(np.max(u + np.sqrt(gz * H))) for _, u in layers)
     s_est = 2.0 * speed + abs(gx) * t
-    dt = run.case.cfl * run.case.dx / s_est
+    dt = run.case.cfl * _courant_length(run.case) / s_est
     return t / math.ceil(t / dt)
 
 
 def _mol_run(run: Run, t: float, repeats: int, cap: float) -> RunTiming:
     state = run.state
-    h_max0 = float(np.max(np.maximum(state.data[::2], 0.0).sum(axis=0)))
+    h_max0 = float(np.max(sum(np.maximum(h, 0.0) for h, _ in _layers(run, state.data))))
     dt = mol_time_step(run, t)
-    s_est = run.case.cfl * run.case.dx / dt
+    s_est = run.case.cfl * _courant_length(run.case) / dt
 
     def broken(d: np.ndarray) -> bool:
         """Blow-up: non-finite, a depth above 1.5 x the initial one, or a velocity
         above 5 x the speed bound (the hook clips negative depths silently)."""
         if not np.all(np.isfinite(d)):
             return True
-        if np.max(d[::2]) > 1.5 * h_max0:
+        rows = d.shape[0] // len(run.pde.system.layers)
+        if np.max(d[::rows]) > 1.5 * h_max0:
             return True
-        h = d[::2]
-        u = np.abs(d[1::2]) / np.maximum(h, 1e-3)
-        return bool(np.max(u) > 5.0 * s_est)
+        for k in range(0, d.shape[0], rows):
+            momentum = np.sqrt(sum(d[k + m] ** 2 for m in range(1, rows)))
+            if np.max(momentum / np.maximum(d[k], 1e-3)) > 5.0 * s_est:
+                return True
+        return False
 
     n_steps = round(t / dt)
     chunk = max(1, math.ceil(n_steps / 50))

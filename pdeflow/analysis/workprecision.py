@@ -181,9 +181,6 @@ def compare(case_path: str | Path | Case, variants: Sequence[str] | None = None,
     harness = _Harness(base, float(t if t is not None else base.t_end), reference,
                        ref_dx, repeats, cfl, mol_cap, log)
     parsed = [Variant.parse(v) for v in variants or default_variants(base)]
-    if base.is_2d and any(v.is_mol for v in parsed):
-        raise CaseError(f"{base.source}: the variant mol-rk (py-pde's solver) is 1D only "
-                        "for now (issue 36): a 2D case runs with fv-split variants")
     rows = [row for model in models or base.models
             for row in harness.model_rows(model, parsed, grids)]
     result = CompareResult(label or base.name, harness.t, rows)
@@ -193,8 +190,9 @@ def compare(case_path: str | Path | Case, variants: Sequence[str] | None = None,
 
 
 def default_variants(case: Case) -> tuple[str, ...]:
-    """:data:`DEFAULT_VARIANTS`; on a 2D grid without mol-rk (py-pde's solvers are
-    1D only for now)."""
+    """:data:`DEFAULT_VARIANTS`; on a 2D grid without mol-rk: py-pde compiles its
+    stepper around the 2D rate for every grid, tens of seconds each (ask for it with
+    ``variants``)."""
     if case.is_2d:
         return tuple(v for v in DEFAULT_VARIANTS if not Variant.parse(v).is_mol)
     return DEFAULT_VARIANTS
