@@ -183,13 +183,21 @@ def test_compare_over_a_2d_case_uniform_across_gives_the_1d_errors_times_the_wid
         assert r2["cell_updates"] == r1["cell_updates"] * r2["cells_y"]
 
 
-def test_compare_refuses_hyperbolicity_on_a_2d_case(tmp_path, capsys):
-    assert main(["compare", str(CYLINDER), "--hyperbolicity",
-                 "--out-dir", str(tmp_path / "o")]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith("pdeflow compare: error:") and err.count("\n") == 1, err
-    assert "--hyperbolicity" in err and "1D only for now (issue 36)" in err
-    assert not (tmp_path / "o").exists()
+def test_compare_hyperbolicity_on_a_2d_case_compares_the_modes(tmp_path, capsys):
+    """--hyperbolicity on a 2D case: each mode runs the two layers on the 2D grid; 'none'
+    applies no F_extra, the restorations do (the collapse leaves the band at first)."""
+    out = tmp_path / "o"
+    assert main(["compare", str(CYLINDER), "--set", "grid.dx=0.1", "--set",
+                 "case.t_end=0.5", "--hyperbolicity", "--variants", "hll/first-order",
+                 "--grids", "10", "--models", "two_layer", "--repeats", "1",
+                 "--out-dir", str(out)]) == 0
+    rows = json.loads((out / "cylinder_2d_hyperbolicity.json").read_text())
+    assert [r["mode"] for r in rows] == ["exact", "bound", "none"]
+    assert all((r["cells"], r["cells_y"]) == (40, 40) for r in rows)  # the case's grid
+    none = rows[2]
+    assert none["hyperbolicity_events"] == 0 and none["max_fextra_over_rho1"] == 0.0
+    assert all(r["hyperbolicity_events"] > 0 and r["max_fextra_over_rho1"] > 0
+               for r in rows[:2])
 
 
 @pytest.mark.slow  # py-pde compiles its Runge-Kutta stepper for each grid: ~1 min each

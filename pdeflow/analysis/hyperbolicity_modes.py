@@ -23,7 +23,8 @@ def hyperbolicity_study(case_path: str | Path | Case,
     once to warm up and ``repeats`` times; rows give the median wall time [s], steps,
     ``max_fextra_over_rho1`` [m^2/s^2], ``hyperbolicity_events`` (cell-steps in which
     F_extra was applied), ``hyperbolicity_bisections`` (of those, how many needed the
-    bisection fallback), stop times [s] and run-out [m].
+    bisection fallback; on a 2D grid every search along du counts), stop times [s]
+    and run-out [m]; on a 2D grid also ``cells_y`` and ``dy`` [m].
     """
     base = resolve_case(case_path)
     rows = []
@@ -38,6 +39,7 @@ def hyperbolicity_study(case_path: str | Path | Case,
                 walls.append(res.summary["wall_time_s"])
                 s = res.summary
             row = {"mode": mode, "cells": c.cells, "dx": c.dx,
+                   **({"cells_y": c.cells_y, "dy": c.dy} if c.is_2d else {}),
                    "wall_s": statistics.median(walls), "walls": walls,
                    "steps": s["steps"], "t_final": s["t_final"],
                    "max_fextra_over_rho1": s["max_fextra_over_rho1"],

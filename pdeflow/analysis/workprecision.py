@@ -66,7 +66,6 @@ from typing import Any
 
 import numpy as np
 
-from ..case_validation_2d import require_1d
 from ..cases import Case, CaseError, load_case
 from ..metrics_2d import ROWS_PER_LAYER
 from ..study.core import Study
@@ -406,8 +405,6 @@ def _cases_and_laws(args: argparse.Namespace) -> list[tuple[str, Case, str | Non
     out: list[tuple[str, Case, str | None]] = []
     for path in args.cases:
         case = load_case(path, args.set)
-        if getattr(args, "hyperbolicity", False):
-            require_1d(case, "pdeflow compare --hyperbolicity")
         if not getattr(args, "laws", None):
             out.append((path, case, None))
             continue
