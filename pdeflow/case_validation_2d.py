@@ -93,12 +93,3 @@ def check_shape_2d(case: Any) -> None:
         check_initial_2d(case.initial, case.length, case.width)
     except ValueError as err:
         raise _err(case, str(err)) from None
-
-
-def require_1d(case: Any, what: str) -> None:
-    """CaseError (one line) if ``case`` is 2D: ``what`` (an option or a command, e.g.
-    'pdeflow sweep') is 1D only for now."""
-    if case.is_2d:
-        raise CaseError(f"{case.source}: {what} {ISSUE}; a 2D case runs with "
-                        "`pdeflow run CASE.toml` (its summary table, --summary, --outdir, "
-                        "--final, --store, --plot, --live, --movie, --frames)")
