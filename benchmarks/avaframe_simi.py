@@ -13,7 +13,8 @@ equal to the mesh cell), t = 5 s. The particle count follows from ``nPPK0`` and 
 kernel radius (``MPPKR``). It writes an .npz with the slope-normal flow thickness FT
 [m] at t = 5 s on com1DFA's horizontal raster (rows along y, columns along x, the
 origin at the release's centre), the raster's ``cellsize`` and lower-left centres
-[m], ``n_part`` (particles at the start) and ``wall`` [s] (com1DFAMain alone).
+[m], ``t`` [s] the time of that step (com1DFA saves the step nearest to 5 s, e.g.
+5.04 s), ``n_part`` (particles at the start) and ``wall`` [s] (com1DFAMain alone).
 
 Run: ``V/bin/python benchmarks/avaframe_simi.py OUT.npz --kernel-radius 5 --nppk0 15``.
 """
@@ -103,17 +104,20 @@ def main() -> None:
         wall = time.perf_counter() - start
         rasters = [p for p in (ava / "Outputs").rglob("*FT*")
                    if p.suffix in (".asc", ".tif")]
-        found = [p for p in rasters if p.stem.endswith(f"_t{T_END:.2f}")]
-        if len(found) != 1:
-            raise RuntimeError(f"com1DFA wrote no single FT raster at t = {T_END} s: "
+        # com1DFA saves the step nearest to each requested time (_t5.04): the nearest
+        saved = {float(p.stem.rpartition("_t")[2]): p for p in rasters
+                 if p.stem.rpartition("_t")[2].replace(".", "").isdigit()}
+        if not saved:
+            raise RuntimeError(f"com1DFA wrote no FT raster at a time: "
                                f"{sorted(p.name for p in rasters)}")
-        raster = rasterUtils.readRaster(found[0])
+        t_saved = min(saved, key=lambda t: abs(t - T_END))
+        raster = rasterUtils.readRaster(saved[t_saved])
         head = raster["header"]
         n_part = int(sims["nPart"].iloc[0]) if "nPart" in sims else -1
         np.savez(args.out, FT=np.asarray(raster["rasterData"], dtype=float),
                  cellsize=head["cellsize"], xllcenter=head["xllcenter"],
                  yllcenter=head["yllcenter"], n_part=n_part, wall=wall,
-                 source=found[0].name)
+                 t=t_saved, source=saved[t_saved].name)
 
 
 if __name__ == "__main__":
