@@ -22,8 +22,8 @@ L1, and the distance between the thickness' centroid and the solution's centre.
   the wall time is com1DFAMain's (one core).
 
 The last lines compare with issue 36's target: com1DFA's best L2 error reached by
-pdeflow in at most 2 s (com1DFA's best measured in this run, or, without AvaFrame, the
-issue's 0.017).
+pdeflow in at most 2 s (the issue's 0.017 and, with AvaFrame, com1DFA's best in this
+run).
 
 Run: ``python benchmarks/similarity_2d.py [--dx 4 2 1 0.5] [--schemes ...]
 [--avaframe-python V/bin/python] [--particles 5:15 3:15 2:15] [--repeats 3]``.
@@ -75,9 +75,12 @@ def avaframe_python(given: str | None) -> str | None:
     """The interpreter that imports avaframe: ``given``, $PDEFLOW_AVAFRAME_PYTHON or
     this one; None if none does."""
     for exe in (given, os.environ.get("PDEFLOW_AVAFRAME_PYTHON"), sys.executable):
-        if exe and subprocess.run([exe, "-c", "import avaframe"], capture_output=True
-                                  ).returncode == 0:
-            return exe
+        try:
+            if exe and subprocess.run([exe, "-c", "import avaframe"], capture_output=True
+                                      ).returncode == 0:
+                return exe
+        except OSError:  # no such interpreter: try the next
+            continue
     return None
 
 
@@ -127,23 +130,26 @@ def orders(rows: list[dict]) -> list[str]:
 
 
 def target_lines(rows: list[dict]) -> list[str]:
-    """Issue 36's target: com1DFA's best L2 reached by pdeflow in <= TARGET_WALL s."""
+    """Issue 36's target: com1DFA's best L2 reached by pdeflow in <= TARGET_WALL s,
+    against the issue's 0.017 and, with AvaFrame, against com1DFA's best here."""
+    goals = [(ISSUE_TARGET_L2, "issue 36's com1DFA best, 59k particles, 22 s")]
     ava = [r for r in rows if r["code"] == "com1DFA"]
     if ava:
         best = min(ava, key=lambda r: r["L2"])
-        goal, whose = best["L2"], (f"com1DFA's best here ({best['size']}, "
-                                   f"{best['wall']:.3g} s wall)")
-    else:
-        goal, whose = ISSUE_TARGET_L2, "issue 36's com1DFA best (59k particles, 22 s)"
-    ok = [r for r in rows if r["code"] == "pdeflow" and r["L2"] <= goal]
-    if not ok:
-        return [f"target: L2 h <= {goal:.4f} ({whose}) in <= {TARGET_WALL:g} s: missed "
-                f"(no pdeflow run reaches it)"]
-    fast = min(ok, key=lambda r: r["wall"])
-    verdict = "met" if fast["wall"] <= TARGET_WALL else "missed"
-    return [f"target: L2 h <= {goal:.4f} ({whose}) in <= {TARGET_WALL:g} s: {verdict}, "
-            f"pdeflow {fast['method']} {fast['size']} L2 {fast['L2']:.4f} in "
-            f"{fast['wall']:.3g} s wall"]
+        goals.append((best["L2"], f"com1DFA's best here, {best['size']}, "
+                                  f"{best['wall']:.3g} s wall"))
+    out = []
+    for goal, whose in goals:
+        ok = [r for r in rows if r["code"] == "pdeflow" and r["L2"] <= goal]
+        head = f"target: L2 h <= {goal:.4f} ({whose}) in <= {TARGET_WALL:g} s:"
+        if not ok:
+            out.append(f"{head} missed (no pdeflow run reaches it)")
+            continue
+        fast = min(ok, key=lambda r: r["wall"])
+        verdict = "met" if fast["wall"] <= TARGET_WALL else "missed"
+        out.append(f"{head} {verdict}, pdeflow {fast['method']} {fast['size']} L2 "
+                   f"{fast['L2']:.4f} in {fast['wall']:.3g} s wall")
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
