@@ -26,7 +26,7 @@ pdeflow in at most 2 s (the issue's 0.017 and, with AvaFrame, com1DFA's best in 
 run).
 
 Run: ``python benchmarks/similarity_2d.py [--dx 4 2 1 0.5] [--schemes ...]
-[--avaframe-python V/bin/python] [--particles 5:15 3:15 2:15] [--repeats 3]``.
+[--avaframe-python V/bin/python] [--particles 5:15 5:50 5:230] [--repeats 3]``.
 Units: lengths [m], times [s].
 """
 
@@ -152,19 +152,35 @@ def target_lines(rows: list[dict]) -> list[str]:
     return out
 
 
+def _pair(text: str, ap: argparse.ArgumentParser) -> tuple[float, float]:
+    """A ``--particles`` item "R:N": the kernel radius R [m] and nPPK0 N, both > 0."""
+    try:
+        radius, nppk0 = (float(v) for v in text.split(":"))
+        if radius > 0 and nppk0 > 0 and math.isfinite(radius * nppk0):
+            return radius, nppk0
+    except ValueError:
+        pass
+    ap.error(f"--particles items must be RADIUS:NPPK0 with both > 0 (e.g. 5:15), "
+             f"got {text!r}")
+    raise AssertionError  # ap.error exits
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--dx", type=float, nargs="+", default=[4.0, 2.0, 1.0, 0.5])
     ap.add_argument("--schemes", nargs="+", default=["hll/first-order", "hll/muscl/mc"])
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--avaframe-python", default=None)
-    ap.add_argument("--particles", nargs="+", default=["5:15", "3:15", "2:15"])
+    ap.add_argument("--particles", nargs="+", default=["5:15", "5:50", "5:230"])
     args = ap.parse_args(argv)
     if args.repeats < 1:
         ap.error(f"--repeats must be >= 1, got {args.repeats}")
     for dx in args.dx:  # the grid's checks, before any run
-        sr.initial_state(dx)
-    pairs = [tuple(float(v) for v in p.split(":")) for p in args.particles]
+        try:
+            sr.initial_state(dx)
+        except ValueError as err:
+            ap.error(f"--dx: {err}")
+    pairs = [_pair(p, ap) for p in args.particles]
     load = os.getloadavg()
     st = sr.solution().state(sr.T_END)
     print(f"similarity solution at t = {sr.T_END:g} s: g = {st['g']:.4f}, "
