@@ -123,6 +123,8 @@ def orders(rows: list[dict]) -> list[str]:
     out = []
     for scheme in dict.fromkeys(r["method"] for r in rows if r["code"] == "pdeflow"):
         l1 = [r["L1"] for r in rows if r["method"] == scheme]
+        if len(l1) < 2:
+            continue  # one grid: no order
         text = ", ".join(f"{math.log2(a / b):.2f}" for a, b in zip(l1, l1[1:],
                                                                      strict=False))
         out.append(f"observed order of L1 h, {scheme}: {text}")

@@ -63,7 +63,8 @@ def initial_state(dx: float, scheme: str = "hll/first-order") -> tuple[Any, Any]
 
 def run(dx: float, scheme: str = "hll/first-order", t_end: float = T_END
         ) -> dict[str, Any]:
-    """pdeflow's run of the set-up to t_end [s] (fv-split, Lie, its default CFL):
+    """pdeflow's run of the set-up to t_end [s] (fv-split at its default Courant
+    number 0.3, Lie splitting):
     ``h`` (nx, ny) [m], the cell centres ``x``, ``y`` [m], ``wall`` [s] (the solve
     alone, kernels compiled on first use: call once before timing) and ``steps``."""
     eq, state = initial_state(dx, scheme)
