@@ -19,7 +19,9 @@ Rows (each the median over ``--repeats`` interleaved rounds, one process):
 ``--memory N`` runs an N x N single-layer step in a fresh process and prints its peak
 resident memory.
 
-Run: ``python benchmarks/two_d_cost.py [--cells 256] [--repeats 5] [--memory 1000]``.
+Run: ``python benchmarks/two_d_cost.py [--cells 256] [--repeats 5] [--memory 1000]``
+(``--memory 1000 --memory-only``: the peak memory alone, which the machine's load does
+not change).
 """
 
 from __future__ import annotations
@@ -179,7 +181,13 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--memory", type=int, default=0,
                     help="also the peak memory of an N x N run (0: not measured)")
+    ap.add_argument("--memory-only", action="store_true",
+                    help="the peak memory alone (--memory N), no timings")
     args = ap.parse_args()
+    if args.memory_only:
+        print(f"peak memory, {args.memory} x {args.memory} single layer: "
+              f"{peak_memory_mb(args.memory):.0f} MB (target < 300)")
+        return
     rows = measure(args.cells, args.repeats)
     print(f"{args.cells} x {args.cells} cells, t = {T_END} s, {SCHEME}, "
           f"median of {args.repeats}")
