@@ -13,10 +13,13 @@ import pytest
 from pdeflow.terrain import (
     Raster,
     bed_on_grid,
+    case_polygon,
     cell_centres,
     read_asc,
     read_raster,
     release_mask,
+    same_crs,
+    shapefile_crs,
     vertical_thickness,
     write_asc,
     write_raster,
@@ -232,6 +235,36 @@ def test_release_errors(tmp_path: Path) -> None:
     with pytest.raises(ValueError) as err:
         release_mask([[np.array([[0.0, 0.0], [1.0, 1.0]])]], x, y)
     one_line(err, "release", "at least 3 points")
+    with pytest.raises(ValueError) as err:  # on the DEM, beyond the grid's north side
+        release_mask([square(1010.0, -450.0, 15.0)], x, y, raster=plane_raster(nrows=8))
+    one_line(err, "release", "(1025, -435)", "grid's domain", "y [-500, -440] m")
+
+
+def test_case_file_polygon_is_measured_from_the_corner() -> None:
+    """A case's vertices [m from (x_start, y_start)] select the cells the 2D polygon
+    shape fills (the same inside test)."""
+    from pdeflow.initial_shapes_2d import total_depth_2d
+    vertices = [[1.0, 1.0], [7.0, 2.0], [3.0, 6.0]]
+    x = cell_centres(100.0, 10.0, 0.5)
+    y = cell_centres(-20.0, 8.0, 0.5, axis="y")
+    mask = release_mask([case_polygon(vertices, 100.0, -20.0)], x, y)
+    X, Y = np.meshgrid(x - 100.0, y + 20.0, indexing="ij")  # noqa: N806
+    shape = total_depth_2d({"shape": "polygon", "vertices": vertices, "H0": 1.0}, X, Y)
+    assert mask.sum() > 20 and np.array_equal(mask, shape > 0)
+
+
+def test_crs_mismatch_is_refused(tmp_path: Path) -> None:
+    rasterio = pytest.importorskip("rasterio")
+    a = rasterio.crs.CRS.from_epsg(31287).to_wkt()
+    b = rasterio.crs.CRS.from_epsg(32632).to_wkt()
+    same_crs(a, a)
+    same_crs(a, None)  # unknown: nothing to compare
+    with pytest.raises(ValueError) as err:
+        same_crs(a, b)
+    one_line(err, "release", "differs from the DEM's", "WGS 84 / UTM zone 32N",
+             "MGI / Austria Lambert")
+    (tmp_path / "rel.prj").write_text(b + "\n")
+    assert shapefile_crs(tmp_path / "rel.shp") == b
 
 
 def test_release_from_a_shapefile(tmp_path: Path) -> None:
