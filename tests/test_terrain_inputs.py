@@ -345,7 +345,8 @@ def test_parabola_mean_slope_top_slope_and_flat_runout() -> None:
     assert math.atan(top) != pytest.approx(math.radians(alpha), rel=0.1)
     # the profile's slope falls linearly from 2 tan(alpha): at x = 1 m, by 2 C / foot^2
     assert top == pytest.approx(2 * math.tan(math.radians(alpha)) * (1 - 1 / foot), rel=1e-7)
-    assert math.degrees(math.atan(top)) == pytest.approx(53.5, abs=0.05)  # docs/terrain.md
+    at_top = top / (1 - 1 / foot)  # the slope at x = 0, from the line through x = 1 m
+    assert math.degrees(math.atan(at_top)) == pytest.approx(53.5, abs=0.05)  # terrain.md
     runout = np.linspace(foot + 1.0, 5000.0, 50)
     assert np.all(topo.parabola(runout, 0 * runout) == 0.0)
     np.testing.assert_allclose(slope_along_x(topo.parabola, np.array([foot - 0.1])), 0.0,
