@@ -81,6 +81,12 @@ def test_asc_xllcenter_and_nodata(tmp_path: Path) -> None:
     assert r.crs is None
 
 
+def test_asc_without_nodata_value_takes_non_finite_values_as_nodata(tmp_path: Path) -> None:
+    (tmp_path / "n.asc").write_text("ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\n"
+                                    "cellsize 1\nnan 1\n2 3\n")
+    assert read_asc(tmp_path / "n.asc").nodata.tolist() == [[True, False], [False, False]]
+
+
 @pytest.mark.parametrize(("text", "words"), [
     ("ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3\n4 5\n",
      ("5 values", "nrows x ncols")),

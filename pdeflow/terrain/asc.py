@@ -29,7 +29,7 @@ def _header(lines: list[str], path: Path) -> tuple[dict[str, float], int]:
     header: dict[str, float] = {}
     for n, line in enumerate(lines):
         parts = line.split()
-        if not parts or not parts[0][0].isalpha():
+        if not parts or _is_number(parts[0]):  # the values begin (a row may open with nan)
             return header, n
         key = parts[0].lower()
         if key not in HEADER_KEYS or len(parts) != 2:
@@ -41,6 +41,14 @@ def _header(lines: list[str], path: Path) -> tuple[dict[str, float], int]:
             raise ValueError(f"{path}: header {parts[0]} must be a number, got "
                              f"{parts[1]!r}") from None
     return header, len(lines)
+
+
+def _is_number(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
 
 
 def _geometry(header: dict[str, float], path: Path) -> tuple[int, int, float, float, float]:
