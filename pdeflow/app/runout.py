@@ -195,7 +195,8 @@ class RunoutPage:
             fl = f.line("a", "r", source=self.src_fits[model], color=colour, line_width=2)
             p, e = PAPER_FITS[model]
             pl = f.line(aa, p * aa**e, color=colour, line_dash="dotted", line_width=2)
-            items += [(f"{label}", [g]), (f"{label}: fit of the set", [fl]),
+            # points and their fit: one entry (one row less in a one-column legend)
+            items += [(f"{label}: points, fit of the set", [g, fl]),
                       (f"paper, {label}: {p} a^{e}", [pl])]
         for name, colour in zip(PUBLISHED_LAWS, ("#7f7f7f", "#17becf"), strict=True):
             law = f.line(aa, published_law(name, aa), color=colour, line_dash="dashed",
