@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from . import systems
 from .case_schema import CaseError
 from .initial_shapes import SHAPES
 from .initial_shapes_2d import SHAPES_2D, check_initial_2d
@@ -27,7 +28,8 @@ def _err(case: Any, msg: str) -> CaseError:
 
 
 def check_dimension(case: Any) -> None:
-    """A 1D case has no 2D key or shape; a 2D case is checked by :func:`_check_2d`."""
+    """A 1D case has no 2D key, shape or slope azimuth; a 2D case is checked by
+    :func:`_check_2d`."""
     grid = case.data.get("grid", {})
     bounds = case.data.get("boundaries", {})
     if case.is_2d:
@@ -41,6 +43,11 @@ def check_dimension(case: Any) -> None:
     if case.initial.get("shape") in SHAPES_2D:
         raise _err(case, f"initial.shape {case.initial['shape']!r} is a 2D shape: give "
                          "grid.width [m] (the domain across) too")
+    for model in systems.names():
+        azimuth = case.data.get(model, {}).get("slope_azimuth_deg", 0.0)
+        if azimuth != 0.0:
+            raise _err(case, f"{model}.slope_azimuth_deg = {azimuth:g} belongs to a 2D "
+                             "grid (a 1D slope is along x): give grid.width [m] too, or 0")
 
 
 def _check_2d(case: Any) -> None:

@@ -238,9 +238,16 @@ def solver_warning(case: Any) -> str | None:
 
 def slope_warning(case: Any) -> str | None:
     """Why the models of ``case`` cannot be compared if they run on different slopes
-    (their ``theta_deg``; e.g. one model's slope set on the command line), else None."""
-    slopes = {m: systems.get(m).parameters_class.from_dict(case.data.get(m, {})).theta_deg
+    (their ``theta_deg``, or in 2D ``slope_azimuth_deg``; e.g. one model's slope set on
+    the command line), else None."""
+    params = {m: systems.get(m).parameters_class.from_dict(case.data.get(m, {}))
               for m in case.models}
+    slopes = {m: p.theta_deg for m, p in params.items()}
+    azimuths = {m: p.slope_azimuth_deg for m, p in params.items()}
+    if len(set(slopes.values())) < 2 and len(set(azimuths.values())) > 1:
+        listed = ", ".join(f"{m}.slope_azimuth_deg = {a:g}" for m, a in azimuths.items())
+        return (f"{case.name}: the models' planes are inclined along different directions "
+                f"({listed} deg), so their results are not comparable; set them alike")
     if len(set(slopes.values())) < 2:
         return None
     steepest = max(slopes.values())

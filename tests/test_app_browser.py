@@ -260,8 +260,13 @@ SIZES = [(1024, 768), (1920, 1080)]
 FIGURES = {"dam-break": ("depths", "velocities", "fextra"), "run-out": ("runout",),
            "hyperbolicity": ("eigen", "imag", "fextra-map")}
 """Per page, its figures' CSS classes (pdeflow-<name>)."""
-IN_HEIGHT = ("dam-break", "run-out")
-"""Pages whose figures (with their legends) end within the window's height."""
+IN_VIEW = {"dam-break": (*FIGURES["dam-break"], "player", "summary"),
+           "run-out": ("a", "clear", "runout", "current", "fits"),
+           "hyperbolicity": (*FIGURES["hyperbolicity"], "frame", "cell", "take",
+                             "cell-state")}
+"""Per page, its main content: inside the window, with the side bar shown or folded
+(issue 38: at 1024x768 the hyperbolicity page's x-t map and the run-out page's results
+with the side bar shown stood below the window's bottom)."""
 OTHERS = {"dam-break": ("summary", "player", "sidebar"),
           "run-out": ("fits", "current", "sidebar"),
           "hyperbolicity": ("spectrum", "sidebar")}
@@ -279,10 +284,9 @@ def test_pages_fit_the_screen(browser, server, shots, name, size):
         if name == "run-out":
             _wait_for(lambda: "computing" not in text(page, "fits"))
         assert layout_problems(page, FIGURES[name], OTHERS[name]) == []
-        if name in IN_HEIGHT:  # the hyperbolicity page's map is below, by design
-            for fig in FIGURES[name]:
-                box = _box(page, fig)
-                assert box["y"] + box["height"] <= size[1] + 0.5, (fig, box)
+        assert _out_of_view(page, IN_VIEW[name]) == [], "side bar shown"
+        if name == "run-out":  # its results beside the figure and the a row, not under
+            assert all(_results_beside(page, name, n) for n in ("runout", "clear"))
         page.screenshot(path=shots / f"layout_{name}_{size[0]}.png", full_page=True)
         first = FIGURES[name][0]
         wide = page.locator(f".pdeflow-{first}").first.bounding_box()["width"]
@@ -291,9 +295,27 @@ def test_pages_fit_the_screen(browser, server, shots, name, size):
         _wait_for(lambda: _box(page, first)["width"] > wide + 100
                   or _results_beside(page, name, first), 10)
         assert layout_problems(page, FIGURES[name]) == []
+        assert _out_of_view(page, IN_VIEW[name]) == [], "side bar folded"
         assert not log.errors, log.errors
     finally:
         page.close()
+
+
+def _out_of_view(page, names) -> list[str]:
+    """The elements ``pdeflow-<name>`` of ``names`` not wholly inside the viewport (to
+    within 0.5 px: boxes are fractional), and the page if it scrolls down."""
+    width, height = page.viewport_size["width"], page.viewport_size["height"]
+    out = []
+    for name in names:
+        b = _box(page, name)
+        if not (b["x"] >= 0 and b["x"] + b["width"] <= width + 0.5
+                and b["y"] >= 0 and b["y"] + b["height"] <= height + 0.5):
+            out.append(f"{name}: x {b['x']:.0f} to {b['x'] + b['width']:.0f}, "
+                       f"y {b['y']:.0f} to {b['y'] + b['height']:.0f} px")
+    scroll = page.evaluate("() => document.documentElement.scrollHeight")
+    if scroll > height:
+        out.append(f"the page is {scroll} px high")
+    return out
 
 
 RESULTS = {"dam-break": "summary", "run-out": "current"}

@@ -51,6 +51,8 @@ NAN = math.nan
     (TWO, "phi_b_deg", 120.0, "(0, 90) deg"),
     (TWO, "phi_b_deg", NAN, "(0, 90) deg"),
     (TWO, "theta_deg", 90.0, "(-90, 90) deg"),
+    (TWO, "slope_azimuth_deg", 180.5, "[-180, 180] deg"),
+    (ONE, "slope_azimuth_deg", NAN, "[-180, 180] deg"),
     (TWO, "g", 0.0, "(0, inf] m/s^2"),
     (TWO, "c", -0.01, "[0, inf]"),
     (TWO, "c", math.inf, "[0, inf]"),

@@ -101,14 +101,15 @@ def _dam_break() -> tuple[np.ndarray, np.ndarray]:
     return h, np.where(x < 1.5, 0.2, 0.0)
 
 
-def _uniform_across(scheme: str, law: str, rotated: bool) -> None:
+def _uniform_across(scheme: str, law: str, rotated: bool, slope: bool = True) -> None:
     """The 2D run uniform across the flow (along y; rotated: along x, the flow along y)
-    against the 1D run: same steps, every cell of every line equal, no cross momentum."""
+    against the 1D run: same steps, every cell of every line equal, no cross momentum.
+    On the slope (``slope``) rotated, the plane is inclined along y (azimuth 90 deg)."""
     from pde import CartesianGrid
 
     from pdeflow.models import SingleLayerGranular
 
-    theta = 0.0 if rotated else 25.0  # gravity acts along x only
+    theta = 25.0 if slope else 0.0
     h, u = _dam_break()
     kw = {"theta_deg": theta, "phi_b_deg": 20.0, "friction_law": law, "scheme": scheme}
     one = SingleLayerGranular(bc=("wall", "open"), **kw)
@@ -122,7 +123,7 @@ def _uniform_across(scheme: str, law: str, rotated: bool) -> None:
         grid = CartesianGrid([[0, N * DX], [0, ACROSS * DX]], [N, ACROSS])
         bc = (("wall", "open"), ("wall", "open"))
         profiles = {"h": np.repeat(h[:, None], ACROSS, 1), "u": np.repeat(u[:, None], ACROSS, 1)}
-    two = SingleLayerGranular(bc=bc, **kw)
+    two = SingleLayerGranular(bc=bc, slope_azimuth_deg=90.0 if rotated else 0.0, **kw)
     st2, info2 = two.solve(two.make_state(grid, **profiles), 0.6, solver="fv-split",
                            cfl=2 * CFL, tracker=None, ret_info=True)
     assert info2["solver"]["steps"] == info1["solver"]["steps"]
@@ -139,12 +140,14 @@ def _uniform_across(scheme: str, law: str, rotated: bool) -> None:
 @pytest.mark.parametrize("law", ["coulomb", "pouliquen"])
 @pytest.mark.parametrize("scheme", QUICK)
 def test_uniform_across_gives_the_1d_run(scheme, law):
-    """A dam break on a 25 deg slope uniform in y, and rotated (horizontal, uniform in x,
-    the flow along y), through GranularPDE.solve with fv-split: the 1D run's numbers bit
-    for bit (exact comparison: the faces across carry exactly zero fluctuations and the
-    vector friction is the 1D arithmetic when v = 0), with the same number of steps."""
-    for rotated in (False, True):
-        _uniform_across(scheme, law, rotated)
+    """A dam break on a 25 deg slope uniform in y, and rotated (uniform in x, the flow
+    along y: horizontal, and on the plane inclined along y, ``slope_azimuth_deg`` = 90),
+    through GranularPDE.solve with fv-split: the 1D run's numbers bit for bit (exact
+    comparison: the faces across carry exactly zero fluctuations, gravity across the
+    flow is exactly 0 and the vector friction is the 1D arithmetic when the velocity
+    lies along one axis), with the same number of steps."""
+    for rotated, slope in ((False, True), (True, False), (True, True)):
+        _uniform_across(scheme, law, rotated, slope)
 
 
 @pytest.mark.slow
@@ -153,8 +156,8 @@ def test_uniform_across_gives_the_1d_run(scheme, law):
 def test_uniform_across_gives_the_1d_run_every_scheme(scheme, law):
     """:func:`test_uniform_across_gives_the_1d_run` for every flux, reconstruction and
     splitting and the other laws."""
-    for rotated in (False, True):
-        _uniform_across(scheme, law, rotated)
+    for rotated, slope in ((False, True), (True, False), (True, True)):
+        _uniform_across(scheme, law, rotated, slope)
 
 
 def _square(n: int, side: float):
@@ -165,11 +168,12 @@ def _square(n: int, side: float):
     return grid, np.hypot(x - side / 2, y - side / 2)
 
 
-@pytest.mark.parametrize("theta", [0.0, 5.0])
+@pytest.mark.parametrize("theta, azimuth", [(0.0, 0.0), (5.0, 0.0), (5.0, 30.0)])
 @pytest.mark.parametrize("scheme", ["hll/first-order", "hll/muscl/mc+strang"])
-def test_a_cone_below_the_friction_angle_stays_at_rest(theta, scheme):
-    """A cone (0.5 m high, sides at 10 deg) on a plane at theta = 0 and 5 deg with a 30 deg
-    basal friction angle: the drive, at most g (sin theta + cos theta tan 10 deg), stays
+def test_a_cone_below_the_friction_angle_stays_at_rest(theta, azimuth, scheme):
+    """A cone (0.5 m high, sides at 10 deg) on a plane at theta = 0 and 5 deg, inclined
+    along x and along 30 deg from x (``slope_azimuth_deg``), with a 30 deg basal friction
+    angle: the drive, at most g (sin theta + cos theta tan 10 deg), stays
     below the friction g cos theta tan 30 deg everywhere, so the set-valued friction
     holds every cell. 100 s of fv-split (not stopped at rest): every value is unchanged
     and the momenta are 0, exactly: the claim is exact rest (a cell at rest moves no
@@ -179,7 +183,7 @@ def test_a_cone_below_the_friction_angle_stays_at_rest(theta, scheme):
     grid, r = _square(24, 3.0)
     h = np.maximum(0.5 - r * math.tan(math.radians(10.0)), 0.0)
     eq = SingleLayerGranular(theta_deg=theta, phi_b_deg=30.0, scheme=scheme,
-                             bc=("open", "open"))
+                             slope_azimuth_deg=azimuth, bc=("open", "open"))
     state = eq.make_state(grid, h=h)
     out, info = eq.solve(state, 100.0, solver="fv-split", stop_at_rest=False, tracker=None,
                          ret_info=True)

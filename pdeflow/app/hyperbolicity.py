@@ -39,10 +39,20 @@ from ..numerics.state import velocity_profile
 from ..plotting import DRY
 from .controls import Slider
 from .dam_break import COLOURS, FRAMES_PER_T_END, DamBreakRun, SharedRun
-from .look import PageLayout, fit_height, legend_outside, style_figures
+from .look import (
+    FIGURES_MIN_PRESENT_PX,
+    PageLayout,
+    fit_height,
+    legend_outside,
+    style_figures,
+)
 
 G = 9.81
 """g_z of the sliders' state [m/s^2] (a flat bed); a cell of a run brings its own."""
+COLUMN_MIN_PX = 380
+"""The least width of each of the page's two columns (the spectrum's figures; the run's
+x-t map with its controls) before the second wraps under the first [px]: a projector's
+1024 px less the side bar (784 px) holds both, so the map is in the window too."""
 
 
 @dataclass
@@ -135,6 +145,14 @@ class HyperbolicityPage:
         self.run: DamBreakRun | None = None
         self._figures()
         self._xt_figure()
+        self.columns = (
+            pn.Column(pn.pane.Bokeh(self.fig_spec), pn.pane.Bokeh(self.fig_im),
+                      sizing_mode="stretch_width"),
+            pn.Column(pn.pane.HTML("<b>where F_extra acts in the dam-break page's run</b>",
+                                   sizing_mode="stretch_width"),
+                      pn.pane.Bokeh(self.fig_xt),
+                      pn.Row(self.frame, self.cell, sizing_mode="stretch_width"),
+                      self.take, self.cell_text, sizing_mode="stretch_width"))
         self.set_present(present)
         self.update()
         shared.param.watch(lambda e: self.show_run(e.new), "run")
@@ -171,7 +189,7 @@ class HyperbolicityPage:
                             line_dash=dash, line_width=1.5)
                 f.add_layout(span)
                 self.lines.setdefault(name, []).append(span)
-        legend_outside(fs)  # never over the curves
+        legend_outside(fs, "above")  # never over the curves; the plot keeps the width
         fs.css_classes = ["pdeflow-eigen"]
         fi.css_classes = ["pdeflow-imag"]
         self.fig_spec, self.fig_im = fs, fi
@@ -231,8 +249,8 @@ class HyperbolicityPage:
         self.mapper.high = max(float(f.max()), 1e-6)
         self.src_xt.data = {"x": run.x[j], "t": run.times[i], "f": f[i, j],
                             "w": np.full(i.size, dx), "h": np.full(i.size, dt)}
-        # short: it must fit a projector's page in presentation mode
-        self.fig_xt.title.text = f"F_extra > 0 in {i.size} of {f.size} cells × frames"
+        # short: it must fit half a projector's page (the map's column)
+        self.fig_xt.title.text = f"F_extra > 0 at {i.size} of {f.size} (x, t)"
         self.fig_xt.x_range.start = run.case.x_start
         self.fig_xt.x_range.end = run.case.x_start + run.case.length
         self.fig_xt.y_range.start, self.fig_xt.y_range.end = 0.0, float(run.times[-1])
@@ -250,8 +268,9 @@ class HyperbolicityPage:
                     tools="pan,wheel_zoom,box_zoom,reset,save")
         fx.rect("x", "t", "w", "h", source=self.src_xt, line_color=None,
                 fill_color={"field": "f", "transform": self.mapper})
-        fx.add_layout(ColorBar(color_mapper=self.mapper, title="F_extra/ρ1 [m²/s²]"),
-                      "right")
+        # below: beside the map it took 100 px of a half page's width
+        fx.add_layout(ColorBar(color_mapper=self.mapper, title="F_extra/ρ1 [m²/s²]",
+                               orientation="horizontal", height=10), "below")
         self.cross = (Span(dimension="height", line_color=COLOURS["lower"],
                            line_width=1.5),
                       Span(dimension="width", line_color=COLOURS["lower"], line_width=1.5))
@@ -274,9 +293,9 @@ class HyperbolicityPage:
             f"h1 = {s['h1']:.4g} m, h2 = {s['h2']:.4g} m, u1 = {s['u1']:.4g} m/s, "
             f"u2 = {s['u2']:.4g} m/s, du = {s['du']:.4g} m/s, "
             f"<b>F_extra/ρ1 = {s['fextra']:.4g} m²/s²</b> (r = {s['r']:.3g}).</p>"
-            f"<p>The largest F_extra/ρ1 over every step of the summary's run: "
+            f"<p>The largest over every step of the summary's run: "
             f"{run.results[PAPER_MODEL].summary['max_fextra_over_rho1']:.4g} m²/s² (the "
-            f"frames come from the animation's run, which stops at every frame).</p>"
+            f"map's frames: the animation's run, which stops at each).</p>"
             + ("" if s["h1"] > DRY and s["h2"] > DRY else
                "<p>a layer is dry here: nothing to analyse</p>"))
 
@@ -304,14 +323,15 @@ class HyperbolicityPage:
         style_figures((self.fig_spec, self.fig_im, self.fig_xt), present)
         for f, normal in ((self.fig_spec, 260), (self.fig_im, 200), (self.fig_xt, 300)):
             f.height = fit_height(normal, present)
+        least = FIGURES_MIN_PRESENT_PX if present else COLUMN_MIN_PX
+        for column in self.columns:  # larger fonts: one column under the other
+            column.styles = {"flex": f"1 1 {least}px", "min-width": "0"}
 
     def panel(self) -> pn.Row:
         left = pn.Column("### a local state", *self.sliders.values(), self.text,
                          sizing_mode="stretch_width")
-        right = pn.Column(pn.pane.Bokeh(self.fig_spec), pn.pane.Bokeh(self.fig_im),
-                          "### where F_extra acts in the dam-break page's run",
-                          pn.pane.Bokeh(self.fig_xt), self.frame, self.cell,
-                          self.cell_text, self.take, sizing_mode="stretch_width")
+        right = pn.FlexBox(*self.columns, flex_wrap="wrap", align_items="flex-start",
+                           sizing_mode="stretch_width")
         # the side bar holds the spectrum's numbers too: presentation mode keeps it
         self.layout = PageLayout(left, right)
         return self.layout.row

@@ -154,12 +154,13 @@ class PageLayout:
             animation's player: one row for both, the figures start higher).
         figures_min_px: the narrowest the figures get before the results wrap under
             them [px] (outside presentation mode).
+        results_px: the results' width [px].
     """
 
     def __init__(self, sidebar: pn.viewable.Viewable, figures: pn.viewable.Viewable,
                  results: pn.viewable.Viewable | None = None,
                  top: pn.viewable.Viewable | None = None,
-                 figures_min_px: int = FIGURES_MIN_PX):
+                 figures_min_px: int = FIGURES_MIN_PX, results_px: int = RESULTS_PX):
         self.figures_min_px = figures_min_px
         self.sidebar = pn.Column(sidebar, width=SIDEBAR_PX, css_classes=["pdeflow-sidebar"],
                                  styles={"max-height": f"calc(100vh - {SIDEBAR_TOP_PX}px)",
@@ -172,7 +173,7 @@ class PageLayout:
         self.set_present(False)
         parts = [figures]
         if results is not None:
-            results.styles = {"flex": f"0 1 {RESULTS_PX}px"}
+            results.styles = {"flex": f"0 1 {results_px}px"}
             parts.append(results)
         self.main = pn.FlexBox(*parts, flex_wrap="wrap", align_items="flex-start",
                                sizing_mode="stretch_width")

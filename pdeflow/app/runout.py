@@ -44,9 +44,21 @@ A_RANGE = (1.0, 35.0)
 """a axis of the figure"""
 R_RANGE = (0.5, 150.0)
 """r axis of the figure"""
-FIGURE_HEIGHT_PX = 545
+FIGURE_HEIGHT_PX = 580
 """Height of the figure with its legend [px], in either mode: on a projector's 768 px
 it ends in the window, under the header, the tabs and the a slider."""
+LEGEND_COLUMNS = {False: 1, True: 2}
+"""Columns of the legend under the plot, outside and in presentation mode: one column
+fits the figure's least width beside the results (two were 580 px wide, and stood out
+of a 454 px figure); in presentation mode the figure is at least 700 px wide."""
+
+
+FIGURES_MIN_PX = 440
+"""The figure's least width [px] beside the results: a projector's 1024 px less the side
+bar (784 px) holds both, so the results stand beside the figure, in the window."""
+RESULTS_PX = 330
+"""The results' width [px] (the fits' lines wrap; 1024x768 with the side bar: in the
+window's height)."""
 
 
 def format_r(r: float | None) -> str:
@@ -66,12 +78,14 @@ class RunoutPage:
             cases, default if default in cases else next(iter(cases)), self.recompute,
             [k for k in KNOBS if not k.column_only and k.in_sweep])
         self.a = Slider(label="aspect ratio a = H0/L0", start=1.0, end=30.0, step=0.5,
-                        value=5.0, css_classes=["pdeflow-a"], sizing_mode="stretch_width")
+                        value=5.0, css_classes=["pdeflow-a"], sizing_mode="stretch_width",
+                        min_width=160)
         self.a.param.watch(lambda e: self.add_point(float(e.new)), "value_throttled")
-        self.reset = pn.widgets.Button(label="the case's a values",
+        self.reset = pn.widgets.Button(label="the case's a values", align="end",
                                        css_classes=["pdeflow-reset"])
         self.reset.on_click(lambda e: self.recompute(self._case_ratios()))
-        self.clear = pn.widgets.Button(label="clear the set", css_classes=["pdeflow-clear"])
+        self.clear = pn.widgets.Button(label="clear the set", align="end",
+                                       css_classes=["pdeflow-clear"])
         self.clear.on_click(lambda e: self.recompute([]))
         self.status = pn.pane.HTML("", css_classes=["pdeflow-status"],
                                    sizing_mode="stretch_width")
@@ -181,7 +195,8 @@ class RunoutPage:
             fl = f.line("a", "r", source=self.src_fits[model], color=colour, line_width=2)
             p, e = PAPER_FITS[model]
             pl = f.line(aa, p * aa**e, color=colour, line_dash="dotted", line_width=2)
-            items += [(f"{label}", [g]), (f"{label}: fit of the set", [fl]),
+            # points and their fit: one entry (one row less in a one-column legend)
+            items += [(f"{label}: points, fit of the set", [g, fl]),
                       (f"paper, {label}: {p} a^{e}", [pl])]
         for name, colour in zip(PUBLISHED_LAWS, ("#7f7f7f", "#17becf"), strict=True):
             law = f.line(aa, published_law(name, aa), color=colour, line_dash="dashed",
@@ -204,7 +219,7 @@ class RunoutPage:
         items.append(("a of the slider (the current point)", [a_item]))
         # under the plot, in two columns: it never covers the points, and the plot
         # keeps the page's width
-        legend = Legend(items=items, click_policy="hide", ncols=2)
+        legend = Legend(items=items, click_policy="hide")  # ncols: set_present
         f.add_layout(legend, "below")
         f.css_classes = ["pdeflow-runout"]
         self.fig = f
@@ -272,14 +287,17 @@ class RunoutPage:
         self.present = present
         style_figure(self.fig, present)
         self.fig.height = FIGURE_HEIGHT_PX  # the legend's larger rows take from the plot
+        self.fig.legend[0].ncols = LEGEND_COLUMNS[present]
         self.controls.set_present(present)
 
     def panel(self) -> pn.Row:
-        main = pn.Column(self.status, self.warnings, self.a, pn.Row(self.reset, self.clear),
+        main = pn.Column(self.status, self.warnings,
+                         pn.Row(self.a, self.reset, self.clear, sizing_mode="stretch_width"),
                          pn.pane.Bokeh(self.fig), sizing_mode="stretch_width")
         results = pn.Column("### results", self.current, self.fits,
                             sizing_mode="stretch_width")
-        self.layout = PageLayout(self.controls.panel("run-out law"), main, results)
+        self.layout = PageLayout(self.controls.panel("run-out law"), main, results,
+                                 figures_min_px=FIGURES_MIN_PX, results_px=RESULTS_PX)
         if self.present:
             self.layout.show_sidebar(False)
         return self.layout.row

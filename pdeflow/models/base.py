@@ -139,7 +139,9 @@ class SharedParameters(ParametersBase):
     g: float = 9.81
     """gravitational acceleration [m/s^2]"""
     theta_deg: float = 0.0
-    """bed slope [deg], x pointing down-slope"""
+    """bed slope [deg], down-slope along x (a 2D grid: along slope_azimuth_deg)"""
+    slope_azimuth_deg: float = 0.0
+    """on a 2D grid, the steepest descent's direction from x towards y [deg]; 1D: 0"""
     dry_tolerance: float = DRY_TOLERANCE
     """layers thinner than this have zero velocity [m]"""
     rest_speed: float = 0.01
@@ -154,6 +156,7 @@ class SharedParameters(ParametersBase):
         check_range("g", self.g, 0, math.inf, low_open=True, unit="m/s^2")
         check_range("theta_deg", self.theta_deg, -90, 90, low_open=True,
                     high_open=True, unit="deg")
+        check_range("slope_azimuth_deg", self.slope_azimuth_deg, -180, 180, unit="deg")
         self.validate_model()
         check_range("dry_tolerance", self.dry_tolerance, 0, 1, low_open=True, unit="m")
         check_range("rest_speed", self.rest_speed, 0, math.inf, low_open=True,
@@ -285,10 +288,13 @@ class GranularPDE(PDEBase):
 
     def _check_geometry(self, geometry: str) -> str:
         """``geometry``, or ValueError: on an axisymmetric grid the left boundary is the
-        axis and must be 'wall'; boundaries per axis need a 2D grid."""
+        axis and must be 'wall'; boundaries per axis and a slope azimuth need a 2D grid."""
         if len(self.bc_axes) == 2 and geometry != "planar-2d":
             raise ValueError(f"bc gives a pair per axis, {self.bc!r}: a {geometry} grid "
                              "takes one pair (left, right)")
+        if geometry != "planar-2d" and self.parameters.slope_azimuth_deg != 0.0:
+            raise ValueError("slope_azimuth_deg must be 0 on a 1D grid (the slope is along "
+                             f"its axis), got {self.parameters.slope_azimuth_deg:g}")
         if geometry == "axisymmetric" and self.bc[0] != "wall":
             raise ValueError(f"on an axisymmetric grid the left boundary is the axis: "
                              f"bc[0] must be 'wall', got {self.bc[0]!r}")

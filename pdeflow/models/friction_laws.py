@@ -155,7 +155,10 @@ class FrictionLawParameters:
         """Write the law's block at ``base`` of the kernel vector ``P`` (its header
         already set); ``tan_b`` is the model's Coulomb coefficient tan(phi_b)."""
         g_z = float(P[L.G_Z])
-        g = math.hypot(g_z, float(P[L.G_X]))
+        # g sin(theta) from the header; read as G_X alone where G_Y is 0 (1D, azimuth 0),
+        # where the constants stay those computed before the azimuth existed, to the bit
+        along = math.hypot(P[L.G_X], P[L.G_Y]) if P[L.G_Y] != 0.0 else float(P[L.G_X])
+        g = math.hypot(g_z, along)
         block = np.zeros(L.N_LAW)
         constants = LAWS[self.friction_law].constants(self, g_z, g, tan_b)
         block[:len(constants)] = constants

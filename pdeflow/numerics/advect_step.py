@@ -124,7 +124,9 @@ def advect_step_function(order: int, strang: bool, update: Any = None, width: in
         if strang:
             # the first half source step may accelerate a layer by up to dt/2 |g_x|
             # (friction only brakes): choose dt with dt (smax + dt |g_x| / 2) = cfl dx
-            gx = abs(P[L.G_X]) * speed_scale(metric, dx) if two_d else abs(P[L.G_X])
+            # (2D: |g_x| + |g_y|, the plane's gravity along both axes, scaled as speeds)
+            gx = (abs(P[L.G_X]) + abs(P[L.G_Y])) * speed_scale(metric, dx) if two_d \
+                else abs(P[L.G_X])
             den = smax + math.sqrt(smax * smax + 2.0 * gx * cfl * dx)
             if den > 0.0:
                 dt = min(dt, 2.0 * cfl * dx / den)

@@ -15,8 +15,9 @@ mass flux M [kg m^-2 s^-1] as M/rho2 [m/s]. Only the density ratio r = rho1/rho2
 
 # --- header of every model's parameter vector -----------------------------------------
 G_Z = 0  #: gravity normal to the bed, g cos(theta) [m/s^2]
-G_X = 1  #: gravity along the bed (down-slope positive), g sin(theta) [m/s^2]
-N_HEADER = 2
+G_X = 1  #: gravity along the bed in x, g sin(theta) cos(azimuth) [m/s^2] (1D: g sin(theta))
+G_Y = 2  #: gravity along the bed in y, g sin(theta) sin(azimuth) [m/s^2] (1D: 0, unread)
+N_HEADER = 3
 
 # --- diagnostics vector (post-step data of the splitting hook) -------------------------
 # The scheme's slots; the others below N_DIAG (MODEL_SLOTS) are the model's own, named

@@ -3,9 +3,9 @@
 Starts with the header of :mod:`pdeflow.numerics.layout`.
 """
 
-from ...numerics.layout import G_X, G_Z, MODEL_SLOTS, N_HEADER, N_LAW
+from ...numerics.layout import G_X, G_Y, G_Z, MODEL_SLOTS, N_HEADER, N_LAW
 
-__all__ = ["G_Z", "G_X"]
+__all__ = ["G_Z", "G_X", "G_Y"]
 
 TAN_B = N_HEADER  #: tan(phi_B), basal friction [-]
 DRY = N_HEADER + 1  #: dry tolerance [m]

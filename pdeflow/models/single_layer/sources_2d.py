@@ -1,17 +1,21 @@
-r"""The single layer's sources on a 2D grid: gravity along x and vector basal friction.
+r"""The single layer's sources on a 2D grid: gravity along the plane and vector basal
+friction.
 
-State (h, hu, hv) on the flattened cells (:mod:`.two_d`). Gravity acts along x (g_x,
-the plane inclined at theta along x). Basal friction opposes the velocity and is
-applied implicitly and set-valued, as in 1D (:mod:`.sources`): from the explicit update
-**u*** = **u** + dt (g_x, 0), the speed after the step is the 1D law's step applied to
-the speed |**u***| (Coulomb: max(|**u***| - dt g_z mu, 0); a rate-dependent law: its
-``speed``), along **u***:
+State (h, hu, hv) on the flattened cells (:mod:`.two_d`). Gravity acts along the
+plane's steepest descent: (g_x, g_y) = g sin(theta) (cos a, sin a), a the slope's
+azimuth (``slope_azimuth_deg``; (g sin(theta), 0) at a = 0). Basal friction opposes the
+velocity and is applied implicitly and set-valued, as in 1D (:mod:`.sources`): from the
+explicit update **u*** = **u** + dt (g_x, g_y), the speed after the step is the 1D
+law's step applied to the speed |**u***| (Coulomb: max(|**u***| - dt g_z mu, 0); a
+rate-dependent law: its ``speed``), along **u***:
 
 .. math:: \mathbf{u}^{n+1} = \frac{\mathbf{u}^*}{|\mathbf{u}^*|}\, s^{n+1}.
 
 With v = 0, sqrt(u*^2) == |u*| and u*/|u*| == +-1 in IEEE arithmetic, so the update is
-the 1D arithmetic to the bit. The method-of-lines rate regularises the direction of the
-friction as the 1D one does, **u** / max(|**u**|, mol_eps).
+the 1D arithmetic to the bit (at a = 0, g_y = 0 adds nothing to v; at a = 90 deg g_x
+is exactly 0, and the same holds with x and y exchanged). The method-of-lines rate
+regularises the direction of the friction as the 1D one does, **u** / max(|**u**|,
+mol_eps).
 """
 
 from __future__ import annotations
@@ -57,10 +61,11 @@ def stage_kernels_2d(law: BasalLaw | None) -> tuple[Any, Any, Any]:
     step = vector_step(after_friction)
 
     def sources_single_2d(q, dt, t, P, book, fex, lo, hi):
-        """Gravity along x and implicit vector basal friction on the cells lo..hi,
+        """Gravity along the plane and implicit vector basal friction on the cells lo..hi,
         booked in ``book`` (no per-cell diagnostic: ``fex`` is not written)."""
         g = P[S.G_Z]
         gx = P[S.G_X]
+        gy = P[S.G_Y]
         dry = P[S.DRY]
         friction = step_friction(dt, g, P)
         moving = False
@@ -75,7 +80,7 @@ def stage_kernels_2d(law: BasalLaw | None) -> tuple[Any, Any, Any]:
             u = velocity(h, m, dry)
             v = velocity(h, n, dry)
             if dt > 0.0 and h > dry:
-                u, v = step(u + dt * gx, v, h, dt, g, friction)
+                u, v = step(u + dt * gx, v + dt * gy, h, dt, g, friction)
             m = h * u if h > dry else 0.0
             n = h * v if h > dry else 0.0
             if m != 0.0 or n != 0.0:
@@ -103,7 +108,7 @@ def stage_kernels_2d(law: BasalLaw | None) -> tuple[Any, Any, Any]:
             h = max(q[0, i], 0.0)
             if h > dry:
                 a = q[1, i] / h + dt * P[S.G_X]
-                b = q[2, i] / h
+                b = q[2, i] / h + dt * P[S.G_Y]
                 s = math.sqrt(a * a + b * b)
                 if s == 0.0 or after_friction(s, h, dt, g, friction) == 0.0:
                     q[1, i] = 0.0
@@ -123,7 +128,7 @@ def fold_single_2d(diag: np.ndarray, book: np.ndarray) -> None:
 
 @functools.cache
 def source_rate_2d(law: BasalLaw | None) -> Any:
-    """The kernel ``(q, rate, P)`` that adds gravity along x and the regularised basal
+    """The kernel ``(q, rate, P)`` that adds gravity along the plane and the regularised basal
     friction of ``law`` (None: Coulomb's) along the velocity to ``rate`` (2D single
     layer; the 1D :func:`.rates.source_rate`'s arithmetic where v = 0)."""
     coulomb = law is None
@@ -141,7 +146,7 @@ def source_rate_2d(law: BasalLaw | None) -> Any:
                 else:
                     f = h * accel(block(P, S.LAW), h, P[S.G_Z], h, s)
                 rate[1, i] += P[S.G_X] * h - f * u / max(s, P[S.MOL_EPS])
-                rate[2, i] -= f * v / max(s, P[S.MOL_EPS])
+                rate[2, i] += P[S.G_Y] * h - f * v / max(s, P[S.MOL_EPS])
 
     return specialise(source_rate_single_2d, STATE, FIELDS, PARAMS)
 

@@ -2,7 +2,7 @@ r"""Implicit friction (32) of one cell with vector velocities, and the restorati
 hyperbolicity along the shear (33)-(34) in 2D.
 
 Backward Euler for the momentum sources with the depths frozen, as in 1D
-(:mod:`.exchange`), now for vectors: with m1 = r h1, m2 = h2 and b = u + dt g_x e_x,
+(:mod:`.exchange`), now for vectors: with m1 = r h1, m2 = h2 and b = u + dt (g_x, g_y),
 
 .. math::  m_1 (u_1 - b_1) + \Delta t\, F_{12} = 0,\qquad
            m_2 (u_2 - b_2) - \Delta t\, F_{12} + \Delta t\, F_B = 0,

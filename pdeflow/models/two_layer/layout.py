@@ -3,9 +3,9 @@
 Starts with the header of :mod:`pdeflow.numerics.layout`; choices are codes from it.
 """
 
-from ...numerics.layout import G_X, G_Z, MODEL_SLOTS, N_HEADER, N_LAW
+from ...numerics.layout import G_X, G_Y, G_Z, MODEL_SLOTS, N_HEADER, N_LAW
 
-__all__ = ["G_Z", "G_X"]
+__all__ = ["G_Z", "G_X", "G_Y"]
 
 R = N_HEADER  #: density ratio rho1/rho2 [-]
 TAN_INT = N_HEADER + 1  #: tan(phi_int), internal friction at the interface [-]

@@ -2,7 +2,8 @@ r"""Source terms (26)-(27) on a 2D state as a method-of-lines rate (py-pde's gen
 solvers): the 1D rate of :mod:`.rates` with vectors. Each sgn(v) becomes
 v / max(|v|, eps) (eps = ``mol_eps``): the interface stress along the shear vector
 du = u1 - u2, the basal Coulomb stress along u2; the closure (25) on |du|; gravity
-along x; a rate-dependent basal law's stress along u2.
+along the plane, (g_x, g_y) = g sin(theta) (cos a, sin a) at the slope's azimuth a; a
+rate-dependent basal law's stress along u2.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ def source_rate_2d(law: BasalLaw | None) -> Any:
         r = P[T.R]
         g = P[T.G_Z]
         gx = P[T.G_X]
+        gy = P[T.G_Y]
         dry = P[T.DRY]
         eps = P[T.MOL_EPS]
         du_reg = max(P[T.DU_REG], eps)
@@ -60,7 +62,7 @@ def source_rate_2d(law: BasalLaw | None) -> Any:
                 t1y = stress * duy
                 rate[0, i] += m / r
                 rate[1, i] += gx * h1 + u1 * m / r - t1x / r
-                rate[2, i] += v1 * m / r - t1y / r
+                rate[2, i] += gy * h1 + v1 * m / r - t1y / r
             rate[3, i] -= m
             if h2 > dry:
                 speed = math.sqrt(u2 * u2 + v2 * v2)
@@ -70,7 +72,7 @@ def source_rate_2d(law: BasalLaw | None) -> Any:
                     bf = h2 * accel(block(P, T.LAW), h1 + h2, g * (r * h1 + h2) / h2,
                                     h2, speed) / max(speed, eps)
                 rate[4, i] += gx * h2 - u1 * m + t1x - bf * u2
-                rate[5, i] += -v1 * m + t1y - bf * v2
+                rate[5, i] += gy * h2 - v1 * m + t1y - bf * v2
             else:
                 rate[4, i] -= u1 * m
                 rate[5, i] -= v1 * m

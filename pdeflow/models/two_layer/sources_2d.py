@@ -6,9 +6,10 @@ The 1D stage (:mod:`.sources`) with vectors:
 * exchange (31): closure (25) on the shear vector du = u1 - u2, its magnitude where
   the 1D stage has |du| (:func:`.exchange.exchange_step` reads du only through du^2
   and |du|); the exchanged mass carries the velocity vector of the layer it leaves;
-* implicit momentum sources (32): gravity along x, the interface stress opposing du
-  and the basal friction opposing u2, both set-valued (:mod:`.friction_2d`; a
-  rate-dependent basal law: :mod:`.laws_2d`);
+* implicit momentum sources (32): gravity along the plane's steepest descent, (g_x,
+  g_y) = g sin(theta) (cos a, sin a) at the slope's azimuth a, the interface stress
+  opposing du and the basal friction opposing u2, both set-valued
+  (:mod:`.friction_2d`; a rate-dependent basal law: :mod:`.laws_2d`);
 * hyperbolicity (33)-(34): F_extra along du. With ``directions`` "all" (the default)
   it brings |du| to F_c1 whenever |du| > F_c1, above the band as inside it: only then
   is the state hyperbolic in every direction (docs/two_d.md); "flow" applies the 1D
@@ -138,6 +139,7 @@ def _sources_2d(fk: Any, bed: Any, every_direction: bool) -> Any:
         r = P[T.R]
         g = P[T.G_Z]
         gx = P[T.G_X]
+        gy = P[T.G_Y]
         dry = P[T.DRY]
         mode = int(P[T.HYPERBOLICITY])
         moving1 = moving2 = fast1 = fast2 = changed = False
@@ -170,9 +172,9 @@ def _sources_2d(fk: Any, bed: Any, every_direction: bool) -> Any:
                         else:
                             book[T.D_ERODED] += dh1
                 b1x = u1x + dt * gx if h1 > dry else 0.0
-                b1y = u1y if h1 > dry else 0.0
+                b1y = u1y + dt * gy if h1 > dry else 0.0
                 b2x = u2x + dt * gx if h2 > dry else 0.0
-                b2y = u2y if h2 > dry else 0.0
+                b2y = u2y + dt * gy if h2 > dry else 0.0
                 v1x, v1y, v2x, v2y = friction(b1x, b1y, b2x, b2y, h1, h2, dt, fp, 0.0, 0.0,
                                               k_eff, c_eff)
                 if mode != L.HYPERBOLICITY_NONE and h1 > dry and h2 > dry:
@@ -234,9 +236,9 @@ def _predictor_2d(fk: Any, bed: Any) -> Any:
             wet1 = h1 > dry
             wet2 = h2 > dry
             b1x = velocity(h1, q[1, i], dry) + dt * P[T.G_X] if wet1 else 0.0
-            b1y = velocity(h1, q[2, i], dry) if wet1 else 0.0
+            b1y = velocity(h1, q[2, i], dry) + dt * P[T.G_Y] if wet1 else 0.0
             b2x = velocity(h2, q[4, i], dry) + dt * P[T.G_X] if wet2 else 0.0
-            b2y = velocity(h2, q[5, i], dry) if wet2 else 0.0
+            b2y = velocity(h2, q[5, i], dry) + dt * P[T.G_Y] if wet2 else 0.0
             u1x, u1y, u2x, u2y = friction(b1x, b1y, b2x, b2y, h1, h2, dt, fp, 0.0, 0.0,
                                           P[T.K], P[T.C])
             if u1x == 0.0 and u1y == 0.0:
