@@ -151,10 +151,18 @@ def test_a_cone_below_the_friction_angles_stays_at_rest(scheme):
     is unchanged after 10 s (exactly: the friction stage is set-valued); with the paper's
     closure (which deposits a layer at rest) every momentum is exactly zero and the mass
     r h1 + h2 [m, per rho2] stays to round-off (relative 1e-12: sums over 400 cells)."""
-    grid, h1, h2 = cone(20, 0.25)
+    cone_stays_at_rest(scheme, 0.25)
+
+
+def cone_stays_at_rest(scheme: tuple, slope: float, **params) -> None:
+    """The cone of ``slope`` (:func:`cone`, 20 x 20 cells, walls) run 10 s with the
+    model's ``params``: with exchange 'none' every value unchanged (exactly); with the
+    paper's closure every momentum exactly zero and the mass r h1 + h2 to relative
+    1e-12."""
+    grid, h1, h2 = cone(20, slope)
     walls = L.sides((L.BC_WALL, L.BC_WALL))
     for closure in ("none", "paper"):
-        P = parameters(exchange_closure=closure)
+        P = parameters(exchange_closure=closure, **params)
         q0 = two_d.state(h1, 0 * h1, 0 * h1, h2, 0 * h2, 0 * h2)
         q, steps, _ = run(kernels_2d(), grid, q0.copy(), scheme, False, walls, walls, P,
                           0.6, 10.0)

@@ -82,15 +82,23 @@ def _check_on_grid(polygons: Sequence[Polygon], x: np.ndarray, y: np.ndarray,
     release beyond it would be lost unseen (as a 2D case's polygon, every vertex must
     lie in the domain)."""
     (x_lo, x_hi), (y_lo, y_hi) = _edges(x), _edges(y)
+    _vertices_within(polygons, (x_lo, x_hi, y_lo, y_hi), name, "the grid's domain")
+
+
+def _vertices_within(polygons: Sequence[Polygon], box: tuple[float, float, float, float],
+                     name: str, what: str) -> None:
+    """One-line ValueError naming the first vertex outside ``box`` (x_min, x_max,
+    y_min, y_max) [m], ``what`` the box is (the grid's domain, the DEM)."""
+    x_lo, x_hi, y_lo, y_hi = box
     for polygon in polygons:
         for ring in _rings(polygon, name):
             out = ((ring[:, 0] < x_lo) | (ring[:, 0] > x_hi) | (ring[:, 1] < y_lo)
                    | (ring[:, 1] > y_hi))
             if out.any():
                 vx, vy = ring[np.argmax(out)]
-                raise ValueError(f"{name}: the vertex ({vx:g}, {vy:g}) m lies outside the "
-                                 f"grid's domain: each must lie in x [{x_lo:g}, {x_hi:g}] m "
-                                 f"x y [{y_lo:g}, {y_hi:g}] m")
+                raise ValueError(f"{name}: the vertex ({vx:g}, {vy:g}) m lies outside "
+                                 f"{what}: each must lie in x [{x_lo:g}, {x_hi:g}] m x y "
+                                 f"[{y_lo:g}, {y_hi:g}] m")
 
 
 def case_polygon(vertices: Sequence[Sequence[float]], x_start: float = 0.0,
@@ -128,16 +136,7 @@ def check_release_on_raster(polygons: Sequence[Polygon], raster: Raster,
                             name: str = "release") -> None:
     """One-line ValueError when a vertex of the release lies outside the raster's
     extent or a raster cell whose centre is inside the release has no data."""
-    x_min, x_max, y_min, y_max = raster.bounds
-    for polygon in polygons:
-        for ring in _rings(polygon, name):
-            out = ((ring[:, 0] < x_min) | (ring[:, 0] > x_max) | (ring[:, 1] < y_min)
-                   | (ring[:, 1] > y_max))
-            if out.any():
-                vx, vy = ring[np.argmax(out)]
-                raise ValueError(f"{name}: the vertex ({vx:g}, {vy:g}) m lies outside the "
-                                 f"DEM: each must lie in x [{x_min:g}, {x_max:g}] m x y "
-                                 f"[{y_min:g}, {y_max:g}] m")
+    _vertices_within(polygons, raster.bounds, name, "the DEM")
     X, Y = np.meshgrid(raster.x_centres, raster.y_centres, indexing="xy")  # noqa: N806
     on_nodata = inside_release(polygons, X, Y, name) & raster.nodata
     if on_nodata.any():
