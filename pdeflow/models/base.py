@@ -24,7 +24,7 @@ from pde import CartesianGrid, FieldCollection
 from pde.pdes.base import PDEBase
 
 from ..numerics import layout as L
-from ..numerics.geometry import Metric, geometry_of, metric_of
+from ..numerics.geometry import Metric, bed_corners, geometry_of, metric_of
 from ..numerics.scheme import Scheme
 from ..numerics.state import DRY_TOLERANCE
 from .cells import boundaries, cell_name, flat_hook, flat_rate, layer_fields
@@ -215,7 +215,7 @@ class GranularPDE(PDEBase):
                  bc: Sequence[str] = ("wall", "open"), scheme: Scheme | str | None = None,
                  flux: str | None = None, reconstruction: str | None = None,
                  limiter: str | None = None, splitting: str | None = None,
-                 **kwargs: Any):
+                 bed: Any = None, **kwargs: Any):
         """
         Args:
             parameters: the model's parameters (a :attr:`parameters_class` or a dict of
@@ -232,6 +232,12 @@ class GranularPDE(PDEBase):
                 'first-order' (the paper's) or 'muscl' (second order in space,
                 advected with SSP-RK2); limiter of 'muscl' 'minmod' or 'mc'; splitting
                 'lie' (the paper's) or 'strang'.
+            bed: on a 2D grid, a bed z_b(x, y) to flow over: its elevation [m] at the
+                grid's cell corners, an (nx + 1, ny + 1) array, or a function of the
+                corners' x, y [m] (:func:`~pdeflow.numerics.geometry.bed_corners`);
+                depths are then vertical and the slope is the bed's (theta_deg and
+                slope_azimuth_deg 0, reconstruction 'first-order'; docs/terrain.md).
+                None: the plane of theta_deg.
             **kwargs: individual parameters overriding ``parameters``.
         """
         super().__init__()
@@ -245,6 +251,25 @@ class GranularPDE(PDEBase):
             parameters = parameters.to_dict()
         self.parameters = self.parameters_class.from_dict({**(parameters or {}),
                                                            **kwargs})
+        self.bed = bed
+        """the bed under a 2D grid (corners' elevations [m] or a function), or None"""
+        if bed is not None:
+            self._check_bed()
+
+    def _check_bed(self) -> None:
+        """ValueError unless this model and scheme can flow over a bed."""
+        kernels_2d = self.system.kernels_for(self.parameters, 2) \
+            if getattr(self.system, "kernels_2d", None) is not None else None
+        if kernels_2d is None or kernels_2d.terrain is None:
+            raise ValueError(f"bed: the {self.system.label} model does not flow over a "
+                             "bed yet; only the single layer does")
+        for name in ("theta_deg", "slope_azimuth_deg"):
+            if getattr(self.parameters, name) != 0.0:
+                raise ValueError(f"{name} must be 0 over a bed (the bed gives the slope), "
+                                 f"got {getattr(self.parameters, name):g}")
+        if self.scheme.reconstruction != "first-order":
+            raise ValueError("reconstruction must be 'first-order' over a bed, got "
+                             f"{self.scheme.reconstruction!r}")
 
     def __repr__(self) -> str:
         return (f"{type(self).__name__}({self.parameters}, bc={self.bc}, "
@@ -289,6 +314,8 @@ class GranularPDE(PDEBase):
     def _check_geometry(self, geometry: str) -> str:
         """``geometry``, or ValueError: on an axisymmetric grid the left boundary is the
         axis and must be 'wall'; boundaries per axis and a slope azimuth need a 2D grid."""
+        if self.bed is not None and geometry != "planar-2d":
+            raise ValueError(f"bed needs a 2D CartesianGrid, got a {geometry} grid")
         if len(self.bc_axes) == 2 and geometry != "planar-2d":
             raise ValueError(f"bc gives a pair per axis, {self.bc!r}: a {geometry} grid "
                              "takes one pair (left, right)")
@@ -307,7 +334,8 @@ class GranularPDE(PDEBase):
         last = self.__dict__.get("_metric")
         if last is None or last[0] is not grid:
             self.geometry(grid)  # a 1D model refuses a 2D grid
-            self._metric = (grid, metric_of(grid))
+            bed = None if self.bed is None else bed_corners(grid, self.bed)
+            self._metric = (grid, metric_of(grid, bed))
         return self._metric[1]
 
     def make_state(self, grid: CartesianGrid, **profiles: np.ndarray) -> FieldCollection:
@@ -315,6 +343,8 @@ class GranularPDE(PDEBase):
         :meth:`~pdeflow.systems.EquationSystem.profile_names_on` the grid, e.g. h1, u1,
         h2, u2; on a 2D grid h, u, v: arrays of the grid's shape [m, m/s])."""
         axes = 2 if self.geometry(grid) == "planar-2d" else 1
+        if self.bed is not None:
+            self.metric(grid)  # the bed on this grid, checked before any work
         return layer_fields(self.system, grid, axes, type(self).__name__, profiles)
 
     def check_state(self, state: FieldCollection) -> Metric:

@@ -266,13 +266,15 @@ def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, ax
 
 
 def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, axis: int,
-                   axisymmetric: bool, lines: bool) -> Any:
+                   axisymmetric: bool, lines: bool, terrain: bool = False) -> Any:
     """One axis' part of the advection stage as a Python closure (inlined):
     ``along(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count, inv_dx, bc_lo,
     bc_hi, g, r, dry, per_row) -> smax``: MUSCL's face values along the axis in cells
     ``r_lo..r_hi``, the axis' faces next to ``lo..hi`` (:func:`_faces_function`), the
     MUSCL cell jump along the axis; with ``lines`` (a 2D grid of ``per_row`` cells a
-    row) ``lo, hi`` and ``r_lo, r_hi`` are boxes (:mod:`pdeflow.numerics.boxes`)."""
+    row) ``lo, hi`` and ``r_lo, r_hi`` are boxes (:mod:`pdeflow.numerics.boxes`).
+    ``terrain``: over a bed, the model's face values and cell term over it
+    (:attr:`ModelKernels.terrain`) in place of MUSCL's."""
     check_flux(model, flux)
     rows = model.axis_rows(axis)
     width = model.layer_rows
@@ -282,6 +284,7 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
     # the MUSCL kernels, only where they are called (see compiled.ready)
     reconstruct = reconstruction(width, normal) if muscl else None
     cell_jump = model.cell_jump if muscl else None
+    bed_faces, bed_jump = model.terrain if terrain else (None, None)
 
     def along(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count, inv_dx, bc_lo,
               bc_hi, g, r, dry, per_row):
@@ -290,6 +293,11 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
             for x in prange(x0, x1 + 1):  # a 2D grid's box row by row, on threads
                 reconstruct(q, work, x * per_row + y0, x * per_row + y1, stride, count,
                             bc_lo, bc_hi, dry, limiter)
+            qm = work[0]
+            qp = work[1]
+        elif terrain:
+            for x in prange(x0, x1 + 1):
+                bed_faces(q, work, metric, x * per_row + y0, x * per_row + y1, axis, dry)
             qm = work[0]
             qp = work[1]
         else:
@@ -305,6 +313,10 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
             for x in prange(x0, x1 + 1):
                 cell_jump(qm, qp, rate, x * per_row + y0, x * per_row + y1, inv_dx, g, r,
                           dry, axis)
+        elif terrain:
+            for x in prange(x0, x1 + 1):
+                bed_jump(qm, qp, rate, metric, x * per_row + y0, x * per_row + y1, inv_dx,
+                         g, dry, axis)
         return smax
 
     return along
@@ -367,12 +379,16 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
     """
     muscl = order == 2
     axisymmetric = geometry == L.GEOMETRY_AXISYMMETRIC
-    two_d = geometry == L.GEOMETRY_PLANAR_2D
+    terrain = geometry == L.GEOMETRY_TERRAIN_2D
+    two_d = geometry == L.GEOMETRY_PLANAR_2D or terrain
+    if terrain and (muscl or model.terrain is None):
+        raise ValueError("over a bed the reconstruction must be 'first-order' and the "
+                         "model must have kernels over a bed (the single layer)")
     width = model.layer_rows
     along_x = njit(inline="always")(_axis_function(model, flux, muscl, limiter, 0,
-                                                   axisymmetric, two_d))
+                                                   axisymmetric, two_d, terrain))
     along_y = njit(inline="always")(_axis_function(model, flux, muscl, limiter, 1, False,
-                                                   True)) if two_d else None
+                                                   True, terrain)) if two_d else None
     area = (area_change_muscl if muscl else area_change) if axisymmetric else None
 
     def advect(q, rate, work, dx, metric, bc_left, bc_right, g, r, dry, start, stop):

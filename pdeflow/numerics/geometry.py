@@ -57,6 +57,9 @@ class Metric:
     """cells along each axis (default: one axis of ``volumes.size`` cells)"""
     spacing: tuple[float, ...] = ()
     """cell width along each axis [m] (default: ``(dx,)``)"""
+    bed: np.ndarray | None = None
+    """a 2D grid over a bed z_b(x, y): its elevation [m] at the cells' corners,
+    (nx + 1, ny + 1) (:func:`bed_corners`); None: no bed"""
 
     @property
     def axes(self) -> list[tuple[int, int, float]]:
@@ -69,15 +72,21 @@ class Metric:
     @property
     def code(self) -> int:
         """The geometry's code for the kernels (layout.GEOMETRY_*)."""
+        if self.bed is not None:
+            return L.GEOMETRY_TERRAIN_2D
         return L.GRID_GEOMETRIES[self.geometry]
 
     def array(self) -> np.ndarray:
         """The rows layout.M_* as one C-contiguous array of shape (N_METRIC, n + 1) (at
         least 3 per axis wide): on a 1D grid per face its weights in the cells left and
-        right of it and per cell its area change; the axes (row M_AXES)."""
+        right of it and per cell its area change; the axes (row M_AXES); over a bed
+        the rows M_BED (:func:`face_beds`)."""
         n = self.volumes.size
         axes = self.axes
-        out = np.zeros((L.N_METRIC, max(n + 1, 3 * len(axes))))
+        rows = L.N_METRIC + (L.N_BED if self.bed is not None else 0)
+        out = np.zeros((rows, max(n + 1, 3 * len(axes))))
+        if self.bed is not None:
+            out[L.M_BED:L.M_BED + L.N_BED, :n] = face_beds(self.bed)
         if len(axes) == 1:
             out[L.M_LEFT, 1:n + 1] = self.areas[1:] / self.volumes  # face i - 1/2 into i - 1
             out[L.M_RIGHT, :n] = self.areas[:-1] / self.volumes
@@ -121,17 +130,21 @@ def geometry_of(grid: Any, two_d: bool = False) -> str:
     return "planar" if grid.num_axes == 1 else "planar-2d"
 
 
-def metric_of(grid: Any) -> Metric:
+def metric_of(grid: Any, bed: np.ndarray | None = None) -> Metric:
     """The metric of a grid that :func:`geometry_of` accepts, a 2D ``CartesianGrid``
-    included (a model without 2D kernels refuses it before: ``GranularPDE.geometry``)."""
+    included (a model without 2D kernels refuses it before: ``GranularPDE.geometry``);
+    ``bed``: the corners' elevations of a bed under a 2D grid (:func:`bed_corners`)."""
     geometry = geometry_of(grid, two_d=True)
+    if bed is not None and geometry != "planar-2d":
+        raise ValueError(f"bed needs a 2D CartesianGrid, got a {geometry} grid")
     if geometry == "planar-2d":
         shape = tuple(int(n) for n in grid.shape)
         spacing = tuple(float(d) for d in grid.discretization)
         x0, x1 = grid.axes_bounds[0]
         return Metric(geometry, COORDINATES[geometry], spacing[0],
                       np.linspace(x0, x1, shape[0] + 1), np.ones(shape[0] + 1),
-                      np.full(shape[0] * shape[1], spacing[0] * spacing[1]), shape, spacing)
+                      np.full(shape[0] * shape[1], spacing[0] * spacing[1]), shape, spacing,
+                      bed)
     if geometry == "axisymmetric":
         r1 = grid.axes_bounds[0][1]
         n = grid.shape[0]
@@ -145,6 +158,47 @@ def metric_of(grid: Any) -> Metric:
     return Metric(geometry, COORDINATES[geometry], dx, np.linspace(x0, x1, n + 1),
                   np.ones(n + 1),
                   np.full(n, dx))
+
+
+def corner_coordinates(grid: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The x (nx + 1,) and y (ny + 1,) [m] of the cell corners of a 2D grid."""
+    (x0, x1), (y0, y1) = grid.axes_bounds
+    nx, ny = (int(n) for n in grid.shape)
+    return np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1)
+
+
+def bed_corners(grid: Any, bed: Any) -> np.ndarray:
+    """The bed's elevations [m] at the corners of the 2D ``grid``'s cells, (nx + 1,
+    ny + 1): ``bed`` is that array, or a function z_b(x, y) [m] of the corners'
+    coordinates (broadcast arrays, the grid's own coordinates [m]); ValueError naming
+    ``bed`` for a wrong shape or a value that is not finite."""
+    xs, ys = corner_coordinates(grid)
+    if callable(bed):
+        bed = bed(*np.meshgrid(xs, ys, indexing="ij"))
+    z = np.array(bed, dtype=float)
+    if z.shape != (xs.size, ys.size):
+        raise ValueError(f"bed must give the elevation at the grid's {xs.size} x {ys.size}"
+                         f" cell corners, got shape {z.shape}")
+    bad = np.argwhere(~np.isfinite(z))
+    if bad.size:
+        i, j = bad[0]
+        raise ValueError(f"bed must be finite at every corner, got {z[i, j]} at x = "
+                         f"{xs[i]:g} m, y = {ys[j]:g} m and {len(bad) - 1} more")
+    return np.ascontiguousarray(z)
+
+
+def face_beds(corners: np.ndarray) -> np.ndarray:
+    r"""The rows layout.M_BED of a 2D grid over a bed, (4, nx ny) [m]: per cell (C
+    order) the bed at the middle of its faces x-low, x-high, y-low, y-high, each the mean
+    of the face's two corners. The bed is continuous and linear along every face (the
+    piecewise-bilinear interpolant of the corners), so two neighbours see the same bed
+    at their common face and the faces' Riemann problems have no bed step; the cell's
+    bed, the mean of its four corners, is the mean of its two face values along either
+    axis (Kurganov & Petrova 2007)."""
+    zx = 0.5 * (corners[:, :-1] + corners[:, 1:])  # x-faces (nx + 1, ny)
+    zy = 0.5 * (corners[:-1, :] + corners[1:, :])  # y-faces (nx, ny + 1)
+    return np.stack([zx[:-1].ravel(), zx[1:].ravel(), zy[:, :-1].ravel(),
+                     zy[:, 1:].ravel()])
 
 
 @cached

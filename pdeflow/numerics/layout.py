@@ -92,6 +92,7 @@ GEOMETRY_PLANAR = 0  #: a 1D Cartesian grid: the planar slope, per unit width
 GEOMETRY_AXISYMMETRIC = 1  #: py-pde's PolarSymGrid: radial flow on a horizontal plane
 GEOMETRIES = {"planar": GEOMETRY_PLANAR, "axisymmetric": GEOMETRY_AXISYMMETRIC}
 GEOMETRY_PLANAR_2D = 2  #: a 2D Cartesian grid (the face loop only: no case file selects it yet)
+GEOMETRY_TERRAIN_2D = 3  #: a 2D Cartesian grid over a bed z_b(x, y) (metric rows M_BED)
 GRID_GEOMETRIES = {**GEOMETRIES, "planar-2d": GEOMETRY_PLANAR_2D}
 """every geometry the kernels know (:data:`GEOMETRIES`: those a case file may name)"""
 M_LEFT = 0  #: metric row: A_{i-1/2} / V_{i-1}, face i - 1/2's weight in cell i - 1 [1/m]
@@ -100,3 +101,6 @@ M_AREA_CHANGE = 2  #: metric row: (A_{i+1/2} - A_{i-1/2}) / V_i [1/m] (n entries
 M_AXES = 3  #: metric row: per axis a, [3a] its stride in the flattened cell index, [3a + 1]
 #: its number of cells, [3a + 2] its cell width [m] (read by the 2D kernels only)
 N_METRIC = 4
+M_BED = N_METRIC  #: over a bed, 4 metric rows per cell: the bed [m] at the middle of its
+#: low and high faces along x, then along y (pdeflow.numerics.geometry.face_beds)
+N_BED = 4

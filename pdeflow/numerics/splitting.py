@@ -250,7 +250,7 @@ class Stepper:
                  strang: bool, geometry: int):
         self.model = model
         self.ifcp = flux == L.FLUX_IFCP
-        self.two_d = geometry == L.GEOMETRY_PLANAR_2D
+        self.two_d = geometry in (L.GEOMETRY_PLANAR_2D, L.GEOMETRY_TERRAIN_2D)
         self.loop = stepping_kernel(order, strang, self.ifcp, model.layer_rows, self.two_d)
         self.advect = advection_kernel(model, flux, order, limiter, geometry)
         # on a 2D grid the stage and the predictor take a box, its rows on threads

@@ -175,6 +175,8 @@ class FVSplitSolver(SolverBase):
         """Return ``stepper(state, t_start, t_end) -> t`` advancing with CFL steps."""
         pde: GranularPDE = self.pde
         metric = pde.check_state(state)  # the grid's geometry, derived here once
+        if metric.bed is not None:  # face depths up to 2 h (pdeflow.models.*.terrain)
+            check_range("cfl (over a bed)", self.cfl, 0, 0.5, low_open=True)
         dx, M = metric.dx, metric.array()
         hook, diag = self._hook(state)
         self.info.update(dt=None, steps=0, dt_adaptive=True, stochastic=False,

@@ -17,6 +17,7 @@ from .flux import cell_jump, face, fluctuations
 from .rates import fluctuations_np, source_rate, source_rate_np
 from .sources import stage_kernels
 from .sources_2d import fold_single_2d, source_rate_2d, stage_kernels_2d
+from .terrain import bed_jump, reconstruct_bed
 
 
 def _constants(P: np.ndarray) -> tuple[float, float, float]:
@@ -53,11 +54,13 @@ def _no_numpy_twin_2d(*args: object) -> None:
 def kernels_2d(law: BasalLaw | None = None) -> ModelKernels:
     """:func:`kernels` on a 2D grid: state (h, hu, hv), the faces of both axes in their
     normal frames (:mod:`.two_d`), gravity along x and the vector basal friction of
-    ``law`` (None: Coulomb's; :mod:`.sources_2d`). No numpy twins (NotImplementedError)."""
+    ``law`` (None: Coulomb's; :mod:`.sources_2d`), and over a bed :mod:`.terrain`. No
+    numpy twins (NotImplementedError)."""
     sources, source_stage, predictor = stage_kernels_2d(law)
     return ModelKernels(
         fields=3, face=two_d.face, fluctuations=two_d.fluctuations,
         cell_jump=two_d.cell_jump, sources=sources, source_stage=source_stage,
         predictor=predictor, mol_sources=source_rate_2d(law),
         numpy_advection=_no_numpy_twin_2d, numpy_sources=_no_numpy_twin_2d,
-        constants=_constants, fold=fold_single_2d, layer_rows=3, rows=two_d.ROWS)
+        constants=_constants, fold=fold_single_2d, terrain=(reconstruct_bed, bed_jump),
+        layer_rows=3, rows=two_d.ROWS)
