@@ -13,7 +13,6 @@ only assembles the kernels into what py-pde expects:
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, fields
@@ -27,36 +26,10 @@ from ..numerics import layout as L
 from ..numerics.geometry import Metric, bed_corners, geometry_of, metric_of
 from ..numerics.scheme import Scheme
 from ..numerics.state import DRY_TOLERANCE
+from .bed import check_bed
 from .cells import boundaries, cell_name, flat_hook, flat_rate, layer_fields
 
 BC_NAMES = L.BOUNDARIES
-
-
-@functools.cache
-def field_units(cls: type) -> dict[str, str]:
-    """The unit of each field of a parameter dataclass, as its attribute docstring gives
-    it: the first bracket without a comma ('[deg]', '[m/s]', '[-]'; a range such as
-    '[0, 1)' is no unit); fields without one are left out."""
-    import ast
-    import inspect
-    import re
-
-    out: dict[str, str] = {}
-    for klass in reversed(cls.__mro__):
-        try:
-            tree = ast.parse(inspect.getsource(klass).lstrip())
-        except (OSError, TypeError, SyntaxError):
-            continue  # builtins, or no source
-        body = tree.body[0].body if tree.body and isinstance(tree.body[0], ast.ClassDef) \
-            else []
-        for stmt, doc in zip(body, body[1:], strict=False):
-            if (isinstance(stmt, ast.AnnAssign) and isinstance(stmt.target, ast.Name)
-                    and isinstance(doc, ast.Expr) and isinstance(doc.value, ast.Constant)
-                    and isinstance(doc.value.value, str)):
-                unit = re.search(r"\[([^\],]+)\]", doc.value.value)
-                if unit:
-                    out[stmt.target.id] = unit.group(1).strip()
-    return out
 
 
 def check_range(name: str, value: Any, low: float, high: float, *,
@@ -232,12 +205,8 @@ class GranularPDE(PDEBase):
                 'first-order' (the paper's) or 'muscl' (second order in space,
                 advected with SSP-RK2); limiter of 'muscl' 'minmod' or 'mc'; splitting
                 'lie' (the paper's) or 'strang'.
-            bed: on a 2D grid, a bed z_b(x, y) to flow over: its elevation [m] at the
-                grid's cell corners, an (nx + 1, ny + 1) array, or a function of the
-                corners' x, y [m] (:func:`~pdeflow.numerics.geometry.bed_corners`);
-                depths are then vertical and the slope is the bed's (theta_deg and
-                slope_azimuth_deg 0, reconstruction 'first-order'; docs/terrain.md).
-                None: the plane of theta_deg.
+            bed: a bed z_b(x, y) under a 2D grid to flow over (:mod:`.bed`); None:
+                the plane of theta_deg.
             **kwargs: individual parameters overriding ``parameters``.
         """
         super().__init__()
@@ -251,25 +220,8 @@ class GranularPDE(PDEBase):
             parameters = parameters.to_dict()
         self.parameters = self.parameters_class.from_dict({**(parameters or {}),
                                                            **kwargs})
-        self.bed = bed
+        self.bed = check_bed(self, bed)
         """the bed under a 2D grid (corners' elevations [m] or a function), or None"""
-        if bed is not None:
-            self._check_bed()
-
-    def _check_bed(self) -> None:
-        """ValueError unless this model and scheme can flow over a bed."""
-        kernels_2d = self.system.kernels_for(self.parameters, 2) \
-            if getattr(self.system, "kernels_2d", None) is not None else None
-        if kernels_2d is None or kernels_2d.terrain is None:
-            raise ValueError(f"bed: the {self.system.label} model does not flow over a "
-                             "bed yet; only the single layer does")
-        for name in ("theta_deg", "slope_azimuth_deg"):
-            if getattr(self.parameters, name) != 0.0:
-                raise ValueError(f"{name} must be 0 over a bed (the bed gives the slope), "
-                                 f"got {getattr(self.parameters, name):g}")
-        if self.scheme.reconstruction != "first-order":
-            raise ValueError("reconstruction must be 'first-order' over a bed, got "
-                             f"{self.scheme.reconstruction!r}")
 
     def __repr__(self) -> str:
         return (f"{type(self).__name__}({self.parameters}, bc={self.bc}, "
@@ -314,8 +266,6 @@ class GranularPDE(PDEBase):
     def _check_geometry(self, geometry: str) -> str:
         """``geometry``, or ValueError: on an axisymmetric grid the left boundary is the
         axis and must be 'wall'; boundaries per axis and a slope azimuth need a 2D grid."""
-        if self.bed is not None and geometry != "planar-2d":
-            raise ValueError(f"bed needs a 2D CartesianGrid, got a {geometry} grid")
         if len(self.bc_axes) == 2 and geometry != "planar-2d":
             raise ValueError(f"bc gives a pair per axis, {self.bc!r}: a {geometry} grid "
                              "takes one pair (left, right)")
@@ -334,8 +284,7 @@ class GranularPDE(PDEBase):
         last = self.__dict__.get("_metric")
         if last is None or last[0] is not grid:
             self.geometry(grid)  # a 1D model refuses a 2D grid
-            bed = None if self.bed is None else bed_corners(grid, self.bed)
-            self._metric = (grid, metric_of(grid, bed))
+            self._metric = (grid, metric_of(grid, bed_corners(grid, self.bed)))
         return self._metric[1]
 
     def make_state(self, grid: CartesianGrid, **profiles: np.ndarray) -> FieldCollection:

@@ -167,11 +167,16 @@ def corner_coordinates(grid: Any) -> tuple[np.ndarray, np.ndarray]:
     return np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1)
 
 
-def bed_corners(grid: Any, bed: Any) -> np.ndarray:
+def bed_corners(grid: Any, bed: Any) -> np.ndarray | None:
     """The bed's elevations [m] at the corners of the 2D ``grid``'s cells, (nx + 1,
     ny + 1): ``bed`` is that array, or a function z_b(x, y) [m] of the corners'
-    coordinates (broadcast arrays, the grid's own coordinates [m]); ValueError naming
-    ``bed`` for a wrong shape or a value that is not finite."""
+    coordinates (broadcast arrays, the grid's own coordinates [m]); None for None.
+    ValueError naming ``bed`` for a grid that is not 2D, a wrong shape or a value that
+    is not finite."""
+    if bed is None:
+        return None
+    if geometry_of(grid, two_d=True) != "planar-2d":
+        raise ValueError(f"bed needs a 2D CartesianGrid, got a {geometry_of(grid)} grid")
     xs, ys = corner_coordinates(grid)
     if callable(bed):
         bed = bed(*np.meshgrid(xs, ys, indexing="ij"))

@@ -13,7 +13,7 @@ import numpy as np
 
 from .. import systems
 from ..io import atomic_path
-from ..models.base import field_units
+from ..models.units import field_units
 from ..simulate import summary_unit
 from .designs import sobol_indices
 from .results import ResultsTable
