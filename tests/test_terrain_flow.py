@@ -190,3 +190,24 @@ def test_a_bed_is_refused_with_one_line_where_it_cannot_run():
     pde = pdeflow.SingleLayerGranular(bed=bed, bc=WALLS)
     with pytest.raises(ValueError, match=r"^cfl \(over a bed\) must lie in \(0, 0.5\]"):
         pde.solve(at_rest(pde, grid, h), 1.0, solver="fv-split", tracker=None, cfl=0.8)
+
+
+def test_the_numbers_docs_terrain_quotes_come_from_its_script():
+    """docs/terrain.md's energy-line row at dx = 20 m and its fully wet lake's rate are
+    what ``python benchmarks/terrain_checks.py --dx 20`` prints (to its digits)."""
+    import re
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).parents[1]
+    out = subprocess.run([sys.executable, str(root / "benchmarks" / "terrain_checks.py"),
+                          "--dx", "20"], capture_output=True, text=True, check=True,
+                         cwd=root).stdout
+    doc = (root / "docs" / "terrain.md").read_text(encoding="utf-8")
+    angle = re.search(r"^\s+20\s+([\d.]+)", out, re.M).group(1)
+    assert f"| 20 | {angle} |" in doc
+    rate = float(re.search(r"100% wet\): max \|rate\| = (\S+)", out).group(1))
+    assert rate < 1e-12
+    shore = re.search(r"shore .* max \|rate\| = (\S+)", out).group(1)
+    assert f"is {shore} m^2/s^2" in doc
