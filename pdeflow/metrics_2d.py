@@ -55,6 +55,26 @@ def max_speed(data: np.ndarray, dry: float) -> float:
     return out
 
 
+PEAK_FIELDS = ("depth", "speed", "pressure")
+"""the rows of :func:`peak_fields`: depth [m], speed [m/s], pressure [kPa]"""
+
+
+def peak_fields(data: np.ndarray, dry: float, density: float) -> np.ndarray:
+    """Per cell, (total depth [m], largest speed of a layer deeper than ``dry`` [m]
+    [m/s], density [kg/m^3] times that speed squared [kPa]), shape (3, nx, ny): the
+    fields whose peaks over a run a hazard map shows (AvaFrame's pft, pfv, ppr)."""
+    out = np.zeros((3, *data.shape[1:]))
+    for k in range(0, data.shape[0], ROWS_PER_LAYER):
+        h = data[k]
+        out[0] += np.maximum(h, 0.0)
+        wet = h > dry
+        speed = np.zeros_like(h)
+        speed[wet] = np.hypot(data[k + 1][wet], data[k + 2][wet]) / h[wet]
+        np.maximum(out[1], speed, out=out[1])
+    out[2] = density * out[1] ** 2 / 1000.0
+    return out
+
+
 def front_x(x: np.ndarray, depth: np.ndarray, threshold: float,
             dx: float) -> float | None:
     """The largest x [m] reached: the downstream face of the last column of cells

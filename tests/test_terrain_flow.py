@@ -211,3 +211,35 @@ def test_the_numbers_docs_terrain_quotes_come_from_its_script():
     assert rate < 1e-12
     shore = re.search(r"shore .* max \|rate\| = (\S+)", out).group(1)
     assert f"is {shore} m^2/s^2" in doc
+
+
+def test_peak_fields_over_a_bed_are_sampled_rasters_that_change_nothing(tmp_path):
+    """A release on the bumpy plane with a PeakTracker of the peak fields: the run's
+    numbers are those without it (bit for bit); the peak depth is at least the initial
+    and the final depth everywhere, the peak pressure is 200 kg/m^3 times the peak
+    speed squared [kPa], the flow reached beyond the release; the rasters read back give
+    the fields, north up, each cell's centre at the grid's."""
+    from pdeflow.metrics_2d import peak_fields
+    from pdeflow.terrain import peak_rasters, read_raster
+    from pdeflow.trackers.peaks import PeakTracker
+
+    grid = CartesianGrid([[1000, 1200], [500, 600]], [40, 20])
+    xx, yy = np.meshgrid(*grid.axes_coords, indexing="ij")
+    column = np.where(np.hypot(xx - 1050, yy - 550) < 15, 6.0, 0.0)
+    pde = pdeflow.SingleLayerGranular(phi_b_deg=28, bc=WALLS,
+                                      bed=inclined_bumpy(grid, 30.0))
+    state = at_rest(pde, grid, column)
+    peaks = PeakTracker(0.5, lambda data: peak_fields(data, 1e-6, 200.0))
+    watched = pde.solve(state, 20.0, solver="fv-split", tracker=[peaks])
+    alone = pde.solve(state, 20.0, solver="fv-split", tracker=None)
+    np.testing.assert_array_equal(watched.data, alone.data)
+    depth, speed, pressure = peaks.peak
+    assert np.all(depth >= column) and np.all(depth >= alone.data[0])
+    np.testing.assert_allclose(pressure, 200.0 * speed ** 2 / 1000.0, rtol=1e-15)
+    assert np.count_nonzero(speed > 0.1) > np.count_nonzero(column)
+    paths = peak_rasters(peaks.peak, 1000.0, 500.0, 5.0, tmp_path)
+    assert [p.name for p in paths] == ["peak_depth.asc", "peak_speed.asc",
+                                       "peak_pressure.asc"]
+    back = read_raster(paths[0])
+    assert (back.x_corner, back.y_corner, back.cellsize) == (1000.0, 500.0, 5.0)
+    np.testing.assert_array_equal(back.values[::-1].T, depth)

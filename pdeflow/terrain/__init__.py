@@ -11,12 +11,14 @@ any work.
 * :mod:`.release`: release areas as polygons; :mod:`.shapefiles`: polygons from a
   shapefile (pyshp, the same extra); :mod:`.thickness`: the release thickness, given
   vertically or normal to the slope, as a vertical depth;
-* :mod:`.topographies`: AvaFrame's idealised topographies z(x, y) from their equations.
+* :mod:`.topographies`: AvaFrame's idealised topographies z(x, y) from their equations;
+* :mod:`.peaks`: a run's peak fields written as georeferenced rasters.
 
-The flow over terrain is not built yet: nothing here is read by a case file or a run.
+The flow over a bed itself is the models' (``GranularPDE(bed=...)``, docs/terrain.md).
 """
 
 from .asc import read_asc, write_asc
+from .peaks import peak_rasters
 from .raster import Raster
 from .rasters import read_raster, write_raster
 from .release import case_polygon, release_mask, same_crs
@@ -26,4 +28,4 @@ from .thickness import vertical_thickness
 
 __all__ = ["Raster", "read_asc", "write_asc", "read_raster", "write_raster",
            "bed_on_grid", "cell_centres", "case_polygon", "release_mask", "same_crs",
-           "shapefile_crs", "shapefile_polygons", "vertical_thickness"]
+           "shapefile_crs", "shapefile_polygons", "vertical_thickness", "peak_rasters"]

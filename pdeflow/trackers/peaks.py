@@ -1,5 +1,5 @@
 """The largest value of a measure of the state over a run, sampled: :class:`PeakTracker`
-(a 2D summary's largest speed).
+(a 2D summary's largest speed; per cell, the peak fields of a run over a bed).
 
 The fastest moment of a collapse lies inside the run (the final deposit is at rest),
 so the summary's ``max_speed`` needs a look at the run: this tracker reads the state
@@ -28,7 +28,8 @@ from .own_times import AtOwnTimes, OwnTimes
 
 class PeakTracker(AtOwnTimes, TrackerBase):
     """The largest ``measure(data)`` (:attr:`peak`, 0 before any) over the states'
-    data seen every ``interval`` [s] and the final one."""
+    data seen every ``interval`` [s] and the final one; a measure that gives an array
+    is maximised element by element (peak fields: :func:`pdeflow.metrics_2d.peak_fields`)."""
 
     def __init__(self, interval: float, measure: Callable[[np.ndarray], float]):
         super().__init__(interrupts=OwnTimes(interval))
@@ -43,7 +44,9 @@ class PeakTracker(AtOwnTimes, TrackerBase):
     def handle(self, field: Any, t: float) -> None:
         if self.handed_early(t):  # at another tracker's time: not sampled
             return
-        self.peak = max(self.peak, self.measure(field.data))
+        value = self.measure(field.data)
+        self.peak = np.maximum(self.peak, value) if np.ndim(value) else \
+            max(self.peak, value)
         self.last_time = t
 
     def finalize(self, info: InfoDict | None = None) -> None:
