@@ -116,3 +116,21 @@ def _refuse(raster: Raster, x: np.ndarray, y: np.ndarray, covered: np.ndarray,
         f"{Y[bad].max():g}] m, lie outside its cell centres' span (x [{xc[0]:g}, "
         f"{xc[-1]:g}] m x y [{yc[-1]:g}, {yc[0]:g}] m) or next to its no-data cells: "
         "move or shrink the grid (x_start, y_start, length, width) or fill the raster")
+
+
+def filled_nearest(raster: Raster) -> tuple[Raster, np.ndarray]:
+    """``raster`` with each no-data cell given the value of the nearest cell with data
+    (Euclidean, ties by scipy's order), and the mask of the cells so filled: a DEM
+    clipped to the outline of a path becomes a rectangle a grid can cover. The fill is
+    a flat-ish continuation of the edge, not terrain: a flow that reaches it has left
+    the DEM (the caller reports the mass there)."""
+    from scipy.ndimage import distance_transform_edt
+
+    if raster.nodata.all():
+        raise ValueError("the raster has no cell with data to fill from")
+    index = distance_transform_edt(raster.nodata, return_distances=False,
+                                   return_indices=True)
+    values = raster.values[tuple(index)]
+    return (Raster(values, raster.x_corner, raster.y_corner, raster.cellsize,
+                   np.zeros(values.shape, bool), raster.crs, raster.nodata_value),
+            raster.nodata.copy())

@@ -1,0 +1,136 @@
+"""A real avalanche path from AvaFrame's public repository, run to rest by pdeflow's
+single layer over its DEM (issue 37's documented example and its timing).
+
+    python benchmarks/real_path.py --avaframe PATH [--path avaHit] [--out DIR]
+
+PATH is a checkout of https://github.com/avaframe/AvaFrame (nothing of it is copied
+here): the DEM ``avaframe/data/<path>/Inputs/<path>.asc`` and the release
+``Inputs/REL/*.shp`` are read with pdeflow's readers (shapefiles: the ``terrain``
+extra). The grid's cell corners are the DEM's cell centres (the bed there is the DEM's
+value), its cells the DEM's size; no-data cells around the path's outline are filled
+with the nearest value (:func:`pdeflow.terrain.resample.filled_nearest`) and the mass
+that ends on them is reported. The release thickness (the shapefile's 1 m, slope-normal
+as AvaFrame measures it) becomes a vertical depth; Coulomb friction ``--phi`` [deg];
+open boundaries; fv-split on ``--threads`` threads until all is at rest (or
+``--t-end``). A first run of one step compiles; the timed run is the second. Prints the
+grid, the wall time, steps, the time at rest, the mass centre's travel angle, the
+affected area (peak depth > 0.1 m) and the largest peaks; with ``--out`` writes the
+peak rasters (.asc, the DEM's CRS) and the peak depth over the hillshade.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+from pde import CartesianGrid
+
+import pdeflow
+from pdeflow.metrics_2d import peak_fields
+from pdeflow.terrain import (
+    bed_on_grid,
+    peak_rasters,
+    read_raster,
+    release_mask,
+    shapefile_polygons,
+    vertical_thickness,
+)
+from pdeflow.terrain.resample import filled_nearest
+from pdeflow.trackers.peaks import PeakTracker
+
+AFFECTED = 0.1
+"""peak depth [m] above which a cell counts as affected"""
+DENSITY = 200.0
+"""flow density of the peak pressure [kg/m^3] (AvaFrame's snow default)"""
+
+
+def load(root: Path, path: str) -> tuple:
+    """(grid, bed corners (nx+1, ny+1), cell beds (nx, ny), filled-cell mask at the
+    cells, release polygons, the DEM) of AvaFrame's ``path`` under ``root``."""
+    inputs = root / "avaframe" / "data" / path / "Inputs"
+    dem = read_raster(next(p for p in inputs.glob("*.asc")))
+    filled, nodata = filled_nearest(dem)
+    xs, ys = dem.x_centres, dem.y_centres[::-1]  # corners: the DEM's centres, y up
+    cs = dem.cellsize
+    grid = CartesianGrid([[xs[0], xs[-1]], [ys[0], ys[-1]]], [xs.size - 1, ys.size - 1])
+    corners = bed_on_grid(filled, xs, ys)
+    beds = 0.25 * (corners[:-1, :-1] + corners[1:, :-1] + corners[:-1, 1:]
+                   + corners[1:, 1:])
+    off = nodata[::-1].T  # (ncols, nrows), y up: no-data at the corners
+    off_cells = off[:-1, :-1] | off[1:, :-1] | off[:-1, 1:] | off[1:, 1:]
+    polygons = [p for f in sorted((inputs / "REL").glob("*.shp"))
+                for p in shapefile_polygons(f)]
+    assert abs(grid.discretization[0] - cs) < 1e-9 * cs
+    return grid, corners, beds, off_cells, polygons, dem
+
+
+def run(grid, corners, depth, phi: float, threads: int, t_end: float, interval: float):
+    """(final state, peak fields, wall time [s], solver info) of the timed run."""
+    pde = pdeflow.SingleLayerGranular(phi_b_deg=phi, bed=corners,
+                                      bc=(("open", "open"), ("open", "open")))
+    state = pde.make_state(grid, h=depth, u=0 * depth, v=0 * depth)
+    pde.solve(state, 1e-3, solver="fv-split", tracker=None, threads=threads)  # compile
+    peaks = PeakTracker(interval, lambda data: peak_fields(data, 1e-6, DENSITY))
+    start = time.perf_counter()
+    end, info = pde.solve(state, t_end, solver="fv-split", tracker=[peaks],
+                          threads=threads, ret_info=True)
+    return end, peaks.peak, time.perf_counter() - start, info
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--avaframe", type=Path, required=True,
+                        help="a checkout of AvaFrame's repository")
+    parser.add_argument("--path", default="avaHit", help="AvaFrame's path (avaHit)")
+    parser.add_argument("--phi", type=float, default=20.0, help="friction angle [deg]")
+    parser.add_argument("--thickness", type=float, default=1.0,
+                        help="release thickness, slope-normal [m] (the shapefile's)")
+    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--t-end", type=float, default=600.0, help="longest run [s]")
+    parser.add_argument("--interval", type=float, default=0.5,
+                        help="peak fields sampled every ... [s]")
+    parser.add_argument("--out", type=Path, help="directory for rasters and figure")
+    args = parser.parse_args()
+    grid, corners, beds, off, polygons, dem = load(args.avaframe, args.path)
+    dx, dy = grid.discretization
+    xc, yc = grid.axes_coords
+    mask = release_mask(polygons, xc, yc, dem)
+    depth = vertical_thickness(mask, args.thickness, beds, dx, dy)
+    end, peak, wall, info = run(grid, corners, depth, args.phi, args.threads,
+                                args.t_end, args.interval)
+    h = end.data[0]
+    x = xc[:, None] * np.ones(grid.shape)
+    y = yc[None, :] * np.ones(grid.shape)
+    mass0, mass = depth.sum(), h.sum()
+    drop = (depth * beds).sum() / mass0 - (h * beds).sum() / mass
+    travel = math.hypot((h * x).sum() / mass - (depth * x).sum() / mass0,
+                        (h * y).sum() / mass - (depth * y).sum() / mass0)
+    print(f"{args.path}: {grid.shape[0]} x {grid.shape[1]} cells of {dx:.3f} m, "
+          f"{int(mask.sum())} released ({mass0 * dx * dy:.0f} m^3), phi {args.phi:g} deg, "
+          f"{args.threads} threads, load {os.getloadavg()[0]:.2f}")
+    print(f"  wall {wall:.2f} s, {info['solver']['steps']} steps, t = "
+          f"{info['solver'].get('t_final', float('nan'))}, at rest: "
+          f"{bool(np.all(end.data[1:] == 0.0))}")
+    print(f"  mass centre: drop {drop:.1f} m over {travel:.1f} m, travel angle "
+          f"{math.degrees(math.atan2(drop, travel)):.2f} deg")
+    print(f"  affected area (peak depth > {AFFECTED:g} m) "
+          f"{np.count_nonzero(peak[0] > AFFECTED) * dx * dy / 1e4:.2f} ha; peak depth "
+          f"{peak[0].max():.2f} m, speed {peak[1].max():.1f} m/s, pressure "
+          f"{peak[2].max():.0f} kPa; mass on filled no-data cells "
+          f"{h[off].sum() / mass:.2%}")
+    if args.out:
+        from pdeflow.terrain_figures import hillshade_figure
+
+        args.out.mkdir(parents=True, exist_ok=True)
+        peak_rasters(peak, xc[0] - dx / 2, yc[0] - dy / 2, dx, args.out, dem.crs)
+        extent = (xc[0] - dx / 2, xc[-1] + dx / 2, yc[0] - dy / 2, yc[-1] + dy / 2)
+        hillshade_figure(beds, peak[0], extent, args.out / f"{args.path}_peak_depth.png",
+                         "peak depth [m]", threshold=AFFECTED)
+
+
+if __name__ == "__main__":
+    main()
