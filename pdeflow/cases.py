@@ -17,6 +17,9 @@ names the key and the file. Sections (all optional except ``[initial]``)::
     [single_layer] any field of SingleLayerParameters
     [output]      snapshot_times [s], front_threshold [m], runout_mass_fraction
     [sweep]       aspect_ratios = [a, ...] (H0 = a L0; see pdeflow.analysis.sweep)
+    [terrain]     a 2D single-layer case over a bed: bed = a topography's name or a DEM's
+                  path, x0, y0 [m], [terrain.topography] its parameters
+                  (pdeflow.case_terrain); initial.measured = "slope_normal" | "vertical"
 
 Initial shapes (x measured from the left end of the domain; the 2D shapes cylinder,
 elliptic_column, cap, box and polygon are those of :mod:`pdeflow.initial_shapes_2d`):
@@ -107,16 +110,22 @@ class Case(GridAcross):
         return case
 
     def set(self, item: str) -> None:
-        """Apply an override ``section.key=value`` (value parsed as a TOML value)."""
+        """Apply an override ``section.key=value`` (value parsed as a TOML value); a key
+        of a sub-table as ``section.table.key=value`` (``terrain.topography.z0=2000``)."""
         if "=" not in item or "." not in item.split("=", 1)[0]:
             raise CaseError(f"override {item!r} must look like section.key=value")
         key, raw = item.split("=", 1)
-        section, name = key.strip().split(".", 1)
+        *tables, name = key.strip().split(".")
         try:
             value = tomllib.loads(f"v = {raw.strip()}")["v"]
         except tomllib.TOMLDecodeError:
             value = raw.strip()  # bare strings such as open or column
-        self.data.setdefault(section, {})[name] = value
+        table = self.data
+        for part in tables:
+            table = table.setdefault(part, {})
+            if not isinstance(table, dict):
+                raise CaseError(f"override {item!r}: {part} is a value, not a table")
+        table[name] = value
 
     def copy(self) -> Case:
         return Case(copy.deepcopy(self.data), self.source, self.base_dir)
@@ -299,11 +308,14 @@ class Case(GridAcross):
 
     def make_pde(self, model: str):
         """The PDE of the registered model ``model`` with this case's parameters,
-        boundaries and scheme."""
+        boundaries and scheme; over a ``[terrain]`` bed, the bed at the cell corners
+        (:meth:`terrain_corners`) as its ``bed``."""
         system = systems.get(model)
+        corners = self.terrain_corners()
+        bed = {} if corners is None else {"bed": corners}  # no bed: the PDE as before
         try:
             return system.pde_class(self.data.get(model, {}), bc=self.bc,
-                                    scheme=self.variant.scheme)
+                                    scheme=self.variant.scheme, **bed)
         except ValueError as err:
             raise self._err(f"[numerics] {err}") from None
 

@@ -11,19 +11,24 @@ any work.
 * :mod:`.release`: release areas as polygons; :mod:`.shapefiles`: polygons from a
   shapefile (pyshp, the same extra); :mod:`.thickness`: the release thickness, given
   vertically or normal to the slope, as a vertical depth;
-* :mod:`.topographies`: AvaFrame's idealised topographies z(x, y) from their equations.
+* :mod:`.topographies`: AvaFrame's idealised topographies z(x, y) from their equations;
+* :mod:`.corners`: the bed at a grid's cell corners (a topography evaluated, a raster
+  resampled), what the flow over terrain takes.
 
-The flow over terrain is not built yet: nothing here is read by a case file or a run.
+A case file's ``[terrain]`` table (:mod:`pdeflow.case_terrain`) reads them.
 """
 
 from .asc import read_asc, write_asc
+from .corners import analytic_bed, bed_corners, topography_parameters
 from .raster import Raster
 from .rasters import read_raster, write_raster
 from .release import case_polygon, release_mask, same_crs
-from .resample import bed_on_grid, cell_centres
+from .resample import bed_on_grid, cell_centres, cell_corners
 from .shapefiles import shapefile_crs, shapefile_polygons
-from .thickness import vertical_thickness
+from .thickness import cos_slope_corners, vertical_depth, vertical_thickness
 
 __all__ = ["Raster", "read_asc", "write_asc", "read_raster", "write_raster",
-           "bed_on_grid", "cell_centres", "case_polygon", "release_mask", "same_crs",
-           "shapefile_crs", "shapefile_polygons", "vertical_thickness"]
+           "bed_on_grid", "cell_centres", "cell_corners", "case_polygon", "release_mask",
+           "same_crs", "shapefile_crs", "shapefile_polygons", "vertical_thickness",
+           "vertical_depth", "cos_slope_corners", "analytic_bed", "bed_corners",
+           "topography_parameters"]
