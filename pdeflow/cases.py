@@ -115,17 +115,14 @@ class Case(GridAcross):
         if "=" not in item or "." not in item.split("=", 1)[0]:
             raise CaseError(f"override {item!r} must look like section.key=value")
         key, raw = item.split("=", 1)
-        *tables, name = key.strip().split(".")
         try:
             value = tomllib.loads(f"v = {raw.strip()}")["v"]
         except tomllib.TOMLDecodeError:
             value = raw.strip()  # bare strings such as open or column
-        table = self.data
-        for part in tables:
-            table = table.setdefault(part, {})
-            if not isinstance(table, dict):
-                raise CaseError(f"override {item!r}: {part} is a value, not a table")
-        table[name] = value
+        try:
+            set_key(self.data, key.strip(), value)
+        except ValueError as err:
+            raise CaseError(f"override {item!r}: {err}") from None
 
     def copy(self) -> Case:
         return Case(copy.deepcopy(self.data), self.source, self.base_dir)
@@ -384,6 +381,19 @@ class Case(GridAcross):
                 raise
             raise self._err(f"initial state: {err}") from None
         return eq, state
+
+
+def set_key(data: dict[str, Any], key: str, value: Any) -> None:
+    """Set ``key`` = ``value`` in a case's ``data``: ``section.key``, or the key of a
+    sub-table ``section.table.key`` (``terrain.topography.z0``), the tables made as
+    needed; ValueError (one line) where a part of the path is a value, not a table."""
+    *tables, name = key.split(".")
+    table = data
+    for part in tables:
+        table = table.setdefault(part, {})
+        if not isinstance(table, dict):
+            raise ValueError(f"{part} is a value, not a table")
+    table[name] = value
 
 
 def _hyperbolicity_sections() -> list[str]:

@@ -272,3 +272,18 @@ def test_a_case_without_terrain_hands_the_pde_no_bed(monkeypatch):
     corners_case = load_case(PARABOLA)
     corners_case.make_pde("single_layer")
     np.testing.assert_array_equal(seen["bed"], corners_case.terrain_corners())
+
+
+def test_a_study_sets_a_topographys_parameter(tmp_path: Path):
+    """A study's parameter may be a key of [terrain.topography] (three parts), as an
+    override may: each point's case holds it in the sub-table and validates."""
+    from pdeflow.study.spec import load_study
+
+    study = tmp_path / "study.toml"
+    study.write_text(f'[study]\ncase = "{PARABOLA.as_posix()}"\ndesign = "grid"\n'
+                     'quantities = ["single_layer.runout"]\n[parameters]\n'
+                     '"terrain.topography.mean_alpha_deg" = { values = [30, 34] }\n')
+    spec = load_study(study)  # its ranges are probed on the case: both validate
+    case = spec.case_for(spec.case, {"terrain.topography.mean_alpha_deg": 30}, ["single_layer"])
+    assert case.data["terrain"]["topography"] == {"fall_height": 1000.0,
+                                                  "mean_alpha_deg": 30}

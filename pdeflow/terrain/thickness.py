@@ -1,12 +1,15 @@
 """The release thickness, measured vertically.
 
-pdeflow's terrain inputs return the release depth measured *vertically*. The user gives
-the thickness either way (``measured``): "slope_normal" (the default, AvaFrame's
-convention for its release thickness: normal to the local slope) is converted by
-h_vertical = h_normal / cos(theta), with tan(theta) = |grad z_b| the bed's steepest
-slope from the resampled bed's gradient (central differences, one-sided at the grid's
-edges; from the bed at the cell corners, differences of the faces' means:
-:func:`cos_slope_corners`); "vertical" is taken as it is (:func:`vertical_depth`).
+pdeflow's terrain inputs return the release depth measured *vertically* (the depth the
+single-layer model over a bed carries). The user gives the thickness either way
+(``measured``): "slope_normal" (the default, AvaFrame's convention for its release
+thickness: normal to the local slope) is converted by h_vertical = h_normal /
+cos(theta), tan(theta) = |grad z_b| the bed's steepest slope; "vertical" is taken as it
+is (:func:`vertical_depth`). The slope comes from the bed at the cell centres
+(:func:`cos_slope`: central differences, one-sided at the grid's edges) or at the cell
+corners (:func:`cos_slope_corners`: the differences of the means of each cell's corners
+on opposite faces, what a case over a ``[terrain]`` bed uses); both are exact on a
+plane.
 """
 
 from __future__ import annotations
