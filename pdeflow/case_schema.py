@@ -36,10 +36,11 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
                "erosion_series": (str,), "series_every": (float, int)},
     "sweep": {"aspect_ratios": (list,)},
     # a 2D single-layer case over a bed (issue 37; pdeflow.case_terrain): a topography's
-    # name or a DEM's path, where the grid's corner lies on it, and the topography's
-    # parameters (a sub-table, [terrain.topography], checked by case_terrain)
+    # name or a DEM's path, where the grid's corner lies on it, the topography's
+    # parameters (a sub-table, [terrain.topography], checked by case_terrain) and a
+    # shapefile of the release's outline
     "terrain": {"bed": (str,), "x0": (float, int), "y0": (float, int),
-                "topography": (dict,)},
+                "topography": (dict,), "release": (str,)},
 }
 
 

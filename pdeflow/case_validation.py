@@ -8,7 +8,7 @@ from typing import Any
 
 from . import systems
 from .case_schema import FRAMES, SCHEMA, SERIES, CaseError
-from .case_terrain import check_terrain, terrain_corners
+from .case_terrain import check_bed, check_terrain
 from .case_validation_2d import check_dimension, check_shape_2d
 from .initial_shapes import SHAPES, check_initial
 from .initial_shapes_2d import SHAPES_2D
@@ -83,7 +83,7 @@ def validate(case: Any) -> None:
         check_memory(case)
     except ValueError as err:
         raise _err(case, str(err)) from None
-    terrain_corners(case)  # the bed itself, last: reads a DEM, checks its coverage
+    check_bed(case)  # the bed itself, last: reads a DEM, checks its coverage
 
 def _check_sections(case: Any) -> None:
     """Known sections and keys of the right types; the models' parameters; known

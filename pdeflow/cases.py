@@ -18,7 +18,8 @@ names the key and the file. Sections (all optional except ``[initial]``)::
     [output]      snapshot_times [s], front_threshold [m], runout_mass_fraction
     [sweep]       aspect_ratios = [a, ...] (H0 = a L0; see pdeflow.analysis.sweep)
     [terrain]     a 2D single-layer case over a bed: bed = a topography's name or a DEM's
-                  path, x0, y0 [m], [terrain.topography] its parameters
+                  path, x0, y0 [m], release = a shapefile's outline (the polygon shape),
+                  [terrain.topography] the topography's parameters
                   (pdeflow.case_terrain); initial.measured = "slope_normal" | "vertical"
 
 Initial shapes (x measured from the left end of the domain; the 2D shapes cylinder,
@@ -60,6 +61,7 @@ else:  # pragma: no cover
 from . import systems
 from .case_2d import GridAcross
 from .case_schema import CaseError
+from .case_terrain import release_vertices
 from .case_validation import validate as _validate
 from .initial_shapes import (
     bed_depth,
@@ -199,7 +201,12 @@ class Case(GridAcross):
 
     @property
     def initial(self) -> dict[str, Any]:
-        return self.data.get("initial", {})
+        """The ``[initial]`` table; with ``terrain.release``, a copy holding the
+        shapefile's outline as the ``polygon`` shape's ``vertices`` [m from the grid's
+        corner] (:func:`pdeflow.case_terrain.release_vertices`)."""
+        initial = self.data.get("initial", {})
+        vertices = release_vertices(self)
+        return initial if vertices is None else {**initial, "vertices": vertices}
 
     @property
     def L0(self) -> float | None:

@@ -287,3 +287,90 @@ def test_a_study_sets_a_topographys_parameter(tmp_path: Path):
     case = spec.case_for(spec.case, {"terrain.topography.mean_alpha_deg": 30}, ["single_layer"])
     assert case.data["terrain"]["topography"] == {"fall_height": 1000.0,
                                                   "mean_alpha_deg": 30}
+
+
+# --- a release from a shapefile ----------------------------------------------------------
+
+def write_release(tmp_path: Path, *rings: list, name: str = "rel",
+                  crs: str | None = None) -> Path:
+    """``name``.shp in ``tmp_path``: one record per ring (closed, as shapefiles store
+    them), with a ``.prj`` of ``crs`` if given."""
+    shapefile = pytest.importorskip("shapefile")
+    with shapefile.Writer(str(tmp_path / name), shapeType=shapefile.POLYGON) as w:
+        w.field("name", "C")
+        for ring in rings:
+            w.poly([[*ring, ring[0]]])
+            w.record(name)
+    if crs is not None:
+        (tmp_path / f"{name}.prj").write_text(crs)
+    return tmp_path / f"{name}.shp"
+
+
+def release_case(tmp_path: Path, **terrain: object) -> dict:
+    """The DEM of :func:`plane_dem` under a grid from (3, -61) m on the map, its release
+    a polygon from terrain.release (the case's own shape keys removed)."""
+    plane_dem(tmp_path)
+    return base(terrain={"bed": "dem.asc", "x0": 3.0, "y0": -61.0, "topography": None,
+                         "release": "rel.shp", **terrain},
+                initial={"shape": "polygon", "x0": None, "y0": None, "semi_x": None,
+                         "semi_y": None})
+
+
+OUTLINE = [[43.0, -41.0], [43.0, 19.0], [123.0, 19.0], [123.0, -41.0]]
+"""a release of 80 m x 60 m on the map [m], 40 m x 20 m from the grid's corner"""
+
+
+def test_a_shapefile_release_is_the_polygon_shape_on_the_map(tmp_path: Path):
+    """The shapefile's outline (map coordinates) becomes the polygon's vertices from the
+    grid's corner; the depth is H0 / cos(theta) on the cells inside, as on release_mask."""
+    from pdeflow.terrain import read_raster, release_mask
+
+    write_release(tmp_path, OUTLINE)
+    case = Case(release_case(tmp_path), str(tmp_path / "c.toml"), tmp_path)
+    case.validate()
+    assert case.initial["vertices"] == [[40.0, 20.0], [40.0, 80.0], [120.0, 80.0],
+                                        [120.0, 20.0]]
+    assert "vertices" not in case.data["initial"]  # the file stays the source
+    mask = release_mask([[np.array(OUTLINE)]], 3.0 + 20.0 * (np.arange(10) + 0.5),
+                        -61.0 + 20.0 * (np.arange(5) + 0.5), read_raster(tmp_path / "dem.asc"))
+    h = case.initial_profiles("single_layer")["h"]
+    np.testing.assert_array_equal(h > 0, mask)
+    assert np.all(h[mask] > 1.0)  # slope-normal 1 m: deeper vertically
+    assert case.release_centre == pytest.approx((80.0, -50.0 + 50.0))
+
+
+@pytest.mark.parametrize("terrain, initial, words", [
+    ({"release": "rel.geojson"}, {}, ["terrain.release", ".shp", "'rel.geojson'"]),
+    ({"release": "none.shp"}, {}, ["terrain.release", "none.shp", "not found"]),
+    ({}, {"shape": "box", "x0": 60.0, "y0": 50.0, "semi_x": 30.0, "semi_y": 30.0},
+     ["initial.shape", "'polygon'", "terrain.release", "'box'"]),
+    ({}, {"vertices": [[0.0, 0.0], [10.0, 0.0], [0.0, 10.0]]},
+     ["initial.vertices", "terrain.release", "remove one"]),
+])
+def test_shapefile_release_errors_name_their_key(tmp_path, terrain, initial, words):
+    write_release(tmp_path, OUTLINE)
+    data = release_case(tmp_path, **terrain)
+    data["initial"].update(initial)
+    refused(data, *words, base_dir=tmp_path)
+
+
+def test_a_shapefile_of_two_outlines_or_off_the_grid_is_refused(tmp_path: Path):
+    write_release(tmp_path, OUTLINE, [[150.0, -41.0], [150.0, 0.0], [190.0, 0.0]])
+    refused(release_case(tmp_path), "terrain.release 'rel.shp'", "2 polygon(s)",
+            "one outline", base_dir=tmp_path)
+    write_release(tmp_path, [[43.0, -41.0], [43.0, 19.0], [250.0, 19.0]])
+    refused(release_case(tmp_path), "terrain.release 'rel.shp'", "(250, 19)",
+            "outside the grid's domain", base_dir=tmp_path)
+
+
+def test_a_shapefile_release_in_another_crs_than_the_dem_is_refused(tmp_path: Path):
+    """pdeflow does not reproject: the DEM's .prj and the shapefile's must agree."""
+    rasterio = pytest.importorskip("rasterio")
+    utm = rasterio.crs.CRS.from_epsg(32632).to_wkt()
+    write_release(tmp_path, OUTLINE, crs=utm)
+    data = release_case(tmp_path)
+    (tmp_path / "dem.prj").write_text(rasterio.crs.CRS.from_epsg(31287).to_wkt())
+    refused(data, "terrain.release 'rel.shp'", "coordinate reference system",
+            "UTM zone 32N", base_dir=tmp_path)
+    (tmp_path / "dem.prj").write_text(utm)
+    Case(data, "<case>", tmp_path).validate()  # the same CRS: accepted
