@@ -66,6 +66,7 @@ DEM_SUFFIXES = (".asc", ".tif", ".tiff")
 MAX_CFL_TERRAIN = 0.5
 """the largest CFL number of the flow over a bed"""
 WHY = "with a [terrain] bed"
+"""what the errors say of a key that a bed constrains"""
 
 
 def _err(case: Any, msg: str) -> CaseError:
