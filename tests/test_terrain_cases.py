@@ -374,3 +374,19 @@ def test_a_shapefile_release_in_another_crs_than_the_dem_is_refused(tmp_path: Pa
             "UTM zone 32N", base_dir=tmp_path)
     (tmp_path / "dem.prj").write_text(utm)
     Case(data, "<case>", tmp_path).validate()  # the same CRS: accepted
+
+
+def test_a_shapefile_release_on_no_data_is_refused(tmp_path: Path):
+    """A no-data DEM cell under the release that no corner's bilinear stencil uses (40 m
+    cells on a 10 m DEM: the raster column at x = 60 m lies between the stencils of the
+    corners at 43 and 83 m) passes the bed's check and is refused by the release's."""
+    from pdeflow.terrain import read_raster
+
+    write_release(tmp_path, OUTLINE)
+    data = release_case(tmp_path)
+    data["grid"].update(dx=40.0, dy=20.0)
+    dem = read_raster(tmp_path / "dem.asc")
+    assert dem.x_centres[7] == 60.0 and dem.y_centres[9] == -10.0
+    dem.nodata[9, 7] = True
+    write_raster(dem, tmp_path / "dem.asc")
+    refused(data, "terrain.release 'rel.shp'", "no data", "(60, -10)", base_dir=tmp_path)
