@@ -1,7 +1,7 @@
 """The y-axis of a case on a 2D grid (issue 36): :class:`GridAcross`, the part of
 :class:`pdeflow.cases.Case` that reads ``grid.width``, ``grid.dy`` (or ``cells_y``),
-``grid.y_start`` and sets up a 2D shape's initial profiles. Validated by
-:mod:`pdeflow.case_validation_2d`."""
+``grid.y_start`` and sets up a 2D shape's initial profiles, over a ``[terrain]`` bed
+(:mod:`pdeflow.case_terrain`) too. Validated by :mod:`pdeflow.case_validation_2d`."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from . import systems
+from .case_terrain import release_depth, terrain_corners
 from .initial_shapes_2d import release_centre, total_depth_2d
 
 
@@ -63,9 +64,16 @@ class GridAcross:
         x0, y0 = release_centre(self.initial)
         return self.x_start + x0, self.y_start + y0
 
+    def terrain_corners(self) -> np.ndarray | None:
+        """The bed [m] at the grid's cell corners (nx + 1, ny + 1) of a case with a
+        ``[terrain]`` table, the PDE's ``bed``; None without one
+        (:func:`pdeflow.case_terrain.terrain_corners`)."""
+        return terrain_corners(self)
+
     def _initial_profiles_2d(self, model: str, grid) -> dict[str, np.ndarray]:
         """:meth:`initial_profiles` on a 2D grid: the 2D shape's total depth
-        (:mod:`pdeflow.initial_shapes_2d`), split by the system as a 1D heap is."""
+        (:mod:`pdeflow.initial_shapes_2d`), split by the system as a 1D heap is; over a
+        ``[terrain]`` bed measured vertically (:func:`pdeflow.case_terrain.release_depth`)."""
         system = systems.get(model)
         x, y = np.meshgrid(grid.axes_coords[0] - self.x_start,
                            grid.axes_coords[1] - self.y_start, indexing="ij")
@@ -74,6 +82,9 @@ class GridAcross:
             raise self._err(f"initial: the {self.initial['shape']} covers no cell centre "
                             f"of the grid (dx = {self.dx:g} m, dy = {self.dy:g} m): "
                             "enlarge it or refine the grid")
+        corners = self.terrain_corners()
+        if corners is not None:  # the model over a bed carries the vertical depth
+            h = release_depth(self, h, corners)
         params = system.parameters_class.from_dict(self.data.get(model, {}))
         depths = system.layer_depths(h, x, self.initial, params)
         out: dict[str, np.ndarray] = {}

@@ -25,7 +25,9 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
                 "bed_thickness": (float, int), "bed_length": (float, int),
                 # the 2D shapes (pdeflow.initial_shapes_2d)
                 "x0": (float, int), "y0": (float, int), "radius": (float, int),
-                "semi_x": (float, int), "semi_y": (float, int), "vertices": (list,)},
+                "semi_x": (float, int), "semi_y": (float, int), "vertices": (list,),
+                # how a 2D release over a [terrain] bed is measured (case_terrain)
+                "measured": (str,)},
     "numerics": {"solver": (str,), "cfl": (float, int), "dt": (float, int),
                  "flux": (str,), "reconstruction": (str,), "limiter": (str,),
                  "splitting": (str,)},
@@ -33,6 +35,12 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
                "runout_mass_fraction": (float, int), "frames": (str,),
                "erosion_series": (str,), "series_every": (float, int)},
     "sweep": {"aspect_ratios": (list,)},
+    # a 2D single-layer case over a bed (issue 37; pdeflow.case_terrain): a topography's
+    # name or a DEM's path, where the grid's corner lies on it, the topography's
+    # parameters (a sub-table, [terrain.topography], checked by case_terrain) and a
+    # shapefile of the release's outline
+    "terrain": {"bed": (str,), "x0": (float, int), "y0": (float, int),
+                "topography": (dict,), "release": (str,)},
 }
 
 

@@ -8,6 +8,7 @@ from typing import Any
 
 from . import systems
 from .case_schema import FRAMES, SCHEMA, SERIES, CaseError
+from .case_terrain import check_bed, check_terrain
 from .case_validation_2d import check_dimension, check_shape_2d
 from .initial_shapes import SHAPES, check_initial
 from .initial_shapes_2d import SHAPES_2D
@@ -50,6 +51,7 @@ def validate(case: Any) -> None:
     except ValueError as err:
         raise _err(case, str(err)) from None
     check_dimension(case)  # a 2D grid's keys, or none of them (before the geometry's)
+    check_terrain(case)  # a [terrain] table's keys (2D, single layer), before any work
     _check_geometry(case)
     if case._get("output", "erosion_series", "auto") not in SERIES:
         raise _err(case, f"output.erosion_series must be one of {list(SERIES)}, got "
@@ -81,6 +83,7 @@ def validate(case: Any) -> None:
         check_memory(case)
     except ValueError as err:
         raise _err(case, str(err)) from None
+    check_bed(case)  # the bed itself, last: reads a DEM, checks its coverage
 
 def _check_sections(case: Any) -> None:
     """Known sections and keys of the right types; the models' parameters; known

@@ -17,6 +17,10 @@ names the key and the file. Sections (all optional except ``[initial]``)::
     [single_layer] any field of SingleLayerParameters
     [output]      snapshot_times [s], front_threshold [m], runout_mass_fraction
     [sweep]       aspect_ratios = [a, ...] (H0 = a L0; see pdeflow.analysis.sweep)
+    [terrain]     a 2D single-layer case over a bed: bed = a topography's name or a DEM's
+                  path, x0, y0 [m], release = a shapefile's outline (the polygon shape),
+                  [terrain.topography] the topography's parameters
+                  (pdeflow.case_terrain); initial.measured = "slope_normal" | "vertical"
 
 Initial shapes (x measured from the left end of the domain; the 2D shapes cylinder,
 elliptic_column, cap, box and polygon are those of :mod:`pdeflow.initial_shapes_2d`):
@@ -57,6 +61,7 @@ else:  # pragma: no cover
 from . import systems
 from .case_2d import GridAcross
 from .case_schema import CaseError
+from .case_terrain import release_vertices
 from .case_validation import validate as _validate
 from .initial_shapes import (
     bed_depth,
@@ -107,16 +112,19 @@ class Case(GridAcross):
         return case
 
     def set(self, item: str) -> None:
-        """Apply an override ``section.key=value`` (value parsed as a TOML value)."""
+        """Apply an override ``section.key=value`` (value parsed as a TOML value); a key
+        of a sub-table as ``section.table.key=value`` (``terrain.topography.z0=2000``)."""
         if "=" not in item or "." not in item.split("=", 1)[0]:
             raise CaseError(f"override {item!r} must look like section.key=value")
         key, raw = item.split("=", 1)
-        section, name = key.strip().split(".", 1)
         try:
             value = tomllib.loads(f"v = {raw.strip()}")["v"]
         except tomllib.TOMLDecodeError:
             value = raw.strip()  # bare strings such as open or column
-        self.data.setdefault(section, {})[name] = value
+        try:
+            set_key(self.data, key.strip(), value)
+        except ValueError as err:
+            raise CaseError(f"override {item!r}: {err}") from None
 
     def copy(self) -> Case:
         return Case(copy.deepcopy(self.data), self.source, self.base_dir)
@@ -193,7 +201,12 @@ class Case(GridAcross):
 
     @property
     def initial(self) -> dict[str, Any]:
-        return self.data.get("initial", {})
+        """The ``[initial]`` table; with ``terrain.release``, a copy holding the
+        shapefile's outline as the ``polygon`` shape's ``vertices`` [m from the grid's
+        corner] (:func:`pdeflow.case_terrain.release_vertices`)."""
+        initial = self.data.get("initial", {})
+        vertices = release_vertices(self)
+        return initial if vertices is None else {**initial, "vertices": vertices}
 
     @property
     def L0(self) -> float | None:
@@ -299,11 +312,14 @@ class Case(GridAcross):
 
     def make_pde(self, model: str):
         """The PDE of the registered model ``model`` with this case's parameters,
-        boundaries and scheme."""
+        boundaries and scheme; over a ``[terrain]`` bed, the bed at the cell corners
+        (:meth:`terrain_corners`) as its ``bed``."""
         system = systems.get(model)
+        corners = self.terrain_corners()
+        bed = {} if corners is None else {"bed": corners}  # no bed: the PDE as before
         try:
             return system.pde_class(self.data.get(model, {}), bc=self.bc,
-                                    scheme=self.variant.scheme)
+                                    scheme=self.variant.scheme, **bed)
         except ValueError as err:
             raise self._err(f"[numerics] {err}") from None
 
@@ -372,6 +388,19 @@ class Case(GridAcross):
                 raise
             raise self._err(f"initial state: {err}") from None
         return eq, state
+
+
+def set_key(data: dict[str, Any], key: str, value: Any) -> None:
+    """Set ``key`` = ``value`` in a case's ``data``: ``section.key``, or the key of a
+    sub-table ``section.table.key`` (``terrain.topography.z0``), the tables made as
+    needed; ValueError (one line) where a part of the path is a value, not a table."""
+    *tables, name = key.split(".")
+    table = data
+    for part in tables:
+        table = table.setdefault(part, {})
+        if not isinstance(table, dict):
+            raise ValueError(f"{part} is a value, not a table")
+    table[name] = value
 
 
 def _hyperbolicity_sections() -> list[str]:

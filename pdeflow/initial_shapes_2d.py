@@ -47,8 +47,9 @@ REQUIRED_2D: dict[str, tuple[str, ...]] = {
 """the keys of [initial] each 2D shape needs"""
 SHAPES_2D = tuple(REQUIRED_2D)
 KEYS_2D = ("shape", "x0", "y0", "radius", "semi_x", "semi_y", "vertices", "H0",
-           "upper_fraction")
-"""the keys of [initial] a 2D shape may have; the others are the 1D shapes'"""
+           "upper_fraction", "measured")
+"""the keys of [initial] a 2D shape may have; the others are the 1D shapes' (``measured``:
+how H0 is measured over a [terrain] bed, checked by :mod:`pdeflow.case_terrain`)"""
 
 
 def semi_axes(initial: dict[str, Any]) -> tuple[float, float]:

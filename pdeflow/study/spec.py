@@ -45,7 +45,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from .. import systems
-from ..cases import Case, CaseError, load_case, read_text
+from ..cases import Case, CaseError, load_case, read_text, set_key
 from ..simulate import summary_keys
 from .expressions import Expression, StudyError
 
@@ -194,8 +194,10 @@ class StudySpec:
         """``base`` with the point's values set, only ``models`` run, no snapshots."""
         case = base.copy()
         for key, value in point.items():
-            section, name = key.split(".", 1)
-            case.data.setdefault(section, {})[name] = value
+            try:
+                set_key(case.data, key, value)  # a sub-table's too: terrain.topography.z0
+            except ValueError as err:
+                raise CaseError(f"{case.source}: {key}: {err}") from None
         case.data.setdefault("case", {})["models"] = list(models)
         case.data.setdefault("output", {})["snapshot_times"] = []
         case.validate()

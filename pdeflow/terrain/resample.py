@@ -53,6 +53,14 @@ def cell_centres(start: float, length: float, spacing: float, axis: str = "x") -
     return start + spacing * (np.arange(n) + 0.5)
 
 
+def cell_corners(start: float, length: float, spacing: float, axis: str = "x") -> np.ndarray:
+    """The cell corners [m] of one axis of a case's grid, ``start`` + spacing k for
+    k <= n, the n cells of :func:`cell_centres` (same keys, same checks): where the flow
+    over terrain takes the bed's elevation."""
+    n = cell_centres(start, length, spacing, axis).size
+    return start + spacing * np.arange(n + 1)
+
+
 def _fractional(coords: np.ndarray, first_centre: float, cellsize: float,
                 cells: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For ``coords`` [m] along a raster axis whose centres are ``first_centre`` +
@@ -66,13 +74,15 @@ def _fractional(coords: np.ndarray, first_centre: float, cellsize: float,
 
 
 def bed_on_grid(raster: Raster, x: np.ndarray, y: np.ndarray,
-                name: str = "dem") -> np.ndarray:
+                name: str = "dem", points: str = "cell centres") -> np.ndarray:
     """The bed z_b [m] at the cell centres ``x`` (nx,) x ``y`` (ny,) [m, the raster's
     map coordinates], shape (nx, ny) as pdeflow's 2D fields: bilinear between the
-    raster's cell centres (module docstring).
+    raster's cell centres (module docstring). Any other points of a tensor grid are
+    sampled alike, e.g. the cell corners (nx + 1,) x (ny + 1,) (``points`` names them
+    in the error).
 
     ValueError (one line, naming ``name`` and the uncovered extent) before any
-    interpolation when a centre lies outside the span of the raster's cell centres or
+    interpolation when a point lies outside the span of the raster's cell centres or
     next to a no-data cell it would use.
     """
     x = np.asarray(x, dtype=float)
@@ -97,7 +107,7 @@ def bed_on_grid(raster: Raster, x: np.ndarray, y: np.ndarray,
     for i, j, w in corners:
         covered &= ~(nodata[i, j] & (w > 0))
     if not covered.all():
-        _refuse(raster, x, y, covered, name)
+        _refuse(raster, x, y, covered, name, points)
     z = np.zeros(covered.shape)
     for i, j, w in corners:
         z += w * np.where(nodata[i, j], 0.0, south_up[i, j])
@@ -105,14 +115,14 @@ def bed_on_grid(raster: Raster, x: np.ndarray, y: np.ndarray,
 
 
 def _refuse(raster: Raster, x: np.ndarray, y: np.ndarray, covered: np.ndarray,
-            name: str) -> None:
+            name: str, points: str) -> None:
     """Raise the one-line error of :func:`bed_on_grid` with the uncovered extent."""
     X, Y = np.meshgrid(x, y, indexing="ij")  # noqa: N806
     bad = ~covered
     xc, yc = raster.x_centres, raster.y_centres
     raise ValueError(
-        f"{name}: the raster does not cover the grid: {int(bad.sum())} of {bad.size} cell "
-        f"centres, in x [{X[bad].min():g}, {X[bad].max():g}] m x y [{Y[bad].min():g}, "
+        f"{name}: the raster does not cover the grid: {int(bad.sum())} of {bad.size} "
+        f"{points}, in x [{X[bad].min():g}, {X[bad].max():g}] m x y [{Y[bad].min():g}, "
         f"{Y[bad].max():g}] m, lie outside its cell centres' span (x [{xc[0]:g}, "
         f"{xc[-1]:g}] m x y [{yc[-1]:g}, {yc[0]:g}] m) or next to its no-data cells: "
         "move or shrink the grid (x_start, y_start, length, width) or fill the raster")
