@@ -243,3 +243,42 @@ def test_peak_fields_over_a_bed_are_sampled_rasters_that_change_nothing(tmp_path
     back = read_raster(paths[0])
     assert (back.x_corner, back.y_corner, back.cellsize) == (1000.0, 500.0, 5.0)
     np.testing.assert_array_equal(back.values[::-1].T, depth)
+
+
+def test_the_real_path_example_runs_on_a_dem_the_test_writes(tmp_path):
+    """benchmarks/real_path.py on a small DEM in AvaFrame's layout, written here: an
+    inclined plane at 30 deg clipped to a disc (no-data outside, filled with the
+    nearest value), a square release in a shapefile; it runs to rest, prints its
+    numbers, and writes the three peak rasters and the hillshade figure."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    shapefile = pytest.importorskip("shapefile")
+    from pdeflow.terrain import Raster, read_raster, write_raster
+
+    inputs = tmp_path / "avaframe" / "data" / "avaTest" / "Inputs"
+    (inputs / "REL").mkdir(parents=True)
+    n, cs = 60, 5.0
+    xc = cs * (np.arange(n) + 0.5)
+    yc = cs * (np.arange(n)[::-1] + 0.5)
+    X, Y = np.meshgrid(xc, yc)  # noqa: N806
+    z = 500.0 - math.tan(math.radians(30.0)) * X
+    outside = np.hypot(X - 150, Y - 150) > 145
+    write_raster(Raster(z, 0.0, 0.0, cs, outside), inputs / "avaTest.asc")
+    with shapefile.Writer(str(inputs / "REL" / "rel")) as w:
+        w.field("thickness", "N", decimal=3)
+        w.poly([[[60, 130], [60, 170], [100, 170], [100, 130], [60, 130]]])
+        w.record(1.0)
+    root = Path(__file__).parents[1]
+    out = subprocess.run([sys.executable, str(root / "benchmarks" / "real_path.py"),
+                          "--avaframe", str(tmp_path), "--path", "avaTest", "--phi", "25",
+                          "--threads", "1", "--out", str(tmp_path / "out")],
+                         capture_output=True, text=True, check=True).stdout
+    assert "avaTest: 59 x 59 cells of 5.000 m" in out
+    assert "at rest: True" in out
+    angle = float(out.split("travel angle ")[1].split()[0])
+    assert angle >= 25.0  # the energy line's bound (the plane at 30 deg ends in the fill)
+    depth = read_raster(tmp_path / "out" / "peak_depth.asc")
+    assert depth.values.shape == (59, 59) and depth.values.max() > 1.0
+    assert (tmp_path / "out" / "avaTest_peak_depth.png").stat().st_size > 10_000

@@ -33,6 +33,9 @@ class Raster:
 
     def __post_init__(self) -> None:
         self.values = np.asarray(self.values, dtype=float)
+        # plain floats: a writer prints them (repr of a numpy scalar is not a number)
+        self.x_corner, self.y_corner = float(self.x_corner), float(self.y_corner)
+        self.cellsize = float(self.cellsize)
         self.nodata = np.asarray(self.nodata, dtype=bool)
         if self.values.ndim != 2 or min(self.values.shape) < 1:
             raise ValueError(f"Raster.values must be a 2D array (nrows, ncols) of at least "
