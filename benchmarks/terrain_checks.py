@@ -19,7 +19,7 @@ import numpy as np
 from pde import CartesianGrid
 
 import pdeflow
-from pdeflow.numerics.geometry import bed_corners
+from pdeflow.numerics.geometry import bed_at_corners
 from pdeflow.terrain.topographies import parabola
 
 WALLS = (("wall", "wall"), ("wall", "wall"))
@@ -33,7 +33,7 @@ def cell_beds(corners: np.ndarray) -> np.ndarray:
 
 def lake_rate(grid: CartesianGrid, bed, level: float) -> tuple[float, float]:
     """(largest |rate| of the lake at rest at ``level`` [m] over ``bed``, wet fraction)."""
-    corners = bed_corners(grid, bed)
+    corners = bed_at_corners(grid, bed)
     h = np.maximum(level - cell_beds(corners), 0.0)
     pde = pdeflow.SingleLayerGranular(phi_b_deg=1e-6, bc=WALLS, bed=corners)
     state = pde.make_state(grid, h=h, u=0 * h, v=0 * h)
@@ -44,7 +44,7 @@ def lake_rate(grid: CartesianGrid, bed, level: float) -> tuple[float, float]:
 def energy_line(dx: float, phi_deg: float = 25.0, depth: float = 1.0) -> tuple[float, float]:
     """(travel angle of the mass centre [deg], wall time [s]) on the parabola."""
     grid = CartesianGrid([[0, 2600], [-2 * dx, 2 * dx]], [round(2600 / dx), 4])
-    corners = bed_corners(grid, parabola)
+    corners = bed_at_corners(grid, parabola)
     x = grid.axes_coords[0][:, None] * np.ones(grid.shape)
     h = np.where((x > 100) & (x < 300), depth, 0.0)
     pde = pdeflow.SingleLayerGranular(phi_b_deg=phi_deg, bed=corners,

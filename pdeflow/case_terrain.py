@@ -41,6 +41,7 @@ import numpy as np
 from . import systems
 from .case_schema import CaseError
 from .models.base import check_range
+from .numerics.scheme import MAX_CFL_BED
 from .terrain import (
     Raster,
     analytic_bed,
@@ -63,8 +64,6 @@ TERRAIN_MODELS = ("single_layer",)
 """the models that flow over a bed (the two-layer model refuses one for now)"""
 DEM_SUFFIXES = (".asc", ".tif", ".tiff")
 """what a DEM's file name ends with (:func:`pdeflow.terrain.read_raster`)"""
-MAX_CFL_TERRAIN = 0.5
-"""the largest CFL number of the flow over a bed"""
 WHY = "with a [terrain] bed"
 """what the errors say of a key that a bed constrains"""
 
@@ -105,7 +104,7 @@ def check_terrain(case: Any) -> None:
         raise _err(case, f"numerics.reconstruction must be 'first-order' {WHY} (the flow "
                          f"over a bed is first order for now), got {reconstruction!r}")
     try:
-        check_range(f"numerics.cfl ({WHY})", case.cfl, 0, MAX_CFL_TERRAIN, low_open=True)
+        check_range(f"numerics.cfl ({WHY})", case.cfl, 0, MAX_CFL_BED, low_open=True)
     except ValueError as err:
         raise _err(case, str(err)) from None
     _check_bed(case, terrain)

@@ -13,7 +13,7 @@ import pytest
 from pde import CartesianGrid
 
 import pdeflow
-from pdeflow.numerics.geometry import bed_corners, corner_coordinates
+from pdeflow.numerics.geometry import bed_at_corners, corner_coordinates
 from pdeflow.terrain.topographies import parabola
 
 WALLS = (("wall", "wall"), ("wall", "wall"))
@@ -64,7 +64,7 @@ def test_a_lake_on_a_bed_without_its_level_moves():
 
 def inclined_bumpy(grid: CartesianGrid, slope_deg: float) -> np.ndarray:
     tan_t = math.tan(math.radians(slope_deg))
-    return bed_corners(grid, lambda x, y: -tan_t * x
+    return bed_at_corners(grid, lambda x, y: -tan_t * x
                        + 0.2 * np.sin(x / 9.0) * np.sin(y / 11.0))
 
 
@@ -91,7 +91,7 @@ def test_a_layer_thinner_than_the_relief_feels_the_slope(depth):
     et al. gives a thin layer a fraction of this slope.)"""
     tan_t = math.tan(math.radians(34.0))
     grid = CartesianGrid([[0, 500], [0, 50]], [100, 10])
-    corners = bed_corners(grid, lambda x, y: -tan_t * x + 0.0 * y)
+    corners = bed_at_corners(grid, lambda x, y: -tan_t * x + 0.0 * y)
     pde = pdeflow.SingleLayerGranular(phi_b_deg=20, bc=(("open", "open"), ("open", "open")),
                                       bed=corners)
     h = np.full(grid.shape, depth)

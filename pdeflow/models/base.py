@@ -23,7 +23,7 @@ from pde import CartesianGrid, FieldCollection
 from pde.pdes.base import PDEBase
 
 from ..numerics import layout as L
-from ..numerics.geometry import Metric, bed_corners, geometry_of, metric_of
+from ..numerics.geometry import Metric, bed_at_corners, geometry_of, metric_of
 from ..numerics.scheme import Scheme
 from ..numerics.state import DRY_TOLERANCE
 from .bed import check_bed
@@ -284,7 +284,7 @@ class GranularPDE(PDEBase):
         last = self.__dict__.get("_metric")
         if last is None or last[0] is not grid:
             self.geometry(grid)  # a 1D model refuses a 2D grid
-            self._metric = (grid, metric_of(grid, bed_corners(grid, self.bed)))
+            self._metric = (grid, metric_of(grid, bed_at_corners(grid, self.bed)))
         return self._metric[1]
 
     def make_state(self, grid: CartesianGrid, **profiles: np.ndarray) -> FieldCollection:

@@ -2,7 +2,7 @@
 
 The bed is given at the 2D grid's cell corners, an (nx + 1, ny + 1) array of
 elevations [m], or as a function z_b(x, y) [m] of the corners' coordinates
-(:func:`pdeflow.numerics.geometry.bed_corners`). Over a bed depths are vertical and the
+(:func:`pdeflow.numerics.geometry.bed_at_corners`). Over a bed depths are vertical and the
 slope is the bed's: theta_deg and slope_azimuth_deg are 0, and the scheme's
 reconstruction is first order (:mod:`pdeflow.models.single_layer.terrain`).
 """

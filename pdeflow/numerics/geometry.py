@@ -59,7 +59,7 @@ class Metric:
     """cell width along each axis [m] (default: ``(dx,)``)"""
     bed: np.ndarray | None = None
     """a 2D grid over a bed z_b(x, y): its elevation [m] at the cells' corners,
-    (nx + 1, ny + 1) (:func:`bed_corners`); None: no bed"""
+    (nx + 1, ny + 1) (:func:`bed_at_corners`); None: no bed"""
 
     @property
     def axes(self) -> list[tuple[int, int, float]]:
@@ -133,7 +133,7 @@ def geometry_of(grid: Any, two_d: bool = False) -> str:
 def metric_of(grid: Any, bed: np.ndarray | None = None) -> Metric:
     """The metric of a grid that :func:`geometry_of` accepts, a 2D ``CartesianGrid``
     included (a model without 2D kernels refuses it before: ``GranularPDE.geometry``);
-    ``bed``: the corners' elevations of a bed under a 2D grid (:func:`bed_corners`)."""
+    ``bed``: the corners' elevations of a bed under a 2D grid (:func:`bed_at_corners`)."""
     geometry = geometry_of(grid, two_d=True)
     if bed is not None and geometry != "planar-2d":
         raise ValueError(f"bed needs a 2D CartesianGrid, got a {geometry} grid")
@@ -167,7 +167,7 @@ def corner_coordinates(grid: Any) -> tuple[np.ndarray, np.ndarray]:
     return np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1)
 
 
-def bed_corners(grid: Any, bed: Any) -> np.ndarray | None:
+def bed_at_corners(grid: Any, bed: Any) -> np.ndarray | None:
     """The bed's elevations [m] at the corners of the 2D ``grid``'s cells, (nx + 1,
     ny + 1): ``bed`` is that array, or a function z_b(x, y) [m] of the corners'
     coordinates (broadcast arrays, the grid's own coordinates [m]); None for None.

@@ -34,6 +34,12 @@ up to 1; MUSCL's SSP-RK2 update with limited slopes keeps depths non-negative on
 1/2 (docs/stability.md)."""
 
 
+MAX_CFL_BED = 0.5
+"""The largest Courant number over a bed z_b(x, y): the face depths of the reconstruction
+over it reach 2h (:mod:`pdeflow.models.single_layer.terrain`), as MUSCL's face values
+make its limit 1/2."""
+
+
 class SchemeError(ValueError):
     """A scheme choice that is not one of the allowed ones."""
 

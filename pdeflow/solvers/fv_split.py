@@ -29,7 +29,7 @@ from pde.trackers.base import FinishedSimulation
 from ..models.base import GranularPDE, check_range
 from ..numerics import layout as L
 from ..numerics.geometry import Metric
-from ..numerics.scheme import SPLITTINGS, Scheme, check_choice
+from ..numerics.scheme import MAX_CFL_BED, SPLITTINGS, Scheme, check_choice
 from ..numerics.splitting import (
     STATUS_FAIL,
     STATUS_REST,
@@ -176,7 +176,7 @@ class FVSplitSolver(SolverBase):
         pde: GranularPDE = self.pde
         metric = pde.check_state(state)  # the grid's geometry, derived here once
         if metric.bed is not None:  # face depths up to 2 h (pdeflow.models.*.terrain)
-            check_range("cfl (over a bed)", self.cfl, 0, 0.5, low_open=True)
+            check_range("cfl (over a bed)", self.cfl, 0, MAX_CFL_BED, low_open=True)
         dx, M = metric.dx, metric.array()
         hook, diag = self._hook(state)
         self.info.update(dt=None, steps=0, dt_adaptive=True, stochastic=False,
