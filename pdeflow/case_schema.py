@@ -40,7 +40,7 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
     # parameters (a sub-table, [terrain.topography], checked by case_terrain) and a
     # shapefile of the release's outline
     "terrain": {"bed": (str,), "x0": (float, int), "y0": (float, int),
-                "topography": (dict,), "release": (str,)},
+                "topography": (dict,), "release": (str,), "flow_density": (float, int)},
 }
 
 

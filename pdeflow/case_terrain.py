@@ -109,6 +109,11 @@ def check_terrain(case: Any) -> None:
         raise _err(case, str(err)) from None
     _check_bed(case, terrain)
     _check_release(case, terrain)
+    try:
+        check_range("terrain.flow_density", flow_density(case), 0, math.inf,
+                    low_open=True, high_open=True, unit="kg/m^3")
+    except ValueError as err:
+        raise _err(case, str(err)) from None
     measured = case.initial.get("measured", MEASURED[0])
     if measured not in MEASURED:
         raise _err(case, f"initial.measured must be one of {list(MEASURED)}, got "
@@ -186,6 +191,26 @@ def _stamped(path: Path, read: Any) -> Any:
             stat = file.stat()
             stamp += (stat.st_mtime_ns, stat.st_size)
     return read(str(path.resolve()), stamp)
+
+
+FLOW_DENSITY = 200.0
+"""the flow's density of the peak pressure [kg/m^3] (``terrain.flow_density``):
+AvaFrame's com1DFA default (snow, ``rho``), so that its peak pressures compare; a dry
+granular flow is nearer 1500"""
+
+
+def flow_density(case: Any) -> float:
+    """``terrain.flow_density`` [kg/m^3], by default :data:`FLOW_DENSITY`."""
+    return case.data["terrain"].get("flow_density", FLOW_DENSITY)
+
+
+def map_corner(case: Any) -> tuple[float, float, str | None]:
+    """(x, y) [m] of the grid's lower-left corner in the bed's (map) coordinates and
+    the DEM's CRS (WKT; None for a topography or a DEM without one): where a case's
+    peak rasters lie."""
+    terrain = case.data["terrain"]
+    bed = _bed(case, terrain)
+    return (*_origin(case), bed.crs if isinstance(bed, Raster) else None)
 
 
 def _origin(case: Any) -> tuple[float, float]:

@@ -179,6 +179,8 @@ class RunOutputs:
             write_json(folder.tmp / "summary.json", summary)
         if args.summary:
             self._file(args.summary, lambda tmp: write_json(tmp, summary))
+        for m in case.models if folder is not None else []:
+            self._peak_outputs(case, m, results[m], folder)
         for i, m in enumerate(case.models if args.final else []):
             self._file(model_path(args.final, m, i == 0),
                        lambda tmp, m=m: write_npz(tmp, results[m].final_arrays()))
@@ -193,6 +195,19 @@ class RunOutputs:
         for path in figures.draw(jobs):
             if folder is not None and Path(path).parent == folder.tmp:
                 self.staged.append((_Done(), folder.path / Path(path).name))
+
+    def _peak_outputs(self, case: Any, model: str, result: Any, folder: PendingDir) -> None:
+        """A run over a bed: its peak rasters and figure in the results folder."""
+        if result.peak_fields is None:
+            return
+        from .terrain_run import write_peak_outputs
+
+        c = result.metric.bed
+        bed = 0.25 * (c[:-1, :-1] + c[1:, :-1] + c[:-1, 1:] + c[1:, 1:])
+        suffix = "" if len(case.models) == 1 else f"_{model}"
+        for path in write_peak_outputs(case, model, result.peak_fields, bed, folder.tmp,
+                                       suffix):
+            self.staged.append((_Done(), folder.path / path.name))
 
     def _file(self, path: str | Path, write: Any) -> None:
         """Stage one file: ``write(tmp)`` writes it under its temporary name."""

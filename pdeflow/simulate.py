@@ -52,6 +52,7 @@ from .numerics.warmup import prepare
 from .solvers.diagnostics import SplitDiagnostics
 from .solvers.fv_split import SimulationBlowUp, split_stepper
 from .summary_2d import COMMON_KEYS_2D, summarize_2d
+from .terrain_run import peak_fields_tracker, terrain_summary
 from .trackers import FextraStorageTracker
 from .trackers.peaks import PeakTracker
 from .trackers.series import SeriesTracker
@@ -80,6 +81,9 @@ class RunResult:
     series: ErosionSeries | None = None
     """the erosion time series (:mod:`pdeflow.erosion`) of a case that records
     it (:attr:`pdeflow.cases.Case.erosion_series`), else None"""
+    peak_fields: np.ndarray | None = None
+    """over a ``[terrain]`` bed, the sampled peaks of depth [m], speed [m/s] and pressure
+    [kPa] per cell (3, nx, ny) (:mod:`pdeflow.terrain_run`), else None"""
 
     @property
     def x(self) -> np.ndarray:
@@ -202,8 +206,8 @@ class Run:
         snaps = FextraStorageTracker(sorted(case.snapshot_times))
         trackers: list[Any] = [snaps] if case.snapshot_times else []
         peaks = peak_tracker(case, self.pde)
-        if peaks is not None:
-            trackers.append(peaks)
+        fields = peak_fields_tracker(case, self.pde, PEAK_SAMPLES)
+        trackers.extend(t for t in (peaks, fields) if t is not None)
         series = (SeriesTracker(case.series_every, self.pde.system.diagnostics)
                   if case.erosion_series else None)
         if series is not None:
@@ -260,6 +264,9 @@ class Run:
         result.summary = (summarize(result, mass0, wall, self.state.data) if peaks is None
                           else summarize_2d(result, mass0, wall, peaks.peak,
                                             self.state.data))
+        if fields is not None:
+            result.peak_fields = fields.peak
+            result.summary.update(terrain_summary(result, fields.peak, self.state.data))
         for message in result.summary["warnings"]:
             warnings.warn(message, RunWarning, stacklevel=2)
         return result
@@ -355,7 +362,8 @@ def summary_unit(key: str, geometry: str | None = None) -> str | None:
         return {"planar": "m^2", "axisymmetric": "m^3", "planar-2d": "m^3"}.get(
             geometry or "", "m^2 or m^3")
     units = {"max_fextra_over_rho1": "m^2/s^2", "front_velocity_max": "m/s",
-             "max_speed": "m/s", "deposit_area": "m^2"}
+             "max_speed": "m/s", "deposit_area": "m^2", "affected_area": "m^2",
+             "travel_angle": "deg", "max_pressure": "kPa"}
     if key in units:
         return units[key]
     if key in ("steps", "mass_relative_error", "mass_change", "runout_mass_fraction",

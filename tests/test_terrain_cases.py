@@ -390,3 +390,33 @@ def test_a_shapefile_release_on_no_data_is_refused(tmp_path: Path):
     dem.nodata[9, 7] = True
     write_raster(dem, tmp_path / "dem.asc")
     refused(data, "terrain.release 'rel.shp'", "no data", "(60, -10)", base_dir=tmp_path)
+
+
+def test_a_terrain_case_run_writes_its_peak_outputs(tmp_path):
+    """``pdeflow run`` of the shipped parabola: the summary has the travel angle (at
+    least the friction angle, the energy line's bound), the affected area (at least the
+    deposit's) and the peak pressure (200 kg/m^3 times a speed squared); the folder
+    holds the three peak rasters, georeferenced at the grid's corner in the bed's
+    coordinates, and the figure; a flow density out of range is one line."""
+    import json
+    import subprocess
+    import sys
+
+    from pdeflow.terrain import read_raster
+
+    case = ROOT / "cases" / "terrain_parabola.toml"
+    subprocess.run([sys.executable, "-m", "pdeflow", "run", str(case), "--out",
+                    str(tmp_path)], check=True, capture_output=True, text=True)
+    s = json.loads((tmp_path / "summary.json").read_text())["models"]["single_layer"]
+    assert s["at_rest"] and 25.0 <= s["travel_angle"] < 35.0
+    assert s["affected_area"] >= s["deposit_area"] > 0
+    assert 0.2 * s["max_speed"] ** 2 >= s["max_pressure"] > 0
+    depth = read_raster(tmp_path / "peak_depth.asc")
+    from pdeflow.case_terrain import map_corner
+
+    loaded = load_case(case)
+    assert (depth.x_corner, depth.y_corner, depth.crs) == map_corner(loaded)
+    assert depth.values.shape == (loaded.cells_y, loaded.cells)
+    assert (tmp_path / "peak_depth.png").is_file()
+    with pytest.raises(CaseError, match=r"terrain.flow_density must lie in \(0, inf\)"):
+        load_case(case, ["terrain.flow_density=0"])
