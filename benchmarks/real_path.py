@@ -11,8 +11,10 @@ value), its cells the DEM's size; no-data cells around the path's outline are fi
 with the nearest value (:func:`pdeflow.terrain.resample.filled_nearest`) and the mass
 that ends on them is reported. The release thickness (the shapefile's 1 m, slope-normal
 as AvaFrame measures it) becomes a vertical depth; Coulomb friction ``--phi`` [deg];
-open boundaries; fv-split on ``--threads`` threads until all is at rest (or
-``--t-end``). A first run of one step compiles; the timed run is the second. Prints the
+open boundaries; fv-split on ``--threads`` threads until all is at rest, or until the
+kinetic energy has fallen below ``--stop-energy`` times its peak (AvaFrame's com1DFA
+stops so: ``stopCrit`` 0.01 of ``kinEnergy``; sampled every 1 s), or ``--t-end``. A
+first run of one step compiles; the timed run is the second. Prints the
 grid, the wall time, steps, the time at rest, the mass centre's travel angle, the
 affected area (peak depth > 0.1 m) and the largest peaks; with ``--out`` writes the
 peak rasters (.asc, the DEM's CRS) and the peak depth over the hillshade.
@@ -28,6 +30,8 @@ from pathlib import Path
 
 import numpy as np
 from pde import CartesianGrid
+from pde.trackers.base import FinishedSimulation
+from pde.trackers.trackers import CallbackTracker
 
 import pdeflow
 from pdeflow.metrics_2d import peak_fields
@@ -68,17 +72,39 @@ def load(root: Path, path: str) -> tuple:
     return grid, corners, beds, off_cells, polygons, dem
 
 
-def run(grid, corners, depth, phi: float, threads: int, t_end: float, interval: float):
-    """(final state, peak fields, wall time [s], solver info) of the timed run."""
+class EnergyStop:
+    """Ends a run (FinishedSimulation) once its kinetic energy sum h |u|^2 / 2 [m^4/s^2
+    per cell area] has fallen below ``fraction`` of the largest seen: com1DFA's rule."""
+
+    def __init__(self, fraction: float):
+        self.fraction = fraction
+        self.peak = 0.0
+        self.stopped_at: float | None = None
+
+    def __call__(self, state, t: float) -> None:
+        h, m, n = state.data
+        wet = h > 1e-6
+        energy = 0.5 * float(((m[wet] ** 2 + n[wet] ** 2) / h[wet]).sum())
+        self.peak = max(self.peak, energy)
+        if self.fraction > 0 and t > 0 and energy < self.fraction * self.peak:
+            self.stopped_at = t
+            raise FinishedSimulation(f"kinetic energy below {self.fraction:g} of its peak")
+
+
+def run(grid, corners, depth, phi: float, threads: int, t_end: float, interval: float,
+        stop_energy: float):
+    """(final state, peak fields, wall time [s], solver info, the energy stop) of the
+    timed run."""
     pde = pdeflow.SingleLayerGranular(phi_b_deg=phi, bed=corners,
                                       bc=(("open", "open"), ("open", "open")))
     state = pde.make_state(grid, h=depth, u=0 * depth, v=0 * depth)
     pde.solve(state, 1e-3, solver="fv-split", tracker=None, threads=threads)  # compile
     peaks = PeakTracker(interval, lambda data: peak_fields(data, 1e-6, DENSITY))
+    stop = EnergyStop(stop_energy)
     start = time.perf_counter()
-    end, info = pde.solve(state, t_end, solver="fv-split", tracker=[peaks],
-                          threads=threads, ret_info=True)
-    return end, peaks.peak, time.perf_counter() - start, info
+    end, info = pde.solve(state, t_end, solver="fv-split", threads=threads, ret_info=True,
+                          tracker=[peaks, CallbackTracker(stop, interrupts=1.0)])
+    return end, peaks.peak, time.perf_counter() - start, info, stop
 
 
 def main() -> None:
@@ -91,6 +117,9 @@ def main() -> None:
                         help="release thickness, slope-normal [m] (the shapefile's)")
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--t-end", type=float, default=600.0, help="longest run [s]")
+    parser.add_argument("--stop-energy", type=float, default=0.01,
+                        help="end when the kinetic energy is below this fraction of its "
+                             "peak (0: only at rest)")
     parser.add_argument("--interval", type=float, default=0.5,
                         help="peak fields sampled every ... [s]")
     parser.add_argument("--out", type=Path, help="directory for rasters and figure")
@@ -100,8 +129,8 @@ def main() -> None:
     xc, yc = grid.axes_coords
     mask = release_mask(polygons, xc, yc, dem)
     depth = vertical_thickness(mask, args.thickness, beds, dx, dy)
-    end, peak, wall, info = run(grid, corners, depth, args.phi, args.threads,
-                                args.t_end, args.interval)
+    end, peak, wall, info, stop = run(grid, corners, depth, args.phi, args.threads,
+                                      args.t_end, args.interval, args.stop_energy)
     h = end.data[0]
     x = xc[:, None] * np.ones(grid.shape)
     y = yc[None, :] * np.ones(grid.shape)
@@ -112,9 +141,13 @@ def main() -> None:
     print(f"{args.path}: {grid.shape[0]} x {grid.shape[1]} cells of {dx:.3f} m, "
           f"{int(mask.sum())} released ({mass0 * dx * dy:.0f} m^3), phi {args.phi:g} deg, "
           f"{args.threads} threads, load {os.getloadavg()[0]:.2f}")
-    print(f"  wall {wall:.2f} s, {info['solver']['steps']} steps, t = "
-          f"{info['solver'].get('t_final', float('nan'))}, at rest: "
-          f"{bool(np.all(end.data[1:] == 0.0))}")
+    rest = bool(np.all(end.data[1:] == 0.0))
+    why = "at rest" if rest else (
+        f"kinetic energy < {args.stop_energy:g} of its peak" if stop.stopped_at is not None
+        else "t_end")
+    t_end = info["controller"].get("t_final", float("nan"))
+    print(f"  wall {wall:.2f} s, {info['solver']['steps']} steps, ended at t = "
+          f"{t_end:.1f} s ({why}), at rest: {rest}")
     print(f"  mass centre: drop {drop:.1f} m over {travel:.1f} m, travel angle "
           f"{math.degrees(math.atan2(drop, travel)):.2f} deg")
     print(f"  affected area (peak depth > {AFFECTED:g} m) "

@@ -273,7 +273,8 @@ def test_the_real_path_example_runs_on_a_dem_the_test_writes(tmp_path):
     root = Path(__file__).parents[1]
     out = subprocess.run([sys.executable, str(root / "benchmarks" / "real_path.py"),
                           "--avaframe", str(tmp_path), "--path", "avaTest", "--phi", "25",
-                          "--threads", "1", "--out", str(tmp_path / "out")],
+                          "--threads", "1", "--stop-energy", "0",
+                          "--out", str(tmp_path / "out")],
                          capture_output=True, text=True, check=True).stdout
     assert "avaTest: 59 x 59 cells of 5.000 m" in out
     assert "at rest: True" in out
