@@ -60,8 +60,8 @@ from .terrain.release import check_release_on_raster
 from .terrain.thickness import MEASURED
 from .terrain.topographies import TOPOGRAPHIES
 
-TERRAIN_MODELS = ("single_layer",)
-"""the models that flow over a bed (the two-layer model refuses one for now)"""
+TERRAIN_MODELS = ("single_layer", "two_layer")
+"""the models that flow over a bed"""
 DEM_SUFFIXES = (".asc", ".tif", ".tiff")
 """what a DEM's file name ends with (:func:`pdeflow.terrain.read_raster`)"""
 WHY = "with a [terrain] bed"

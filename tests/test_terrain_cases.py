@@ -58,8 +58,6 @@ def refused(data: dict, *words: str, base_dir: Path | None = None) -> None:
 # --- the errors --------------------------------------------------------------------------
 
 @pytest.mark.parametrize("sections, words", [
-    ({"case": {"models": ["two_layer", "single_layer"]}}, ["case.models", "two_layer",
-                                                           "single_layer"]),
     ({"single_layer": {"theta_deg": 20.0}}, ["single_layer.theta_deg", "must be 0"]),
     ({"single_layer": {"slope_azimuth_deg": 30.0}}, ["single_layer.slope_azimuth_deg",
                                                      "must be 0"]),

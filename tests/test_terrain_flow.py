@@ -164,7 +164,8 @@ def test_the_energy_line_bounds_the_travel_angle_on_the_parabola():
 
 def test_a_bed_is_refused_with_one_line_where_it_cannot_run():
     """Before any work: a bed on a 1D grid, with a slope angle or azimuth, with MUSCL,
-    under the two-layer model, of the wrong shape, not finite, or with cfl > 0.5."""
+    under a model without kernels over a bed, of the wrong shape, not finite, or with
+    cfl > 0.5."""
     grid = CartesianGrid([[0, 10], [0, 10]], [5, 5])
     bed = np.zeros((6, 6))
     h = np.ones((5, 5))
@@ -177,8 +178,15 @@ def test_a_bed_is_refused_with_one_line_where_it_cannot_run():
         pdeflow.SingleLayerGranular(slope_azimuth_deg=10, bed=bed)
     with pytest.raises(ValueError, match=r"^reconstruction must be 'first-order' over a"):
         pdeflow.SingleLayerGranular(scheme="hll/muscl", bed=bed)
-    with pytest.raises(ValueError, match=r"^bed: the two layers? model does not flow"):
-        pdeflow.TwoLayerGranular(bed=bed)
+    from types import SimpleNamespace
+
+    from pdeflow.models.bed import check_bed
+
+    no_bed = SimpleNamespace(label="toy", kernels_2d=True,
+                             kernels_for=lambda p, axes: SimpleNamespace(terrain=None))
+    toy = SimpleNamespace(system=no_bed, parameters=None, scheme=None)
+    with pytest.raises(ValueError, match=r"^bed: the toy model does not flow over a bed"):
+        check_bed(toy, bed)
     with pytest.raises(ValueError, match=r"^bed must give the elevation at the grid's "
                                          r"6 x 6 cell corners, got shape \(5, 5\)$"):
         pdeflow.SingleLayerGranular(bed=np.zeros((5, 5)), bc=WALLS).make_state(grid, h=h)

@@ -4,7 +4,8 @@ The bed is given at the 2D grid's cell corners, an (nx + 1, ny + 1) array of
 elevations [m], or as a function z_b(x, y) [m] of the corners' coordinates
 (:func:`pdeflow.numerics.geometry.bed_at_corners`). Over a bed depths are vertical and the
 slope is the bed's: theta_deg and slope_azimuth_deg are 0, and the scheme's
-reconstruction is first order (:mod:`pdeflow.models.single_layer.terrain`).
+reconstruction is first order (:mod:`pdeflow.models.single_layer.terrain`,
+:mod:`pdeflow.models.two_layer.terrain`).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from typing import Any
 def check_bed(pde: Any, bed: Any) -> Any:
     """``bed``, or ValueError, one line naming the parameter, unless the model and
     scheme of the granular PDE ``pde`` can flow over it: a model with kernels over a
-    bed (the single layer), theta_deg and slope_azimuth_deg 0 and a first-order
+    bed (both of pdeflow's), theta_deg and slope_azimuth_deg 0 and a first-order
     reconstruction (None passes)."""
     if bed is None:
         return None
@@ -23,8 +24,8 @@ def check_bed(pde: Any, bed: Any) -> Any:
     kernels_2d = system.kernels_for(pde.parameters, 2) \
         if getattr(system, "kernels_2d", None) is not None else None
     if kernels_2d is None or kernels_2d.terrain is None:
-        raise ValueError(f"bed: the {system.label} model does not flow over a bed yet; "
-                         "only the single layer does")
+        raise ValueError(f"bed: the {system.label} model does not flow over a bed (it "
+                         "has no kernels over one)")
     for name in ("theta_deg", "slope_azimuth_deg"):
         value = getattr(pde.parameters, name)
         if value != 0.0:

@@ -41,6 +41,7 @@ import numpy as np
 from numba import njit, prange
 
 from . import layout as L
+from .bed_slope import bed_slope
 from .boxes import box_grow, box_of, rows_of, zero_box
 from .compiled import FIELDS, METRIC, STATE, WORK, cached, f8, i8, kernel, specialise
 from .geometry import area_change, area_change_muscl
@@ -273,8 +274,9 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
     ``r_lo..r_hi``, the axis' faces next to ``lo..hi`` (:func:`_faces_function`), the
     MUSCL cell jump along the axis; with ``lines`` (a 2D grid of ``per_row`` cells a
     row) ``lo, hi`` and ``r_lo, r_hi`` are boxes (:mod:`pdeflow.numerics.boxes`).
-    ``terrain``: over a bed, the model's face values and cell term over it
-    (:attr:`ModelKernels.terrain`) in place of MUSCL's."""
+    ``terrain``: over a bed, the model's face values over it
+    (:attr:`ModelKernels.terrain`) in place of MUSCL's, and the cell term with the
+    bed's slope (:mod:`.bed_slope`)."""
     check_flux(model, flux)
     rows = model.axis_rows(axis)
     width = model.layer_rows
@@ -283,8 +285,8 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
     normal = rows[1]  # the row of a layer's momentum normal to the axis' faces
     # the MUSCL kernels, only where they are called (see compiled.ready)
     reconstruct = reconstruction(width, normal) if muscl else None
-    cell_jump = model.cell_jump if muscl else None
-    bed_faces, bed_jump = model.terrain if terrain else (None, None)
+    cell_jump = model.cell_jump if muscl or terrain else None
+    bed_faces = model.terrain if terrain else None
 
     def along(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count, inv_dx, bc_lo,
               bc_hi, g, r, dry, per_row):
@@ -315,8 +317,9 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
                           dry, axis)
         elif terrain:
             for x in prange(x0, x1 + 1):
-                bed_jump(qm, qp, rate, metric, x * per_row + y0, x * per_row + y1, inv_dx,
-                         g, dry, axis)
+                lo_x, hi_x = x * per_row + y0, x * per_row + y1
+                cell_jump(qm, qp, rate, lo_x, hi_x, inv_dx, g, r, dry, axis)
+                bed_slope(qm, qp, rate, metric, lo_x, hi_x, inv_dx, g, width, normal, axis)
         return smax
 
     return along

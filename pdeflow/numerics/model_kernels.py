@@ -63,10 +63,10 @@ class ModelKernels:
     """2D: ``fold(diag, book)`` adds a row's booking (:attr:`sources` from zeros) to
     ``diag``'s model slots, called in row order (:func:`.threads.box_kernels`)"""
     terrain: Any = None
-    """2D over a bed (layout.GEOMETRY_TERRAIN_2D): ``(reconstruct, jump)``, the face
-    values ``reconstruct(q, work, metric, lo, hi, axis, dry)`` of cells lo..hi and the
-    cell term ``jump(qm, qp, rate, metric, lo, hi, inv_dx, g, dry, axis)`` with the
-    bed's slope; None: the model does not flow over a bed"""
+    """2D over a bed (layout.GEOMETRY_TERRAIN_2D): the face values of cells lo..hi
+    with free surface and interfaces flat, ``reconstruct(q, work, metric, lo, hi, axis,
+    dry)`` (the cell term is :attr:`cell_jump` and :mod:`.bed_slope`); None: the model
+    does not flow over a bed"""
     layer_rows: int = 2
     """rows per layer: its depth, then its discharge along each axis"""
     rows: tuple[tuple[int, ...], ...] = ()

@@ -17,7 +17,7 @@ from .flux import cell_jump, face, fluctuations
 from .rates import fluctuations_np, source_rate, source_rate_np
 from .sources import stage_kernels
 from .sources_2d import fold_single_2d, source_rate_2d, stage_kernels_2d
-from .terrain import bed_jump, reconstruct_bed
+from .terrain import reconstruct_bed
 
 
 def _constants(P: np.ndarray) -> tuple[float, float, float]:
@@ -62,5 +62,5 @@ def kernels_2d(law: BasalLaw | None = None) -> ModelKernels:
         cell_jump=two_d.cell_jump, sources=sources, source_stage=source_stage,
         predictor=predictor, mol_sources=source_rate_2d(law),
         numpy_advection=_no_numpy_twin_2d, numpy_sources=_no_numpy_twin_2d,
-        constants=_constants, fold=fold_single_2d, terrain=(reconstruct_bed, bed_jump),
+        constants=_constants, fold=fold_single_2d, terrain=reconstruct_bed,
         layer_rows=3, rows=two_d.ROWS)

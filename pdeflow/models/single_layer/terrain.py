@@ -21,7 +21,8 @@ each cell the free surface h + z_b is taken flat, so the face depths are
 and where that would make one negative (a layer thinner than half the bed's rise across
 the cell) the surface is tilted so that that face is dry and the other face holds 2h.
 Face momenta are the face depths times the cell's velocity. The cell term, the total
-jump across the reconstruction inside the cell along an axis, is
+jump across the reconstruction inside the cell along an axis, is the MUSCL cell jump
+(:func:`.two_d.cell_jump`) and the bed's slope (:mod:`pdeflow.numerics.bed_slope`),
 
 .. math:: \mathcal{A} = f(q^+) - f(q^-) + g \bar h\,(z_b^+ - z_b^-),
           \qquad \bar h = (h^- + h^+)/2 = h,
@@ -66,26 +67,3 @@ def reconstruct_bed(q, work, metric, lo, hi, axis, dry):
         work[1, 0, i] = hp
         work[1, 1, i] = hp * u
         work[1, 2, i] = hp * v
-
-
-@cached
-def bed_jump(qm, qp, rate, metric, lo, hi, inv_dx, g, dry, axis):
-    """Subtract the cell term along ``axis`` (module docstring) from ``rate`` in cells
-    lo..hi: the flux difference across the face values ``qm`` (low face), ``qp`` (high
-    face) with the pressure and the bed's slope as g h d(h + z_b); ``inv_dx`` [1/m]."""
-    n = 1 + axis
-    t = 2 - axis
-    z_lo = L.M_BED + 2 * axis
-    for i in range(lo, hi + 1):
-        hl, hr = qm[0, i], qp[0, i]
-        if hl == 0.0 and hr == 0.0:
-            continue
-        ul = velocity(hl, qm[n, i], dry)
-        ur = velocity(hr, qp[n, i], dry)
-        vl = velocity(hl, qm[t, i], dry)
-        vr = velocity(hr, qp[t, i], dry)
-        rise = metric[z_lo + 1, i] - metric[z_lo, i]
-        rate[0, i] -= (ur * hr - ul * hl) * inv_dx
-        rate[n, i] -= (ur * ur * hr - ul * ul * hl
-                       + g * 0.5 * (hl + hr) * ((hr - hl) + rise)) * inv_dx
-        rate[t, i] -= (ur * hr * vr - ul * hl * vl) * inv_dx

@@ -18,6 +18,7 @@ from .rates import fluctuations_np, source_rate, source_rate_np
 from .rates_2d import source_rate_2d
 from .sources import stage_kernels
 from .sources_2d import fold_two_layer_2d, stage_kernels_2d
+from .terrain import reconstruct_bed
 
 
 def _constants(P: np.ndarray) -> tuple[float, float, float]:
@@ -54,14 +55,14 @@ def kernels_2d(law: BasalLaw | None = None, directions: str = "all") -> ModelKer
     :mod:`.two_d`, the source stages of :mod:`.sources_2d` (hyperbolicity restored in
     ``directions`` 'all' or, as in 1D, along the 'flow') and the method-of-lines rate
     of :mod:`.rates_2d`, with the basal law ``law`` (None: the paper's Coulomb
-    friction at the bed)."""
+    friction at the bed); over a bed the face values of :mod:`.terrain`."""
     sources, source_stage, predictor = stage_kernels_2d(law, directions)
     return ModelKernels(
         fields=6, face=two_d.face, fluctuations=two_d.fluctuations,
         cell_jump=two_d.cell_jump, sources=sources, source_stage=source_stage,
         predictor=predictor, mol_sources=source_rate_2d(law), numpy_advection=_no_numpy_twin,
         numpy_sources=_no_numpy_twin, constants=_constants, fold=fold_two_layer_2d,
-        layer_rows=two_d.LAYER_ROWS, rows=two_d.ROWS)
+        terrain=reconstruct_bed, layer_rows=two_d.LAYER_ROWS, rows=two_d.ROWS)
 
 
 KERNELS = kernels()
