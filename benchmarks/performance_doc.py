@@ -12,6 +12,7 @@ import layer_cost
 import pyclaw_2d
 import start_up
 import study_scaling
+import terrain_path
 from doc_tables import conditions_text, fmt, verdict
 from render_bench import hyperbolicity_share, render_bench
 from render_wp import crawl, render_wp
@@ -22,6 +23,7 @@ SECTIONS: dict[str, tuple[Any, str, int]] = {
     "bed": (bed_cost, "bed.json", 7),
     "layers": (layer_cost, "layers.json", 9),
     "pyclaw2d": (pyclaw_2d, "pyclaw_2d.json", 5),
+    "terrain": (terrain_path, "terrain_path.json", 1),
 }
 """the parts that are one module each: ``--only NAME`` -> (the module, with
 ``measure(repeats)`` and ``render(data)``; its stored results; the least repeats), in

@@ -107,6 +107,44 @@ def run(grid, corners, depth, phi: float, threads: int, t_end: float, interval: 
     return end, peaks.peak, time.perf_counter() - start, info, stop
 
 
+def measure_path(root: Path, path: str = "avaHit", phi: float = 20.0,
+                 thickness: float = 1.0, threads: int = 2, t_end: float = 600.0,
+                 interval: float = 0.5, stop_energy: float = 0.01) -> dict:
+    """The run of AvaFrame's ``path`` under the checkout ``root`` (module docstring) and
+    its numbers: grid, release, wall time, steps, how and when it ended, the mass
+    centre's travel angle, affected area, peaks, the mass on filled no-data cells and
+    the load average; ``"_arrays"`` holds what the figure and rasters need."""
+    grid, corners, beds, off, polygons, dem = load(root, path)
+    dx, dy = grid.discretization
+    xc, yc = grid.axes_coords
+    mask = release_mask(polygons, xc, yc, dem)
+    depth = vertical_thickness(mask, thickness, beds, dx, dy)
+    end, peak, wall, info, stop = run(grid, corners, depth, phi, threads, t_end, interval,
+                                      stop_energy)
+    h = end.data[0]
+    x = xc[:, None] * np.ones(grid.shape)
+    y = yc[None, :] * np.ones(grid.shape)
+    mass0, mass = depth.sum(), h.sum()
+    drop = (depth * beds).sum() / mass0 - (h * beds).sum() / mass
+    travel = math.hypot((h * x).sum() / mass - (depth * x).sum() / mass0,
+                        (h * y).sum() / mass - (depth * y).sum() / mass0)
+    rest = bool(np.all(end.data[1:] == 0.0))
+    return {"path": path, "cells": list(grid.shape), "dx": float(dx),
+            "released_cells": int(mask.sum()), "volume_m3": float(mass0 * dx * dy),
+            "phi_deg": phi, "threads": threads, "wall_s": wall,
+            "steps": int(info["solver"]["steps"]),
+            "t_end_s": float(info["controller"].get("t_final", float("nan"))),
+            "ended": "at rest" if rest else (
+                f"kinetic energy < {stop_energy:g} of its peak"
+                if stop.stopped_at is not None else "t_end"),
+            "travel_angle_deg": math.degrees(math.atan2(drop, travel)),
+            "affected_ha": float(np.count_nonzero(peak[0] > AFFECTED) * dx * dy / 1e4),
+            "peak_depth_m": float(peak[0].max()), "peak_speed_m_s": float(peak[1].max()),
+            "peak_pressure_kpa": float(peak[2].max()),
+            "mass_on_fill": float(h[off].sum() / mass), "load_avg": os.getloadavg(),
+            "_arrays": (xc, yc, dx, dy, beds, peak, dem.crs)}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--avaframe", type=Path, required=True,
@@ -124,44 +162,26 @@ def main() -> None:
                         help="peak fields sampled every ... [s]")
     parser.add_argument("--out", type=Path, help="directory for rasters and figure")
     args = parser.parse_args()
-    grid, corners, beds, off, polygons, dem = load(args.avaframe, args.path)
-    dx, dy = grid.discretization
-    xc, yc = grid.axes_coords
-    mask = release_mask(polygons, xc, yc, dem)
-    depth = vertical_thickness(mask, args.thickness, beds, dx, dy)
-    end, peak, wall, info, stop = run(grid, corners, depth, args.phi, args.threads,
-                                      args.t_end, args.interval, args.stop_energy)
-    h = end.data[0]
-    x = xc[:, None] * np.ones(grid.shape)
-    y = yc[None, :] * np.ones(grid.shape)
-    mass0, mass = depth.sum(), h.sum()
-    drop = (depth * beds).sum() / mass0 - (h * beds).sum() / mass
-    travel = math.hypot((h * x).sum() / mass - (depth * x).sum() / mass0,
-                        (h * y).sum() / mass - (depth * y).sum() / mass0)
-    print(f"{args.path}: {grid.shape[0]} x {grid.shape[1]} cells of {dx:.3f} m, "
-          f"{int(mask.sum())} released ({mass0 * dx * dy:.0f} m^3), phi {args.phi:g} deg, "
-          f"{args.threads} threads, load {os.getloadavg()[0]:.2f}")
-    rest = bool(np.all(end.data[1:] == 0.0))
-    why = "at rest" if rest else (
-        f"kinetic energy < {args.stop_energy:g} of its peak" if stop.stopped_at is not None
-        else "t_end")
-    t_end = info["controller"].get("t_final", float("nan"))
-    print(f"  wall {wall:.2f} s, {info['solver']['steps']} steps, ended at t = "
-          f"{t_end:.1f} s ({why}), at rest: {rest}")
-    print(f"  mass centre: drop {drop:.1f} m over {travel:.1f} m, travel angle "
-          f"{math.degrees(math.atan2(drop, travel)):.2f} deg")
-    print(f"  affected area (peak depth > {AFFECTED:g} m) "
-          f"{np.count_nonzero(peak[0] > AFFECTED) * dx * dy / 1e4:.2f} ha; peak depth "
-          f"{peak[0].max():.2f} m, speed {peak[1].max():.1f} m/s, pressure "
-          f"{peak[2].max():.0f} kPa; mass on filled no-data cells "
-          f"{h[off].sum() / mass:.2%}")
+    r = measure_path(args.avaframe, args.path, args.phi, args.thickness, args.threads,
+                     args.t_end, args.interval, args.stop_energy)
+    print(f"{r['path']}: {r['cells'][0]} x {r['cells'][1]} cells of {r['dx']:.3f} m, "
+          f"{r['released_cells']} released ({r['volume_m3']:.0f} m^3), phi "
+          f"{r['phi_deg']:g} deg, {r['threads']} threads, load {r['load_avg'][0]:.2f}")
+    print(f"  wall {r['wall_s']:.2f} s, {r['steps']} steps, ended at t = {r['t_end_s']:.1f}"
+          f" s ({r['ended']}), at rest: {r['ended'] == 'at rest'}")
+    print(f"  mass centre travel angle {r['travel_angle_deg']:.2f} deg")
+    print(f"  affected area (peak depth > {AFFECTED:g} m) {r['affected_ha']:.2f} ha; peak "
+          f"depth {r['peak_depth_m']:.2f} m, speed {r['peak_speed_m_s']:.1f} m/s, pressure "
+          f"{r['peak_pressure_kpa']:.0f} kPa; mass on filled no-data cells "
+          f"{r['mass_on_fill']:.2%}")
     if args.out:
         from pdeflow.terrain_figures import hillshade_figure
 
+        xc, yc, dx, dy, beds, peak, crs = r["_arrays"]
         args.out.mkdir(parents=True, exist_ok=True)
-        peak_rasters(peak, xc[0] - dx / 2, yc[0] - dy / 2, dx, args.out, dem.crs)
+        peak_rasters(peak, xc[0] - dx / 2, yc[0] - dy / 2, dx, args.out, crs)
         extent = (xc[0] - dx / 2, xc[-1] + dx / 2, yc[0] - dy / 2, yc[-1] + dy / 2)
-        hillshade_figure(beds, peak[0], extent, args.out / f"{args.path}_peak_depth.png",
+        hillshade_figure(beds, peak[0], extent, args.out / f"{r['path']}_peak_depth.png",
                          "peak depth [m]", threshold=AFFECTED)
 
 

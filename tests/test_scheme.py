@@ -103,7 +103,8 @@ def test_a_run_derives_its_grids_metric_once(monkeypatch):
 
     calls = []
     real = base.metric_of
-    monkeypatch.setattr(base, "metric_of", lambda grid: calls.append(grid) or real(grid))
+    monkeypatch.setattr(base, "metric_of",
+                        lambda grid, bed=None: calls.append(grid) or real(grid, bed))
     case = load_case(CASES / "ritter_dam_break.toml", ["grid.cells=20",
                                                       "case.t_end=0.05"])
     run = Run(case, "single_layer")
