@@ -35,3 +35,35 @@ def bed_slope(qm: np.ndarray, qp: np.ndarray, rate: np.ndarray, metric: np.ndarr
         rise = metric[z_lo + 1, i] - metric[z_lo, i]
         for k in range(0, qm.shape[0], width):
             rate[k + normal, i] -= g * 0.5 * (qm[k, i] + qp[k, i]) * rise * inv_dx
+
+
+# --- what the models' reconstructions over a bed share ------------------------------------
+
+@cached(inline="always")
+def surface_half_rise(w: float, w_low: float, w_high: float) -> float:
+    """Half the rise [m] of a surface across a cell whose value is ``w`` and its
+    neighbours' ``w_low``, ``w_high`` along the axis: half the minmod of the one-sided
+    differences (0 at an extremum)."""
+    a = w - w_low
+    b = w_high - w
+    if a * b <= 0.0:
+        return 0.0
+    return 0.5 * (a if abs(a) < abs(b) else b)
+
+
+@cached(inline="always")
+def clamped(s: float, base: float) -> float:
+    """``s`` clamped between 0 (a flat surface) and ``base`` (a surface parallel to the
+    layer's base, whose half rise across the cell ``base`` is) [m]."""
+    return min(max(s, min(base, 0.0)), max(base, 0.0))
+
+
+@cached(inline="always")
+def tilted(h: float, hm: float, hp: float) -> tuple[float, float]:
+    """(low, high) face depths ``hm``, ``hp`` [m] of a layer of depth ``h``, tilted to
+    (0, 2h) or (2h, 0) where one would be negative (Kurganov & Petrova's positivity)."""
+    if hm < 0.0:
+        return 0.0, 2.0 * h
+    if hp < 0.0:
+        return 2.0 * h, 0.0
+    return hm, hp
