@@ -418,3 +418,30 @@ def test_a_terrain_case_run_writes_its_peak_outputs(tmp_path):
     assert (tmp_path / "peak_depth.png").is_file()
     with pytest.raises(CaseError, match=r"terrain.flow_density must lie in \(0, inf\)"):
         load_case(case, ["terrain.flow_density=0"])
+
+
+def test_a_dem_case_writes_peak_rasters_in_the_dem_s_place_and_crs(tmp_path: Path):
+    """A case over a DEM with a .prj (the grid on part of it, terrain.x0, y0): ``pdeflow
+    run`` writes the peak rasters with the grid's corner at (x0, y0) on the map, the
+    DEM's CRS in their .prj, and cells of the grid's size."""
+    import subprocess
+    import sys
+
+    from pdeflow.terrain import read_raster
+
+    crs = 'LOCAL_CS["test metres",UNIT["metre",1]]'
+    path = plane_dem(tmp_path)
+    path.with_suffix(".prj").write_text(crs + "\n")
+    (tmp_path / "c.toml").write_text(
+        '[case]\nmodels = ["single_layer"]\nt_end = 5.0\n'
+        '[grid]\nlength = 200.0\nwidth = 100.0\ndx = 10.0\n'
+        '[initial]\nshape = "box"\nx0 = 60.0\ny0 = 50.0\nsemi_x = 20.0\nsemi_y = 20.0\n'
+        'H0 = 1.0\n'
+        f'[terrain]\nbed = "{path.name}"\nx0 = 3.0\ny0 = -61.0\n')
+    subprocess.run([sys.executable, "-m", "pdeflow", "run", str(tmp_path / "c.toml"),
+                    "--out", str(tmp_path / "out")], check=True, capture_output=True,
+                   text=True)
+    depth = read_raster(tmp_path / "out" / "peak_depth.asc")
+    assert (depth.x_corner, depth.y_corner, depth.cellsize) == (3.0, -61.0, 10.0)
+    assert depth.values.shape == (10, 20) and depth.values.max() > 0.5
+    assert depth.crs is not None and depth.crs.strip() == crs
