@@ -91,7 +91,9 @@ def _is_run_file(path: Path) -> bool:
     """A file a run writes into its folder (or a temporary one left by a killed run)."""
     if path.name.startswith(".") and ".part" in path.name:
         return True
-    return path.is_file() and (path.name == "summary.json" or path.suffix == ".png")
+    return path.is_file() and (path.name == "summary.json" or path.suffix == ".png"
+                               or (path.name.startswith("peak_")  # a run over a bed's
+                                   and path.suffix in (".asc", ".prj")))
 
 
 def _is_run_summary(path: Path) -> bool:
@@ -105,8 +107,8 @@ def _is_run_summary(path: Path) -> bool:
 
 def check_run_folder(path: Path, option: str) -> None:
     """Raise :class:`OutputError` unless the run may replace ``path`` as a whole: it does
-    not exist, is empty, or is an earlier run's folder (its ``summary.json`` and
-    figures, nothing else); it is not the working directory or above it."""
+    not exist, is empty, or is an earlier run's folder (its ``summary.json``, figures
+    and peak rasters, nothing else); it is not the working directory or above it."""
     if not path.exists():
         return
     if Path.cwd().resolve().is_relative_to(path.resolve()):
