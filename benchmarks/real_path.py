@@ -129,7 +129,12 @@ def measure_path(root: Path, path: str = "avaHit", phi: float = 20.0,
     travel = math.hypot((h * x).sum() / mass - (depth * x).sum() / mass0,
                         (h * y).sum() / mass - (depth * y).sum() / mass0)
     rest = bool(np.all(end.data[1:] == 0.0))
-    return {"path": path, "cells": list(grid.shape), "dx": float(dx),
+    moving = np.any(end.data[1:] != 0.0, axis=0)
+    slope = np.degrees(np.arctan(np.hypot(*np.gradient(beds, dx, dy))))[moving]
+    return {"moving_mass": float(h[moving].sum() / mass),
+            "moving_slopes_deg": [float(np.min(slope)), float(np.median(slope)),
+                                  float(np.max(slope))] if slope.size else None,
+            "path": path, "cells": list(grid.shape), "dx": float(dx),
             "released_cells": int(mask.sum()), "volume_m3": float(mass0 * dx * dy),
             "phi_deg": phi, "threads": threads, "wall_s": wall,
             "steps": int(info["solver"]["steps"]),
@@ -169,6 +174,10 @@ def main() -> None:
           f"{r['phi_deg']:g} deg, {r['threads']} threads, load {r['load_avg'][0]:.2f}")
     print(f"  wall {r['wall_s']:.2f} s, {r['steps']} steps, ended at t = {r['t_end_s']:.1f}"
           f" s ({r['ended']}), at rest: {r['ended'] == 'at rest'}")
+    if r["moving_slopes_deg"]:
+        lo, mid, hi = r["moving_slopes_deg"]
+        print(f"  still moving: {r['moving_mass']:.2%} of the mass, on slopes of "
+              f"{lo:.0f}-{hi:.0f} deg (median {mid:.0f})")
     print(f"  mass centre travel angle {r['travel_angle_deg']:.2f} deg")
     print(f"  affected area (peak depth > {AFFECTED:g} m) {r['affected_ha']:.2f} ha; peak "
           f"depth {r['peak_depth_m']:.2f} m, speed {r['peak_speed_m_s']:.1f} m/s, pressure "
