@@ -30,8 +30,9 @@ between the start and the end; the largest peak thickness, speed (pdeflow's hori
 speed, com1DFA's along the surface) and pressure (200 kg/m^3 times speed^2, kPa); the
 area (horizontal) where the peak thickness exceeds ``THRESHOLD``.
 
-Run: ``python benchmarks/terrain_vs_com1dfa.py [--path parabola] [--dx 20 10 5]
-[--avaframe-python /tmp/ava_venv/bin/python] [--voellmy 0.155 4000]``.
+Run: ``python benchmarks/terrain_vs_com1dfa.py [--path parabola|hockey]
+[--dx 20 10 5 2.5] [--avaframe-python /tmp/ava_venv/bin/python] [--stop-crit 0.01 0]
+[--voellmy 0.155 4000]``.
 Units: lengths [m], angles [deg], speeds [m/s], pressures [kPa], times [s].
 """
 
@@ -78,7 +79,6 @@ THRESHOLD = 0.1  #: peak thickness (slope-normal) counted as reached [m]
 DENSITY = 200.0  #: [kg/m^3], com1DFA's rho
 PEAK_INTERVAL = 0.1  #: [s], com1DFA's dt
 DRY = 1e-6  #: [m]
-HALF_WIDTH = 300.0  #: pdeflow's domain reaches |y| <= HALF_WIDTH + dx/2 [m]
 T_MAX = 600.0  #: pdeflow's runs end at rest, at the latest here [s]
 NO_AVAFRAME = ("AvaFrame is not available (pip install avaframe in its own environment, "
                "it pins numpy < 2; give its python with --avaframe-python): pdeflow only")
@@ -86,18 +86,24 @@ NO_AVAFRAME = ("AvaFrame is not available (pip install avaframe in its own envir
 
 @dataclass(frozen=True)
 class AvalanchePath:
-    """An idealised path: its bed z(x, y) [m], the DEM's extent x in [0, ``dem_length``],
-    |y| <= ``dem_half_width`` and pdeflow's domain length ``length`` [m] (from x = 0)."""
+    """An idealised path: its bed z(x, y) [m], the DEM's cell centres x in [0,
+    ``dem_length``], |y| <= ``dem_half_width``, and pdeflow's domain x in [0,
+    ``length``], |y| <= ``half_width`` + dx/2 [m]; com1DFA's ``tEnd`` [s] (beyond the
+    time the mass needs to stop)."""
 
     name: str
     bed: Any
     dem_length: float
     dem_half_width: float
     length: float
+    half_width: float
+    t_end: float
 
 
-PATHS = {"parabola": AvalanchePath("parabola", parabola, 3000.0, 500.0, 2600.0),
-         "hockey": AvalanchePath("hockey", hockey_stick, 5500.0, 500.0, 5200.0)}
+PATHS = {"parabola": AvalanchePath("parabola", parabola, 3000.0, 500.0, 2600.0, 300.0,
+                                   120.0),
+         "hockey": AvalanchePath("hockey", hockey_stick, 5500.0, 500.0, 5200.0, 300.0,
+                                 200.0)}
 
 
 def write_dem(path: AvalanchePath, file: str | Path, cellsize: float = DEM_CELL) -> Raster:
@@ -126,7 +132,7 @@ def pdeflow_setup(raster: Raster, path: AvalanchePath, dx: float,
                   voellmy: tuple[float, float] | None = None) -> tuple[Any, Any, dict]:
     """(model, initial state, geometry) of the path on cells dx [m]: the bed from the
     DEM at the corners, the release's slope-normal thickness made vertical."""
-    ny = 2 * round(HALF_WIDTH / dx) + 1  # odd: a column of cells on the axis y = 0
+    ny = 2 * round(path.half_width / dx) + 1  # odd: a column of cells on the axis y = 0
     grid = CartesianGrid([[0.0, path.length], [-ny * dx / 2, ny * dx / 2]],
                          [round(path.length / dx), ny])
     corners = bed_on_grid(raster, *corner_coordinates(grid))
@@ -190,9 +196,10 @@ def avaframe_python(given: str | None) -> str | None:
     return None
 
 
-def com1dfa_run(exe: str, dem: Path, voellmy: tuple[float, float] | None = None,
-                stop_crit: float = 0.01) -> dict[str, Any]:
-    """com1DFA on the DEM file ``dem`` (``benchmarks/avaframe_paths.py``): its peak
+def com1dfa_run(exe: str, dem: Path, t_end: float, stop_crit: float = 0.01,
+                voellmy: tuple[float, float] | None = None) -> dict[str, Any]:
+    """com1DFA on the DEM file ``dem`` (``benchmarks/avaframe_paths.py``) with ``tEnd``
+    = ``t_end`` [s] and ``stopCrit`` = ``stop_crit`` (0: run to ``t_end``): its peak
     rasters, mass centres and wall time in the form of :func:`measures`."""
     x0, x1, y0, y1 = RELEASE
     law = (["--mu", repr(voellmy[0]), "--xi", repr(voellmy[1])] if voellmy else
@@ -202,13 +209,15 @@ def com1dfa_run(exe: str, dem: Path, voellmy: tuple[float, float] | None = None,
         proc = subprocess.run([exe, str(ROOT / "benchmarks" / "avaframe_paths.py"),
                                str(dem), str(out), "--release", *map(repr, RELEASE),
                                "--rel-th", repr(REL_TH), "--stop-crit", repr(stop_crit),
+                               "--t-end", repr(t_end),
                                *law], capture_output=True, text=True)
         if proc.returncode != 0:
             raise RuntimeError(f"com1DFA's run failed:\n{proc.stderr[-2000:]}")
         d = {k: v for k, v in np.load(out).items()}
     cs = float(d["cellsize"])
     rows, cols = d["pft"].shape
-    return {"code": "com1DFA", "size": f"{int(d['n_part'])} particles, {cs:g} m mesh",
+    return {"code": "com1DFA", "size": f"{int(d['n_part'])} particles, {cs:g} m mesh, "
+                                        f"stopCrit {stop_crit:g}",
             "dx": cs, "x": float(d["xllcenter"]) + cs * np.arange(cols),
             "y": float(d["yllcenter"]) + cs * np.arange(rows),
             **{k: d[k].T for k in ("pft", "pfv", "ppr")},  # (x, y) as pdeflow's
@@ -277,11 +286,12 @@ def converged_lines(rows: list[dict[str, Any]]) -> list[str]:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--path", choices=sorted(PATHS), default="parabola")
-    ap.add_argument("--dx", type=float, nargs="+", default=[20.0, 10.0, 5.0],
+    ap.add_argument("--dx", type=float, nargs="+", default=[20.0, 10.0, 5.0, 2.5],
                     help="pdeflow's cell sizes [m]")
     ap.add_argument("--avaframe-python", default=None)
     ap.add_argument("--voellmy", type=float, nargs=2, default=None, metavar=("MU", "XI"))
-    ap.add_argument("--stop-crit", type=float, default=0.01, help="com1DFA's stopCrit")
+    ap.add_argument("--stop-crit", type=float, nargs="+", default=[0.01, 0.0],
+                    help="com1DFA's stopCrit, a run each (0: to the path's tEnd)")
     args = ap.parse_args(argv)
     path = PATHS[args.path]
     law = (f"Voellmy mu {args.voellmy[0]:g}, xi {args.voellmy[1]:g} m/s^2"
@@ -299,8 +309,8 @@ def main(argv: list[str] | None = None) -> int:
         if exe is None:
             print(NO_AVAFRAME)
         else:
-            rows.append(measures(com1dfa_run(exe, dem, args.voellmy, args.stop_crit),
-                                 path))
+            rows += [measures(com1dfa_run(exe, dem, path.t_end, sc, args.voellmy), path)
+                     for sc in args.stop_crit]
         dxs = sorted(args.dx, reverse=True)
         compile_kernels(raster, path, dxs[0], args.voellmy)
         rows += [measures(pdeflow_run(raster, path, dx, args.voellmy), path)
