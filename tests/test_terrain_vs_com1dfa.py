@@ -28,8 +28,9 @@ def tv():
 
 def test_pdeflow_side_on_a_coarse_grid_runs_out_onto_the_flat(tv, tmp_path):
     """40 m cells: the run ends at rest with its run-out on the axis beyond the
-    parabola's foot (1482.6 m) and inside the domain, its travel angles above the
-    friction angle (the energy line's bound) and below the path's mean slope, the
+    parabola's foot (1482.6 m) and inside the domain, the mass centre's travel angle
+    above the friction angle (the energy line's bound) and below the path's mean slope,
+    the front's from the release's top below it (the front runs farther), the
     volume released slope-normal 1 m over the rectangle (to the cells' share), and one
     table row with the run-out."""
     path = tv.PATHS["parabola"]
@@ -41,7 +42,7 @@ def test_pdeflow_side_on_a_coarse_grid_runs_out_onto_the_flat(tv, tmp_path):
     row = tv.measures(run, path)
     assert foot < row["runout"] < path.length
     assert tv.PHI_DEG < row["centre_angle"] < 34.0
-    assert tv.PHI_DEG < row["runout_angle"] < 34.0
+    assert 20.0 < row["runout_angle"] < row["centre_angle"]  # the front runs farther
     assert row["pft"] > tv.THRESHOLD and row["area"] > 0.0 and row["t_end"] > 10.0
     _, state, geo = tv.pdeflow_setup(raster, path, 40.0)
     volume = state.data[0].sum() * 40.0 ** 2

@@ -20,7 +20,12 @@ each cell the free surface h + z_b is taken flat, so the face depths are
 
 and where that would make one negative (a layer thinner than half the bed's rise across
 the cell) the surface is tilted so that that face is dry and the other face holds 2h.
-Face momenta are the face depths times the cell's velocity. The cell term, the total
+The face deeper than the cell carries the cell's momentum (hu, hv), its velocity
+scaled by h / h^\pm (Kurganov & Petrova's first order: the momentum is not
+reconstructed); the shallower face the cell's velocity. So no face sends more mass
+than the cell's momentum and the mass centre moves with the momentum, d/dt sum h x =
+sum hu (with the face depths times the cell's velocity it moved at (1 + |d|/h) u,
+twice u in the tilted regime: a thin avalanche ran ahead of its momentum). The cell term, the total
 jump across the reconstruction inside the cell along an axis, is
 
 .. math:: \mathcal{A} = f(q^+) - f(q^-) + g \bar h\,(z_b^+ - z_b^-),
@@ -60,12 +65,16 @@ def reconstruct_bed(q, work, metric, lo, hi, axis, dry):
             hp = 0.0
         u = velocity(h, q[1, i], dry)
         v = velocity(h, q[2, i], dry)
+        um = u * h / hm if hm > h else u  # the thicker face: the cell's momentum
+        vm = v * h / hm if hm > h else v
+        up = u * h / hp if hp > h else u
+        vp = v * h / hp if hp > h else v
         work[0, 0, i] = hm
-        work[0, 1, i] = hm * u
-        work[0, 2, i] = hm * v
+        work[0, 1, i] = hm * um
+        work[0, 2, i] = hm * vm
         work[1, 0, i] = hp
-        work[1, 1, i] = hp * u
-        work[1, 2, i] = hp * v
+        work[1, 1, i] = hp * up
+        work[1, 2, i] = hp * vp
 
 
 @cached
