@@ -142,8 +142,9 @@ def test_the_energy_line_bounds_the_travel_angle_on_the_parabola():
     """AvaFrame's energy-line idea on its parabolic path (fall height 1000 m, mean slope
     34 deg; a strip of 4 cells across, walls): friction dissipates at least mu g times
     the mass centre's horizontal travel, so the mass centre's travel angle is at least
-    the friction angle (25 deg). Measured in docs/terrain.md: 25.4-25.5 deg (before
-    the mass flux was made the momentum, 27.4-28.7 deg: the test below)."""
+    the friction angle (25 deg). Measured in docs/terrain.md: 25.05-25.14 deg, the
+    excess falling with the grid (with each cell's surface flat, 27.4-28.7 deg: the
+    test below)."""
     dx = 10.0
     grid = CartesianGrid([[0, 2600], [-2 * dx, 2 * dx]], [260, 4])
     xs, ys = corner_coordinates(grid)
@@ -159,16 +160,18 @@ def test_the_energy_line_bounds_the_travel_angle_on_the_parabola():
     drop = (h * zc).sum() / h.sum() - (h1 * zc).sum() / h1.sum()
     travel = (h1 * x).sum() / h1.sum() - (h * x).sum() / h.sum()
     angle = math.degrees(math.atan(drop / travel))
-    assert 25.0 <= angle < 26.0
+    assert 25.0 <= angle < 25.3
 
 
 @pytest.mark.parametrize("slope_deg, dx", [(10.0, 5.0), (10.0, 20.0), (34.0, 5.0),
                                            (34.0, 20.0)])
 def test_the_mass_centre_moves_with_the_momentum(slope_deg, dx):
-    """d/dt sum h x = sum h u, the discrete mass flux being the momentum: a release
-    1.2 m deep moving at 10 m/s down a plane, the layer thicker than half the bed's
-    rise across a cell (10 deg, 5 m) or thinner (the tilted surface: 10 deg, 20 m and
-    34 deg). The face depths times the cell's velocity gave 1.37 and 2 times sum h u."""
+    """d/dt sum h x = sum h u up to the release's two end cells: a release 1.2 m deep
+    over 200 m moving at 10 m/s down a plane, the layer thicker than half the bed's
+    rise across a cell (10 deg, 5 m) or thinner (10 deg, 20 m and 34 deg). Measured:
+    1.009-1.05 times sum h u, 1 + (dx / 200 m) / 4 at 34 deg, the ends' share. With
+    each cell's surface flat (no surface slope from the neighbours) it was 1.37 and 2
+    times: the mass ran ahead of its momentum."""
     grid = CartesianGrid([[0, 600], [-2 * dx, 2 * dx]], [round(600 / dx), 4])
     tan_t = math.tan(math.radians(slope_deg))
     corners = bed_corners(grid, lambda x, y: -tan_t * x + 0.0 * y)
@@ -178,7 +181,8 @@ def test_the_mass_centre_moves_with_the_momentum(slope_deg, dx):
                                       bc=(("wall", "open"), ("wall", "wall")))
     state = pde.make_state(grid, h=h, u=10.0 + 0 * h, v=0 * h)
     rate = pde.make_evolution_rate(state, "numba")(state.data, 0.0)
-    assert (rate[0] * x).sum() == pytest.approx(state.data[1].sum(), rel=1e-12)
+    ratio = (rate[0] * x).sum() / state.data[1].sum()
+    assert 1.0 - 1e-12 <= ratio <= 1.0 + 0.3 * dx / 100.0
 
 
 def test_a_bed_is_refused_with_one_line_where_it_cannot_run():

@@ -13,20 +13,25 @@ gives each cell's bed at the middle of its faces):
 (the basal law's deceleration in place of Coulomb's, :mod:`.sources_2d`). The scheme is
 Kurganov & Petrova's (2007, Commun. Math. Sci. 5, 133) positivity-preserving
 well-balanced reconstruction with the polynomial-viscosity fluctuations of :mod:`.two_d`:
-the bed is continuous across faces, so a face's Riemann problem sees no bed step; in
-each cell the free surface h + z_b is taken flat, so the face depths are
+the bed is continuous across faces, so a face's Riemann problem sees no bed step. In
+each cell the free surface w = h + z_b rises by 2s across the cell, s the minmod of its
+one-sided differences with the neighbours along the axis, halved, and then clamped
+between 0 (a flat surface) and the bed's half rise b = (z_b^+ - z_b^-)/2 (a surface
+parallel to the bed); s = 0 in a dry cell and at the axis' ends. The face depths are
 
-.. math:: h^\mp = h \pm d, \qquad d = (z_b^+ - z_b^-)/2,
+.. math:: h^\mp = h \pm d, \qquad d = b - s,
 
-and where that would make one negative (a layer thinner than half the bed's rise across
-the cell) the surface is tilted so that that face is dry and the other face holds 2h.
-The face deeper than the cell carries the cell's momentum (hu, hv), its velocity
-scaled by h / h^\pm (Kurganov & Petrova's first order: the momentum is not
-reconstructed); the shallower face the cell's velocity. So no face sends more mass
-than the cell's momentum and the mass centre moves with the momentum, d/dt sum h x =
-sum hu (with the face depths times the cell's velocity it moved at (1 + |d|/h) u,
-twice u in the tilted regime: a thin avalanche ran ahead of its momentum). The cell term, the total
-jump across the reconstruction inside the cell along an axis, is
+and where that would make one negative (a layer thinner than |d|: at a shore, or a
+layer thinner than the bed's half rise with its surface flat) the surface is tilted
+so that that face is dry and the other face holds 2h. Face momenta are the face depths
+times the cell's velocity. A lake at rest has s = 0 (flat: well balanced); a
+flowing layer whose surface follows the bed has s = b, face depths h on both sides, so
+the faces pass the mass the momentum carries, d/dt sum h x = sum hu (up to the ends of
+the layer); on a horizontal bed s = 0 and the scheme is the plane's first-order one.
+(With s = 0 everywhere, as first built, a layer thinner than the bed's half rise had
+face depths 0 and 2h in every cell: the mass moved at twice its velocity, (1 + |b|/h)
+times it when thicker, and a thin avalanche's energy line was lost.) The cell term, the
+total jump across the reconstruction inside the cell along an axis, is
 
 .. math:: \mathcal{A} = f(q^+) - f(q^-) + g \bar h\,(z_b^+ - z_b^-),
           \qquad \bar h = (h^- + h^+)/2 = h,
@@ -46,15 +51,41 @@ from ...numerics.compiled import cached
 from ...numerics.state import velocity
 
 
+@cached(inline="always")
+def _surface(q, metric, i, z_lo):
+    """The free surface h + z_b [m] of cell ``i``, its bed the mean of its faces'."""
+    return max(q[0, i], 0.0) + 0.5 * (metric[z_lo, i] + metric[z_lo + 1, i])
+
+
+@cached(inline="always")
+def _half_rise(q, metric, i, z_lo, stride, k, count, dry):
+    """Half the rise of the surface across cell ``i`` (the ``k``-th of ``count`` along
+    the axis, neighbours ``stride`` apart) [m]: the minmod of its one-sided differences
+    with the neighbours; 0 at the axis' ends and in a dry cell."""
+    if k == 0 or k == count - 1 or q[0, i] <= dry:
+        return 0.0
+    w = _surface(q, metric, i, z_lo)
+    a = w - _surface(q, metric, i - stride, z_lo)
+    b = _surface(q, metric, i + stride, z_lo) - w
+    if a * b <= 0.0:
+        return 0.0
+    return 0.5 * (a if abs(a) < abs(b) else b)
+
+
 @cached
 def reconstruct_bed(q, work, metric, lo, hi, axis, dry):
     """Face values along ``axis`` (0: x, 1: y) of cells lo..hi over the bed (module
     docstring): work[0] on each cell's low face, work[1] on its high face, (h, hu, hv)
     [m, m^2/s, m^2/s]."""
     z_lo = L.M_BED + 2 * axis
+    stride = int(metric[L.M_AXES, 3 * axis])
+    count = int(metric[L.M_AXES, 3 * axis + 1])
     for i in range(lo, hi + 1):
         h = max(q[0, i], 0.0)
-        d = 0.5 * (metric[z_lo + 1, i] - metric[z_lo, i])
+        bed = 0.5 * (metric[z_lo + 1, i] - metric[z_lo, i])  # the bed's half rise
+        s = _half_rise(q, metric, i, z_lo, stride, (i // stride) % count, count, dry)
+        s = min(max(s, min(bed, 0.0)), max(bed, 0.0))  # between flat and the bed's
+        d = bed - s
         hm = h + d
         hp = h - d
         if hm < 0.0:  # thinner than the bed's half rise: the surface tilts, dry at the top
@@ -65,16 +96,12 @@ def reconstruct_bed(q, work, metric, lo, hi, axis, dry):
             hp = 0.0
         u = velocity(h, q[1, i], dry)
         v = velocity(h, q[2, i], dry)
-        um = u * h / hm if hm > h else u  # the thicker face: the cell's momentum
-        vm = v * h / hm if hm > h else v
-        up = u * h / hp if hp > h else u
-        vp = v * h / hp if hp > h else v
         work[0, 0, i] = hm
-        work[0, 1, i] = hm * um
-        work[0, 2, i] = hm * vm
+        work[0, 1, i] = hm * u
+        work[0, 2, i] = hm * v
         work[1, 0, i] = hp
-        work[1, 1, i] = hp * up
-        work[1, 2, i] = hp * vp
+        work[1, 1, i] = hp * u
+        work[1, 2, i] = hp * v
 
 
 @cached
