@@ -67,6 +67,16 @@ def test_asc_round_trip_is_exact(tmp_path: Path) -> None:
     assert back != r
 
 
+def test_asc_header_from_numpy_scalars_reads_back(tmp_path: Path) -> None:
+    """A raster whose corner and cell size are numpy scalars (numpy >= 2 prints them
+    as np.float64(...)) is written with plain numbers and reads back the same."""
+    values = np.arange(6.0).reshape(2, 3)
+    r = Raster(values, np.float64(-2.5), np.float64(-502.5), np.float64(5.0),
+               np.zeros(values.shape, bool))
+    back = read_asc(write_asc(r, tmp_path / "dem.asc"))
+    assert back == r and (back.x_corner, back.y_corner) == (-2.5, -502.5)
+
+
 def test_asc_xllcenter_and_nodata(tmp_path: Path) -> None:
     """A header with cell-centre origin and its own NODATA value, keys in any case; the
     first row is the northernmost."""

@@ -115,8 +115,9 @@ def write_asc(raster: Raster, path: str | Path) -> Path:
     body = io.StringIO()
     np.savetxt(body, values, fmt="%.17g")
     header = (f"ncols {raster.ncols}\nnrows {raster.nrows}\n"
-              f"xllcorner {raster.x_corner!r}\nyllcorner {raster.y_corner!r}\n"
-              f"cellsize {raster.cellsize!r}\nNODATA_value {raster.nodata_value!r}\n")
+              f"xllcorner {float(raster.x_corner)!r}\nyllcorner {float(raster.y_corner)!r}\n"
+              f"cellsize {float(raster.cellsize)!r}\n"
+              f"NODATA_value {float(raster.nodata_value)!r}\n")  # numpy scalars too
     if raster.crs is not None:
         write_text(path.with_suffix(".prj"), raster.crs + "\n")
     return write_text(path, header + body.getvalue())
