@@ -35,6 +35,7 @@ whole grid, the method-of-lines rate.
 from __future__ import annotations
 
 import functools
+import math
 from typing import Any
 
 import numpy as np
@@ -186,8 +187,23 @@ def wet_box(q: np.ndarray, dry: float, lo: int, hi: int, width: int,
     return box_of(a0, a1, b0, b1, line)
 
 
+@cached(inline="always")
+def _resting_speed(q: np.ndarray, i: int, g: float, width: int, s: float) -> float:
+    """Over a bed, the wave speed a face takes from its cell ``i``: sqrt(g_z H_i), H_i
+    the cell's total depth, if every layer of the cell is at rest (the bound
+    :func:`pdeflow.numerics.resting.rest_speed` gives the faces of resting cells that the
+    loop skips, so that skipping them changes no step), else the fluctuations' ``s``."""
+    depth = 0.0
+    for k in range(0, q.shape[0], width):
+        for j in range(k + 1, k + width):
+            if q[j, i] != 0.0:
+                return s
+        depth += max(q[k, i], 0.0)
+    return math.sqrt(g * depth)
+
+
 def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, axis: int,
-                    axisymmetric: bool, lines: bool) -> Any:
+                    axisymmetric: bool, lines: bool, terrain: bool = False) -> Any:
     """The faces of one axis as a Python closure (inlined into the advection stage):
 
     ``faces(q, qm, qp, rate, metric, lo, hi, stride, count, inv_dx, s_lo, s_hi, g, r,
@@ -204,11 +220,26 @@ def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, ax
 
     A line's faces beyond its last wet cell are not visited, as on a 1D grid: a face
     between sub-dry traces of depth is not exactly zero (its hydrostatic jump), so
-    visiting them would change the numbers of a line that a 1D run has."""
+    visiting them would change the numbers of a line that a 1D run has.
+
+    ``terrain`` (over a bed): a face between two cells at rest takes the larger of the
+    cells' sqrt(g_z H) as its wave speed instead of its reconstructed states' (whose
+    depths reach h + |d|): the bound the stepping loop takes for the resting faces it
+    skips (:mod:`pdeflow.numerics.resting`), so that skipping changes no step. No mass
+    crosses such a face (the fluctuations of layers at rest move none), so its speed
+    bounds no transport."""
     identity = rows == tuple(range(len(rows)))
 
     @njit(inline="always")
-    def line(qm, qp, rate, metric, base, stride, count, klo, khi, inv_dx, s_lo, s_hi,
+    def resting(q, i_left, i_right, g, s):
+        if not terrain:
+            return s
+        c_left = _resting_speed(q, i_left, g, width, -1.0)
+        c_right = _resting_speed(q, i_right, g, width, -1.0)
+        return s if c_left < 0.0 or c_right < 0.0 else max(c_left, c_right)
+
+    @njit(inline="always")
+    def line(q, qm, qp, rate, metric, base, stride, count, klo, khi, inv_dx, s_lo, s_hi,
              g, r, dry):
         w_l = inv_dx  # weights of a face's fluctuations in the cells on either side
         w_r = inv_dx
@@ -217,7 +248,7 @@ def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, ax
             i = base + k * stride  # the face between cells i - stride and i
             dm, dp, s = fluct(face(qp, i - stride, axis, 1.0), face(qm, i, axis, 1.0),
                               g, r, dry)
-            smax = max(smax, s)
+            smax = max(smax, resting(q, i - stride, i, g, s))
             if axisymmetric:
                 w_l = metric[L.M_LEFT, i]
                 w_r = metric[L.M_RIGHT, i]
@@ -228,7 +259,7 @@ def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, ax
         if klo == 0:
             i = base
             dm, dp, s = fluct(face(qm, i, axis, s_lo), face(qm, i, axis, 1.0), g, r, dry)
-            smax = max(smax, s)
+            smax = max(smax, resting(q, i, i, g, s))
             if axisymmetric:
                 w_r = metric[L.M_RIGHT, i]
             for j in range(len(rows)):
@@ -236,7 +267,7 @@ def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, ax
         if khi == count - 1:
             i = base + (count - 1) * stride
             dm, dp, s = fluct(face(qp, i, axis, 1.0), face(qp, i, axis, s_hi), g, r, dry)
-            smax = max(smax, s)
+            smax = max(smax, resting(q, i, i, g, s))
             if axisymmetric:
                 w_l = metric[L.M_LEFT, i + 1]
             for j in range(len(rows)):
@@ -246,7 +277,7 @@ def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, ax
     def faces(q, qm, qp, rate, metric, lo, hi, stride, count, inv_dx, s_lo, s_hi, g, r,
               dry, per_row):
         if not lines:
-            return line(qm, qp, rate, metric, 0, 1, count, lo, hi, inv_dx, s_lo, s_hi, g,
+            return line(q, qm, qp, rate, metric, 0, 1, count, lo, hi, inv_dx, s_lo, s_hi, g,
                         r, dry)
         # the axis' lines through the box, each over its cells: dry margins not swept
         x0, x1, y0, y1 = rows_of(lo, hi, per_row)
@@ -259,8 +290,8 @@ def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, ax
             base = m * step  # the line of cells base + k stride, k = 0..count - 1
             klo, khi = line_wet(q, dry, width, base, stride, k0, k1)
             if klo <= khi:
-                speeds[m - l0] = line(qm, qp, rate, metric, base, stride, count, klo, khi,
-                                      inv_dx, s_lo, s_hi, g, r, dry)
+                speeds[m - l0] = line(q, qm, qp, rate, metric, base, stride, count, klo,
+                                      khi, inv_dx, s_lo, s_hi, g, r, dry)
         return speeds.max()
 
     return faces
@@ -281,7 +312,8 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
     rows = model.axis_rows(axis)
     width = model.layer_rows
     faces = njit(inline="always")(_faces_function(model.face, model.fluctuations(flux),
-                                                  rows, width, axis, axisymmetric, lines))
+                                                  rows, width, axis, axisymmetric, lines,
+                                                  terrain))
     normal = rows[1]  # the row of a layer's momentum normal to the axis' faces
     # the MUSCL kernels, only where they are called (see compiled.ready)
     reconstruct = reconstruction(width, normal) if muscl else None
