@@ -17,10 +17,10 @@ the running maxima of c from either end of the grid (:func:`extend_prefix`,
 :func:`extend_suffix`) and updates them only where cells froze, so that a run gives the
 same numbers, bit for bit, as one that visits every wet cell
 (``tests/test_resting_cells.py``; 2D: ``tests/test_two_d_dry_margin.py``). Over a bed
-(layout.GEOMETRY_TERRAIN_2D) this identity does not hold: a face depth of the
-reconstruction over a bed reaches h + |d| (up to 2h), so a full sweep's wave speeds at
-resting faces can exceed the cells' bound used here, and its time steps can be
-smaller; the steps taken are CFL steps of the faces that move either way.
+(layout.GEOMETRY_TERRAIN_2D) the reconstruction's face depths reach h + |d|, so the
+advection stage gives a face between two resting cells this same bound instead of its
+states' speeds (:func:`pdeflow.numerics.advection._faces_function`), and the identity
+holds there too.
 
 Cells are the flattened index of any grid (:mod:`pdeflow.numerics.geometry`): a cell's
 neighbours are those along its line of the last axis (``line`` cells long; on a 1D grid
