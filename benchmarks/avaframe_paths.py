@@ -27,7 +27,8 @@ The .npz holds the peak rasters ``pft`` (slope-normal peak flow thickness [m]), 
 (row i at y = ``yllcenter`` + i ``cellsize``), with ``cellsize``, ``xllcenter`` and
 ``yllcenter`` [m]; the particles' mass centre (``x0``, ``y0``, ``z0``) at the start
 and (``x1``, ``y1``, ``z1``) at the end [m; x and y from the DEM's lower-left cell
-centre]; ``n_part`` (particles at the start),
+centre]; ``n_part`` (particles at the start), ``mass0`` and ``mass1`` [kg] (their mass at the
+start and the end),
 ``t_end`` [s] (the last step's time: com1DFA stops when the kinetic energy falls below
 ``stopCrit`` times its peak, or at ``tEnd``) and ``wall`` [s] (com1DFAMain alone, one
 core, its outputs included).
@@ -150,7 +151,8 @@ def run(args: argparse.Namespace, tmp: pathlib.Path) -> dict:
     first, last = parts[order[0]], parts[order[-1]]
     (x0, y0, z0), (x1, y1, z1) = mass_centre(first), mass_centre(last)
     out = {"wall": wall, "n_part": int(first["nPart"]), "t_end": float(last["t"]),
-           "x0": x0, "y0": y0, "z0": z0, "x1": x1, "y1": y1, "z1": z1}
+           "x0": x0, "y0": y0, "z0": z0, "x1": x1, "y1": y1, "z1": z1,
+           "mass0": float(np.sum(first["m"])), "mass1": float(np.sum(last["m"]))}
     for name in ("pft", "pfv", "ppr"):
         raster = peak(ava, name)
         out[name] = np.nan_to_num(np.asarray(raster["rasterData"], dtype=float))

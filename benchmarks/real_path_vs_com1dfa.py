@@ -48,6 +48,7 @@ from pdeflow.terrain import read_raster, release_mask, shapefile_polygons  # noq
 from pdeflow.terrain.thickness import cos_slope  # noqa: E402
 
 THRESHOLD = 0.1  #: peak thickness (slope-normal) counted as affected [m]
+DENSITY = 200.0  #: com1DFA's rho [kg/m^3]: its released mass over it is a volume
 NO_AVAFRAME = "AvaFrame is not available (give its python with --avaframe-python)"
 
 
@@ -87,7 +88,9 @@ def com1dfa_fields(exe: str, inputs: Path, phi: float) -> dict[str, Any]:
             "x": x0 + cs * np.arange(cols), "y": y0 + cs * np.arange(rows), "dx": cs,
             "z": z, **{k: d[k].T for k in ("pft", "pfv", "ppr")},
             "centre_angle": math.degrees(math.atan2(drop, travel)),
-            "t_end": float(d["t_end"]), "wall": float(d["wall"])}
+            "t_end": float(d["t_end"]), "wall": float(d["wall"]),
+            "volume": float(d["mass0"]) / DENSITY,
+            "lost": 1.0 - float(d["mass1"]) / float(d["mass0"])}
 
 
 def pdeflow_fields(root: Path, path: str, phi: float, threads: int) -> dict[str, Any]:
@@ -98,7 +101,8 @@ def pdeflow_fields(root: Path, path: str, phi: float, threads: int) -> dict[str,
     return {"code": "pdeflow", "what": f"{cells}, {threads} threads", "x": xc, "y": yc,
             "dx": dx, "z": beds, "pft": peak[0] * cos_slope(beds, dx, dy),
             "pfv": peak[1], "ppr": peak[2], "centre_angle": r["travel_angle_deg"],
-            "t_end": r["t_end_s"], "wall": r["wall_s"], "ended": r["ended"]}
+            "t_end": r["t_end_s"], "wall": r["wall_s"], "ended": r["ended"],
+            "volume": r["volume_m3"], "lost": 0.0}
 
 
 def measures(run: dict[str, Any], top: tuple[float, float, float]) -> dict[str, Any]:
@@ -168,8 +172,9 @@ def main(argv: list[str] | None = None) -> int:
                  ppr=float(r["ppr"].max()))
     print("\n".join(table(rows)))
     for r in rows:
-        print(f"{r['code']}: farthest affected cell ({r['runout_xy'][0]:.0f}, "
-              f"{r['runout_xy'][1]:.0f})" + (f", ended: {r['ended']}" if "ended" in r
+        print(f"{r['code']}: released {r['volume']:.0f} m^3, {r['lost']:.2%} of it left "
+              f"the domain; farthest affected cell ({r['runout_xy'][0]:.0f}, "
+              f"{r['runout_xy'][1]:.0f})" + (f"; ended: {r['ended']}" if "ended" in r
                                              else ""))
     if len(rows) == 2:
         both, only_p, only_c = shared(rows[1], rows[0])
