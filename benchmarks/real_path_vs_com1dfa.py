@@ -21,7 +21,10 @@ horizontal, whose peak thickness exceeds ``THRESHOLD``) and how much of it the t
 share; the largest peak thickness, speed and pressure; the mass centre's travel angle
 (drop over horizontal travel, start to end); the **run-out**: the affected cell
 horizontally farthest from the release's highest point (the highest DEM cell centre in
-the release), its distance and its travel angle seen from that point.
+the release), its distance and its travel angle seen from that point; and, if the
+path has AvaFrame's ``LINES/path_aimec.shp``, how far along that line (each cell
+projected to its nearest point on it, the line prolonged straight beyond its ends) the
+affected cells reach.
 """
 
 from __future__ import annotations
@@ -119,6 +122,39 @@ def measures(run: dict[str, Any], top: tuple[float, float, float]) -> dict[str, 
             "runout_xy": (float(x[k]), float(y[k]))}
 
 
+def along(line: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """The distance [m] along the polyline ``line`` (k, 2) of each point's nearest point
+    on it, its first and last segments prolonged beyond its ends (negative before its
+    start, beyond its length after its end; the points' x, y arrays of one shape)."""
+    px, py = np.ravel(x)[:, None], np.ravel(y)[:, None]
+    a, b = line[:-1], line[1:]
+    seg = b - a
+    length = np.hypot(seg[:, 0], seg[:, 1])
+    lo, hi = np.zeros(len(seg)), np.ones(len(seg))
+    lo[0], hi[-1] = -np.inf, np.inf
+    t = np.clip(((px - a[:, 0]) * seg[:, 0] + (py - a[:, 1]) * seg[:, 1]) / length ** 2,
+                lo, hi)
+    dist = np.hypot(a[:, 0] + t * seg[:, 0] - px, a[:, 1] + t * seg[:, 1] - py)
+    k = np.argmin(dist, axis=1)
+    start = np.concatenate([[0.0], np.cumsum(length)[:-1]])
+    rows = np.arange(k.size)
+    return (start[k] + t[rows, k] * length[k]).reshape(np.shape(x))
+
+
+def path_line(inputs: Path) -> np.ndarray | None:
+    """The vertices (k, 2) [m] of AvaFrame's ``LINES/path_aimec.shp`` (its first
+    shape), or None without it or pyshp."""
+    try:
+        import shapefile
+    except ImportError:
+        return None
+    file = inputs / "LINES" / "path_aimec.shp"
+    if not file.exists():
+        return None
+    with shapefile.Reader(str(file)) as r:
+        return np.asarray(r.shapes()[0].points, dtype=float)[:, :2]
+
+
 def shared(a: dict[str, Any], b: dict[str, Any]) -> tuple[float, float, float]:
     """(both, only a, only b) [ha]: a's affected cells matched to b's nearest cell
     centre (the grids are offset by half a cell), areas in a's cells."""
@@ -176,6 +212,16 @@ def main(argv: list[str] | None = None) -> int:
               f"the domain; farthest affected cell ({r['runout_xy'][0]:.0f}, "
               f"{r['runout_xy'][1]:.0f})" + (f"; ended: {r['ended']}" if "ended" in r
                                              else ""))
+    line = path_line(inputs)
+    if line is not None:
+        s_top = float(along(line, np.array(top[0]), np.array(top[1])))
+        for r in rows:
+            x = r["x"][:, None] * np.ones(r["hit"].shape)
+            y = r["y"][None, :] * np.ones(r["hit"].shape)
+            reach = float(along(line, x[r["hit"]], y[r["hit"]]).max())
+            print(f"{r['code']}: along path_aimec.shp the affected cells reach s = "
+                  f"{reach:.0f} m, {reach - s_top:.0f} m beyond the release top's "
+                  f"{s_top:.0f} m")
     if len(rows) == 2:
         both, only_p, only_c = shared(rows[1], rows[0])
         print(f"affected by both {both:.1f} ha, by pdeflow only {only_p:.1f} ha, by "

@@ -88,3 +88,12 @@ def test_the_script_runs_pdeflow_alone_on_a_dem_the_test_writes(tmp_path):
     assert "59 x 59 cells of 5.00 m" in cells[2]
     centre, runout_angle = float(cells[7]), float(cells[9])
     assert centre >= 25.0 and runout_angle < centre
+
+
+def test_the_distance_along_a_polyline_is_that_of_the_nearest_point():
+    """An L-shaped line (10 m east, then 10 m north): points beside each leg, before
+    its start and beyond its end (on the legs prolonged)."""
+    rv = load("real_path_vs_com1dfa")
+    line = np.array([[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]])
+    s = rv.along(line, np.array([4.0, 12.0, -3.0, 10.0]), np.array([-1.0, 6.0, 0.0, 15.0]))
+    np.testing.assert_allclose(s, [4.0, 16.0, -3.0, 25.0])
