@@ -320,7 +320,9 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
     ``geometry`` (layout.GEOMETRY_*) and ``metric`` (the rows layout.M_* of
     :class:`~pdeflow.numerics.geometry.Metric`) weight the faces. Planar: every weight is
     1/dx (``metric`` is not read); 2D: 1/dx_a on the faces of axis a (``metric``'s
-    row M_AXES gives the axes). Axisymmetric, with face areas A and cell volumes V,
+    row M_AXES gives the axes); 2D over a bed (rows M_BED): also the model's face values
+    over the bed and the bed's slope in the cell term (:mod:`.bed_slope`, first order
+    only). Axisymmetric, with face areas A and cell volumes V,
 
     .. math:: \frac{dq_i}{dt} = -\frac{A_{i-1/2} D^+_{i-1/2} + A_{i+1/2} D^-_{i+1/2}
               + \bar A_i \mathcal{A}(q_i^-, q_i^+)}{V_i}
