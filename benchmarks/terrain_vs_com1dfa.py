@@ -55,6 +55,9 @@ from pde import CartesianGrid
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from similarity_2d import avaframe_python  # noqa: E402  (the same lookup as its own)
 
 import pdeflow  # noqa: E402
 from pdeflow.metrics_2d import peak_fields  # noqa: E402
@@ -181,19 +184,6 @@ def compile_kernels(raster: Raster, path: AvalanchePath, dx: float,
     pde, state, _ = pdeflow_setup(raster, path, dx, voellmy)
     peaks = PeakTracker(PEAK_INTERVAL, partial(peak_fields, dry=DRY, density=DENSITY))
     pde.solve(state, 1.0, solver="fv-split", tracker=[peaks])
-
-
-def avaframe_python(given: str | None) -> str | None:
-    """The interpreter that imports avaframe: ``given``, $PDEFLOW_AVAFRAME_PYTHON or
-    this one; None if none does."""
-    for exe in (given, os.environ.get("PDEFLOW_AVAFRAME_PYTHON"), sys.executable):
-        try:
-            if exe and subprocess.run([exe, "-c", "import avaframe"], capture_output=True
-                                      ).returncode == 0:
-                return exe
-        except OSError:  # no such interpreter: try the next
-            continue
-    return None
 
 
 def com1dfa_run(exe: str, dem: Path, t_end: float, stop_crit: float = 0.01,

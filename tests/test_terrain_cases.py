@@ -410,7 +410,8 @@ def test_a_terrain_case_run_writes_its_peak_outputs(tmp_path):
     s = json.loads((tmp_path / "summary.json").read_text())["models"]["single_layer"]
     assert s["at_rest"] and 25.0 <= s["travel_angle"] < 35.0
     assert s["affected_area"] >= s["deposit_area"] > 0
-    assert 0.2 * s["max_speed"] ** 2 >= s["max_pressure"] > 0
+    # the same speed squared, times 200 / 1000 in another order: equal to round-off
+    assert 0.2 * s["max_speed"] ** 2 * (1 + 1e-12) >= s["max_pressure"] > 0
     depth = read_raster(tmp_path / "peak_depth.asc")
     from pdeflow.case_terrain import map_corner
 
