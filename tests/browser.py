@@ -29,7 +29,7 @@ CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic"
                  "--disable-component-update", "--disable-sync"]
 """Headless, no sandbox (CI runs as root), and no traffic of Chromium's own."""
 READY = {"dam-break": ".pdeflow-summary pre", "run-out": ".pdeflow-fits ul",
-         "hyperbolicity": ".pdeflow-spectrum ul"}
+         "hyperbolicity": ".pdeflow-spectrum ul", "hillside": ".pdeflow-hint"}
 """Per page, an element that exists once the page has shown its first result."""
 
 

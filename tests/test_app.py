@@ -522,22 +522,25 @@ def test_app_present_option():
 
 
 def test_pages_not_shown_are_built_when_their_tab_opens():
-    """Only the dam-break page is built at start; the run-out and hyperbolicity pages
-    when their tab is first opened (then in the mode of that moment)."""
+    """Only the dam-break page is built at start; the run-out, hyperbolicity and
+    hillside pages when their tab is first opened (then in the mode of that moment)."""
     from pdeflow.app.layout import SessionPages, build_pages
 
     toggle = pn.widgets.Toggle(value=False)
     pages = SessionPages(CASES)
     tabs = build_pages(CASES, toggle=toggle, pages=pages)
     assert list(pages.pages) == ["dam-break"]
-    assert [len(t.objects) for t in tabs.objects] == [1, 0, 0]
+    assert [len(t.objects) for t in tabs.objects] == [1, 0, 0, 0]
     toggle.value = True  # presentation mode before the others exist
     tabs.active = 2
-    assert [len(t.objects) for t in tabs.objects] == [1, 0, 1]
+    assert [len(t.objects) for t in tabs.objects] == [1, 0, 1, 0]
     tabs.active = 1
-    assert [len(t.objects) for t in tabs.objects] == [1, 1, 1]
+    assert [len(t.objects) for t in tabs.objects] == [1, 1, 1, 0]
+    tabs.active = 3
+    assert [len(t.objects) for t in tabs.objects] == [1, 1, 1, 1]
     runout = pages.pages["run-out"]
     assert runout.started and runout.present and pages.pages["hyperbolicity"].present
+    assert pages.pages["hillside"].present
     shown = tabs.objects[1].objects[0]
     tabs.active = 0
     tabs.active = 1  # built once
@@ -551,7 +554,10 @@ def test_the_page_asked_for_is_built_at_start():
 
     tabs = build_pages(CASES, page="hyperbolicity")
     assert tabs.active == 2
-    assert [len(t.objects) for t in tabs.objects] == [1, 0, 1]
+    assert [len(t.objects) for t in tabs.objects] == [1, 0, 1, 0]
+    tabs = build_pages(CASES, page="hillside")
+    assert tabs.active == 3
+    assert [len(t.objects) for t in tabs.objects] == [1, 0, 0, 1]
 
 
 def _short_sweep(tmp_path: Path, t_end: float, length: float) -> Path:

@@ -1,4 +1,4 @@
-"""The app: the three pages as tabs, built once the numba kernels are loaded, under a
+"""The app: the four pages as tabs, built once the numba kernels are loaded, under a
 header with the presentation-mode toggle (:mod:`.look`)."""
 
 from __future__ import annotations
@@ -10,12 +10,13 @@ import panel as pn
 
 from .controls import find_case_dir, served
 from .dam_break import DamBreakPage, SharedRun
+from .hillside import HillsidePage
 from .hyperbolicity import HyperbolicityPage
 from .kernels import WARMUP
 from .runout import RunoutPage
 
 PAGES = {"dam-break": "Dam break", "run-out": "Run-out law",
-         "hyperbolicity": "Hyperbolicity"}
+         "hyperbolicity": "Hyperbolicity", "hillside": "Hillside"}
 """Page keys (the URL's ``?page=``) and tab titles, in the order of the tabs."""
 POLL_MS = 500
 """How often the waiting page updates its elapsed time [ms]."""
@@ -61,7 +62,7 @@ def _requested_present() -> bool | None:
 
 
 class SessionPages:
-    """The three pages of one session, each built when its tab is first shown: the
+    """The pages of one session, each built when its tab is first shown: the
     dam-break page at once (the hyperbolicity page shows its run), the others on
     demand, so the first picture does not wait for pages nobody looks at yet."""
 
@@ -78,6 +79,8 @@ class SessionPages:
         if key not in self.pages:
             if key == "dam-break":
                 page: Any = DamBreakPage(self.case_dir, self.shared, present=self.present)
+            elif key == "hillside":
+                page = HillsidePage(self.case_dir, present=self.present)
             elif key == "run-out":
                 page = RunoutPage(self.case_dir, start=self.first == "run-out",
                                   present=self.present)
@@ -108,7 +111,7 @@ class SessionPages:
 def build_pages(case_dir: Path, page: str | None = None, present: bool = False,
                 toggle: pn.widgets.Toggle | None = None,
                 pages: SessionPages | None = None) -> pn.Tabs:
-    """The three pages of one session as tabs (``page`` selects the one shown first;
+    """The pages of one session as tabs (``page`` selects the one shown first;
     ``present``: presentation mode, switched by ``toggle`` if given). Only the
     dam-break page and the one shown first are built now, the others when their tab
     is first opened (``pages``: the session's pages, default new ones)."""

@@ -1,8 +1,8 @@
-"""Serve the teaching app in the browser: three pages (dam break, run-out law,
-hyperbolicity) where every slider reruns pdeflow in the server.
+"""Serve the teaching app in the browser: four pages (dam break, run-out law,
+hyperbolicity, hillside) where every slider or run button reruns pdeflow in the server.
 
 The page opens in the default browser (unless --no-browser) at http://HOST:PORT/;
-?page=run-out or ?page=hyperbolicity opens another page first; --present (or
+?page=run-out, ?page=hyperbolicity or ?page=hillside opens another page first; --present (or
 ?present=1) opens in presentation mode, for a projector: larger fonts and lines, fewer
 controls (a toggle in the header switches it). The first start on a
 machine compiles the numerical kernels (the page says so, with the elapsed time); later
