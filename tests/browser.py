@@ -33,12 +33,20 @@ READY = {"dam-break": ".pdeflow-summary pre", "run-out": ".pdeflow-fits ul",
 """Per page, an element that exists once the page has shown its first result."""
 
 
+class ServerURL(str):
+    """The page's URL, as :func:`app_server` yields it; ``pid`` is the server's process
+    id (its memory in ``/proc/<pid>/status``)."""
+
+    pid: int
+
+
 @contextmanager
 def app_server(root: Path, *, timeout: float = 60.0, env: dict[str, str] | None = None,
-               log: Path | None = None, args: Sequence[str] = ()) -> Iterator[str]:
+               log: Path | None = None, args: Sequence[str] = ()) -> Iterator[ServerURL]:
     """Run ``pdeflow app --no-browser`` of the checkout ``root`` on a free port of
-    127.0.0.1; yield the page's URL; stop the server when the block ends, also on an
-    error (Ctrl-C, then kill after 10 s).
+    127.0.0.1; yield the page's URL (a :class:`ServerURL`: a string with the server's
+    ``pid``); stop the server when the block ends, also on an error (Ctrl-C, then kill
+    after 10 s).
 
     ``root/pdeflow`` is put first on PYTHONPATH, so the server runs the same code as the
     caller; ``env`` adds variables (e.g. NUMBA_CACHE_DIR); the server's stderr goes to
@@ -54,7 +62,9 @@ def app_server(root: Path, *, timeout: float = 60.0, env: dict[str, str] | None 
          "127.0.0.1", "--port", "0", *args], cwd=root, env=full_env, stdout=subprocess.PIPE,
         stderr=err, text=True)
     try:
-        yield _read_url(proc, timeout)
+        url = ServerURL(_read_url(proc, timeout))
+        url.pid = proc.pid
+        yield url
     finally:
         proc.send_signal(signal.SIGINT)
         try:

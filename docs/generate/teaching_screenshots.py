@@ -2,6 +2,7 @@
 
     python docs/generate/teaching_screenshots.py          # minutes: includes a cold start
     python docs/generate/teaching_screenshots.py --warm   # kernels cached: no cold start
+    python docs/generate/teaching_screenshots.py --hillside   # the hillside page's only
 
 Starts ``pdeflow app`` of this checkout with an empty numba cache (a fresh machine, as
 far as the kernels go), screenshots the page while it compiles, times how long the
@@ -140,12 +141,46 @@ def other_pages(browser: Any, url: str) -> None:
     page.close()
 
 
+def _shown_seconds(page: Any) -> float | None:
+    """The hillside page's time [s] in its status line ('t = 12.5 s ...'), if shown."""
+    status = text(page, "status")
+    return float(status.split("t = ")[1].split(" s")[0]) if status.startswith("t = ") \
+        else None
+
+
+def hillside(browser: Any, url: str) -> None:
+    """The hillside page: the default release on a projector in presentation mode,
+    caught while it flows; and the deposit with its table on a wide screen."""
+    page, log = open_page(browser, url, "hillside", viewport=PROJECTOR, query="present=1")
+    page.locator(".pdeflow-run button").first.click()
+    _wait(lambda: (_shown_seconds(page) or 0.0) >= 20.0)
+    page.screenshot(path=FIGURES / "teaching_hillside_projector.png")
+    page.close()
+    page, log = open_page(browser, url, "hillside", viewport=WIDE)
+    page.locator(".pdeflow-run button").first.click()
+    _wait(lambda: "done in" in text(page, "status"))
+    time.sleep(1)
+    page.screenshot(path=FIGURES / "teaching_hillside.png", full_page=True)
+    print(f"hillside page, default release: {text(page, 'status')} ({_load()})")
+    if log.errors:
+        raise RuntimeError(f"the hillside page logged errors: {log.errors[:3]}")
+    page.close()
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--warm", action="store_true",
                     help="use the usual numba cache (no cold start, no compiling screenshot)")
-    warm = ap.parse_args(argv).warm
+    ap.add_argument("--hillside", action="store_true",
+                    help="only the hillside page's screenshots (kernels cached)")
+    args = ap.parse_args(argv)
+    warm = args.warm
     FIGURES.mkdir(exist_ok=True)
+    if args.hillside:
+        with chromium() as browser, app_server(ROOT) as url:
+            hillside(browser, url)
+        print("wrote docs/figures/teaching_hillside{,_projector}.png")
+        return 0
     with tempfile.TemporaryDirectory() as tmp, chromium() as browser:
         env = {} if warm else {"NUMBA_CACHE_DIR": str(Path(tmp) / "numba")}
         t_start = time.monotonic()
@@ -155,6 +190,7 @@ def main(argv: list[str] | None = None) -> int:
             dam_break(browser, url)
             slope_35(browser, url)
             other_pages(browser, url)
+            hillside(browser, url)
         t_start = time.monotonic()  # again, with the kernels now in the cache
         with app_server(ROOT, env=env) as url:
             page, _ = open_page(browser, url, "dam-break")
@@ -162,7 +198,8 @@ def main(argv: list[str] | None = None) -> int:
                   f"{time.monotonic() - t_start:.1f} s ({_load()})")
             page.close()
     for name in ("dam_break", "dam_break_projector", "slope_35", "runout",
-                 "hyperbolicity", *(() if warm else ("compiling",))):
+                 "hyperbolicity", "hillside", "hillside_projector",
+                 *(() if warm else ("compiling",))):
         print(f"wrote docs/figures/teaching_{name}.png")
     return 0
 

@@ -2,9 +2,10 @@
 
 The lecturer picks a terrain (a case file over a named topography,
 :func:`~pdeflow.app.hillside_setup.hillside_cases`; the plane with a flat run-out
-first), draws the release polygon on the plan view (Bokeh's polygon tools: click the
-vertices, double-click the last; drag a vertex to move it), sets its thickness, the
-models, the friction law and angle and the grid, and presses run. The run goes to the
+first), draws the release polygon on the plan view (Bokeh's polygon tools: press and
+hold at the first vertex, click the next ones, press and hold at the last; drag the
+polygon to move it), sets its thickness, the models, the friction law and angle and the
+grid, and presses run. The run goes to the
 server's queue (:mod:`.run_queue`) and computes in a worker
 (:class:`~pdeflow.app.live_run.LiveRun`); the page draws its frames as they arrive,
 every :data:`FRAME_MS` ms, the models side by side with their fronts, and the long
@@ -115,8 +116,10 @@ class HillsidePage:
         self.cells = w.IntSlider(name="cells down the path", value=120,
                                  start=CELLS_RANGE[0], end=CELLS_RANGE[1], step=10,
                                  css_classes=["pdeflow-cells"], sizing_mode="stretch_width")
-        self.run_button = w.Button(name="▶ run", button_type="primary",
-                                   css_classes=["pdeflow-run"], sizing_mode="stretch_width")
+        # above the figures, beside the side bar's toggle: in view when the controls
+        # are folded away (presentation mode)
+        self.run_button = w.Button(name="▶ run", button_type="primary", width=140,
+                                   height=30, css_classes=["pdeflow-run"])
         self.download = w.FileDownload(callback=self._case_file, filename="hillside.toml",
                                        label="download the case file",
                                        css_classes=["pdeflow-download"],
@@ -186,9 +189,11 @@ class HillsidePage:
                                                    for m in MODEL_COLOURS}}
             self.table.text = ""
             self.player.visible = False
-            self._say("<span class='pdeflow-hint'>Draw a release on the plan view (click "
-                      "its corners, double-click the last; drag a corner to move it), "
-                      "then press <b>▶ run</b>.</span>")
+            # Bokeh 3's PolyDrawTool starts and ends a polygon with a press (held 300
+            # ms); a click adds a vertex only while drawing, a double-click nothing
+            self._say("<span class='pdeflow-hint'>Draw a release on the plan view (press "
+                      "and hold at its first corner, click the next ones, press and hold "
+                      "at the last; drag it to move it), then press <b>▶ run</b>.</span>")
         self.command.object = ""
 
     def _section_row(self, ny: int) -> int:
@@ -260,19 +265,22 @@ class HillsidePage:
         section: dict[str, Any] = {"x": self.section_depths.data["x"]}
         row = self._section_row(run.case.cells_y)
         t = 0.0
+        fronts = []
         for m in MODEL_COLOURS:
             frame = frames.get(m)
             if frame is None:
                 section[m] = np.full(run.case.cells, np.nan)
                 continue
             t = max(t, frame.t)
-            self.plans[m].show_depth(frame.depth, threshold, length, width,
-                                     front_x(frame.depth, threshold, run.case.dx))
+            front = front_x(frame.depth, threshold, run.case.dx)
+            self.plans[m].show_depth(frame.depth, threshold, length, width, front)
             section[m] = np.where(frame.depth[:, row] > threshold, frame.depth[:, row],
                                   np.nan)
+            fronts.append(f"{LABELS[m]} {front:.0f} m" if front is not None else "")
         if len(section["x"]) == run.case.cells:
             self.section_depths.data = section
-        self._say(f"t = {t:.1f} s" + ("" if run.finished else " (computing)"))
+        self._say(f"t = {t:.1f} s{'' if run.finished else ' (computing)'}; fronts: "
+                  f"<span class='pdeflow-fronts'>{', '.join(fronts)}</span>")
 
     def _scrub(self, k: int) -> None:
         if self.run is not None and self.run.finished and self.player.visible:
@@ -298,8 +306,11 @@ class HillsidePage:
         self.player.end = max(run.frame_count() - 1, 1)
         self.player.value = run.frame_count() - 1
         self.player.visible = True
-        ends = ", ".join(f"{LABELS[m]} {'at rest' if s.get('at_rest') else 'still moving'}"
-                         f" at t = {s['t_final']:.1f} s" for m, s in run.summaries.items())
+        # the stop time, as the table (one end time on the page, issue 38)
+        ends = ", ".join(f"{LABELS[m]} at rest at {s['stop_time']:.1f} s (the stop time)"
+                         if s.get("stop_time") is not None
+                         else f"{LABELS[m]} still moving at t_end"
+                         for m, s in run.summaries.items())
         self._say(f"done in {run.wall_time_s:.1f} s of computing: {ends}")
 
     def _table_html(self, run: LiveRun) -> str:
@@ -332,15 +343,15 @@ class HillsidePage:
 
     def panel(self) -> pn.Row:
         sidebar = pn.Column("### hillside", self.case_select, self.models, self.thickness,
-                            self.law, self.angle, self.cells, self.run_button,
-                            self.download, self.command, sizing_mode="stretch_width")
+                            self.law, self.angle, self.cells, self.download,
+                            self.command, sizing_mode="stretch_width")
         plans = pn.Row(*(pn.pane.Bokeh(p.figure, sizing_mode="stretch_width")
                          for p in self.plans.values()), sizing_mode="stretch_width")
         figures = pn.Column(self.status, self.warnings, plans, self.player,
                             pn.pane.Bokeh(self.section, sizing_mode="stretch_width"),
                             pn.pane.Bokeh(self.table, sizing_mode="stretch_width"),
                             sizing_mode="stretch_width")
-        self.layout = PageLayout(sidebar, figures)
+        self.layout = PageLayout(sidebar, figures, top=self.run_button)
         if self.present:
             self.layout.show_sidebar(False)
         return self.layout.row

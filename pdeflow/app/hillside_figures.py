@@ -108,7 +108,7 @@ class PlanView:
         fig = figure(title=label, x_range=x_range, y_range=y_range, tools=tools,
                      height=PLAN_HEIGHT_PX[0], sizing_mode="stretch_width",
                      x_axis_label="x down the path [m]", y_axis_label="y [m]",
-                     toolbar_location="right" if draw else None, match_aspect=True)
+                     toolbar_location="above" if draw else None, match_aspect=True)
         fig.image_rgba("image", x="x", y="y", dw="dw", dh="dh", source=self.terrain)
         fig.multi_line("xs", "ys", source=self.contours, line_color="#4a3f30",
                        line_alpha=0.5, line_width=1)
