@@ -114,6 +114,24 @@ def chromium(executable: str = CHROMIUM) -> Iterator[Any]:
             browser.close()
 
 
+@contextmanager
+def browser_for_tests() -> Iterator[Any]:
+    """:func:`chromium` for a test module's fixture: the test fails (not skips) with a
+    one-line reason when Chromium or Playwright is missing."""
+    import pytest
+
+    if not Path(CHROMIUM).is_file():
+        pytest.fail(f"{CHROMIUM} is missing: apt-get install chromium (CI: .ci/run does), "
+                    "set PDEFLOW_CHROMIUM to another Chromium, or set "
+                    "PDEFLOW_SKIP_BROWSER=1 to skip the browser tests")
+    try:
+        import playwright  # noqa: F401
+    except ImportError:
+        pytest.fail("playwright is missing: pip install '.[test]'")
+    with chromium() as b:
+        yield b
+
+
 @dataclass
 class PageLog:
     """What a page reported: console errors and warnings, uncaught exceptions, foreign

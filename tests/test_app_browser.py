@@ -24,10 +24,9 @@ from pdeflow.cases import load_case
 from pdeflow.simulate import run_model
 
 from .browser import (
-    CHROMIUM,
     READY,
     app_server,
-    chromium,
+    browser_for_tests,
     figure_titles,
     foreign_urls,
     key_to_picture,
@@ -53,15 +52,7 @@ docs/generate/teaching_screenshots.py, not asserted here."""
 
 @pytest.fixture(scope="module")
 def browser():
-    if not Path(CHROMIUM).is_file():
-        pytest.fail(f"{CHROMIUM} is missing: apt-get install chromium (CI: .ci/run does), "
-                    "set PDEFLOW_CHROMIUM to another Chromium, or set "
-                    "PDEFLOW_SKIP_BROWSER=1 to skip the browser tests")
-    try:
-        import playwright  # noqa: F401
-    except ImportError:
-        pytest.fail("playwright is missing: pip install '.[test]'")
-    with chromium() as b:
+    with browser_for_tests() as b:
         yield b
 
 
