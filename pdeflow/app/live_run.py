@@ -145,9 +145,9 @@ class LiveRun:
             self.cancel()  # the other model stops too: the run as a whole failed
 
     def execute(self) -> None:
-        """Run the models side by side, one thread each (their frames arrive together;
-        the kernels hold the GIL only between frames); never raises (the page shows
-        :attr:`message`)."""
+        """Run the models side by side, one thread each, so that their frames arrive
+        together (the kernels hold the GIL while they step: the threads take turns
+        between frames); never raises (the page shows :attr:`message`)."""
         self._started = time.perf_counter()
         errors: list[BaseException] = []
         try:
@@ -157,6 +157,9 @@ class LiveRun:
             # both models' kernels compiled (or loaded) before their threads start: numba
             # must not compile one kernel from two threads
             prepare_kernels(self.case)
+            # the limit and the wall time count computing, not compiling the kernels
+            # (minutes on a fresh machine, once)
+            self._started = time.perf_counter()
             threads = [threading.Thread(target=self._model_thread, args=(m, errors),
                                         name=f"pdeflow-{m}", daemon=True)
                        for m in self.models]
