@@ -148,7 +148,12 @@ class HillsideSetup:
         self.check()
         base = load_case(self.case_path).data
         data = {k: dict(v) if isinstance(v, dict) else v for k, v in base.items()}
-        data["case"] = data["case"] | {"models": list(self.models)}
+        data["case"] = data["case"] | {
+            "models": list(self.models),
+            # the case file's own description names its own release
+            "description": f"a drawn release of {self.thickness:g} m (slope-normal) on "
+                           f"{Path(self.case_path).name}'s terrain, {self.friction_law} "
+                           f"{self.friction_deg:g} deg, {self.cells} cells down the path"}
         data["grid"] = self._grid(base["grid"])
         data["initial"] = {"shape": "polygon", "H0": float(self.thickness),
                            "vertices": [[float(x), float(y)] for x, y in self.vertices],
