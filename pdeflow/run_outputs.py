@@ -202,10 +202,10 @@ class RunOutputs:
         """A run over a bed: its peak rasters and figure in the results folder."""
         if result.peak_fields is None:
             return
+        from .terrain.corners import centre_values
         from .terrain_run import write_peak_outputs
 
-        c = result.metric.bed
-        bed = 0.25 * (c[:-1, :-1] + c[1:, :-1] + c[:-1, 1:] + c[1:, 1:])
+        bed = centre_values(result.metric.bed)
         suffix = "" if len(case.models) == 1 else f"_{model}"
         for path in write_peak_outputs(case, model, result.peak_fields, bed, folder.tmp,
                                        suffix):

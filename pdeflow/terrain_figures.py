@@ -23,20 +23,26 @@ def contour_step(relief: float) -> float:
     return 1000.0
 
 
+def hillshade(bed: np.ndarray, dx: float, dy: float) -> np.ndarray:
+    """The hillshade in [0, 1] of ``bed`` (nx, ny) [m] with cells ``dx`` x ``dy`` [m],
+    lit from the north-west at 45 deg as maps are: an image (ny, nx), row 0 north."""
+    from matplotlib.colors import LightSource
+
+    return LightSource(azdeg=315, altdeg=45).hillshade(np.asarray(bed, float).T[::-1],
+                                                       vert_exag=1.0, dx=dx, dy=dy)
+
+
 def hillshade_figure(bed: np.ndarray, field: np.ndarray, extent: tuple[float, ...],
                      path: str | Path, label: str, threshold: float = 0.0,
                      title: str = "") -> Path:
     """Draw ``field`` (nx, ny) over the hillshade and contours of ``bed`` (nx, ny) [m]
     at the same cell centres, ``extent`` (x0, x1, y0, y1) [m] of the cells' outer
     faces, the colour bar named ``label``; write it at ``path`` (complete or absent)."""
-    from matplotlib.colors import LightSource
-
     bed = np.asarray(bed, dtype=float)
     x0, x1, y0, y1 = extent
     dx = (x1 - x0) / bed.shape[0]
     dy = (y1 - y0) / bed.shape[1]
-    shade = LightSource(azdeg=315, altdeg=45).hillshade(bed.T[::-1], vert_exag=1.0,
-                                                        dx=dx, dy=dy)
+    shade = hillshade(bed, dx, dy)
     width = 8.0
     height = min(max(width * (y1 - y0) / (x1 - x0), 3.0), 10.0) + 0.8
     fig = new_figure((width, height))

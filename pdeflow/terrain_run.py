@@ -22,6 +22,7 @@ import numpy as np
 
 from .case_terrain import flow_density, map_corner
 from .metrics_2d import peak_fields, total_depth
+from .terrain.corners import centre_values
 from .trackers.peaks import PeakTracker
 
 TERRAIN_KEYS = ("travel_angle", "affected_area", "max_pressure")
@@ -41,8 +42,7 @@ def peak_fields_tracker(case: Any, pde: Any, samples: int) -> PeakTracker | None
 def terrain_summary(res: Any, peaks: np.ndarray, initial: np.ndarray) -> dict[str, Any]:
     """:data:`TERRAIN_KEYS` of the run ``res`` (a RunResult over a bed) from its peak
     fields ``peaks`` (3, nx, ny) and its initial state data."""
-    corners = res.metric.bed
-    bed = 0.25 * (corners[:-1, :-1] + corners[1:, :-1] + corners[:-1, 1:] + corners[1:, 1:])
+    bed = centre_values(res.metric.bed)
     x, y = res.state.grid.axes_coords
     X, Y = np.meshgrid(x, y, indexing="ij")  # noqa: N806
     centres = []

@@ -26,6 +26,8 @@ import panel as pn
 from bokeh.models import ColumnDataSource, DataRange1d, Div, Range1d
 
 from ..cases import CaseError, load_case
+from ..metrics_2d import front_x
+from ..terrain.corners import centre_values
 from .controls import served
 from .dam_break import LABELS, WARNING_STYLE, warnings_html
 from .hillside_figures import (
@@ -33,9 +35,7 @@ from .hillside_figures import (
     PLAN_HEIGHT_PX,
     SECTION_HEIGHT_PX,
     PlanView,
-    bed_centres,
     contour_lines,
-    front_x,
     hillshade_rgba,
     section_figure,
 )
@@ -169,7 +169,7 @@ class HillsidePage:
         except (CaseError, ValueError) as err:
             self._say(f"<b>cannot draw this terrain:</b> {escape(str(err))}")
             return
-        bed = bed_centres(grid_case.terrain_corners())
+        bed = centre_values(grid_case.terrain_corners())
         self.grid = grid_case
         dx, dy = grid_case.dx, grid_case.dy
         x = (np.arange(bed.shape[0]) + 0.5) * dx
@@ -264,6 +264,7 @@ class HillsidePage:
         length, width = run.case.length, run.case.width
         section: dict[str, Any] = {"x": self.section_depths.data["x"]}
         row = self._section_row(run.case.cells_y)
+        x = (np.arange(run.case.cells) + 0.5) * run.case.dx  # from the grid's corner
         t = 0.0
         fronts = []
         for m in MODEL_COLOURS:
@@ -272,7 +273,7 @@ class HillsidePage:
                 section[m] = np.full(run.case.cells, np.nan)
                 continue
             t = max(t, frame.t)
-            front = front_x(frame.depth, threshold, run.case.dx)
+            front = front_x(x, frame.depth, threshold, run.case.dx)
             self.plans[m].show_depth(frame.depth, threshold, length, width, front)
             section[m] = np.where(frame.depth[:, row] > threshold, frame.depth[:, row],
                                   np.nan)

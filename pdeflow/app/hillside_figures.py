@@ -25,7 +25,7 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
-from ..terrain_figures import contour_step
+from ..terrain_figures import contour_step, hillshade
 
 DEPTH_PALETTE = tuple(reversed(Viridis256))
 """Depth colours: light and thin, dark and deep."""
@@ -41,21 +41,10 @@ SECTION_HEIGHT_PX = (170, 200)
 """Height of the long section [px], normal and presentation mode."""
 
 
-def bed_centres(corners: np.ndarray) -> np.ndarray:
-    """The bed [m] at the cell centres (nx, ny): the mean of each cell's four corners
-    (``corners`` (nx + 1, ny + 1) [m])."""
-    c = np.asarray(corners, dtype=float)
-    return 0.25 * (c[:-1, :-1] + c[1:, :-1] + c[:-1, 1:] + c[1:, 1:])
-
-
 def hillshade_rgba(bed: np.ndarray, dx: float, dy: float) -> np.ndarray:
     """The hillshade of ``bed`` (nx, ny) [m], lit from the north-west at 45 deg as maps
     are, as Bokeh's RGBA image (ny, nx) of uint32, row 0 at the lowest y."""
-    from matplotlib.colors import LightSource
-
-    # matplotlib's light assumes row 0 at the top (north): shade the flipped rows
-    shade = LightSource(azdeg=315, altdeg=45).hillshade(bed.T[::-1], vert_exag=1.0,
-                                                        dx=dx, dy=dy)[::-1]
+    shade = hillshade(bed, dx, dy)[::-1]  # Bokeh's row 0 is the lowest y
     grey = (150 + 100 * np.clip(shade, 0.0, 1.0)).astype(np.uint32)  # never black
     return (255 << 24) | (grey << 16) | (grey << 8) | grey
 
@@ -154,13 +143,6 @@ class PlanView:
     def show_outline(self, lines: dict[str, list[np.ndarray]]) -> None:
         """The deposit's outline (contour lines at the front threshold)."""
         self.outline.data = lines
-
-
-def front_x(depth: np.ndarray, threshold: float, dx: float) -> float | None:
-    """The downstream face [m from the grid's corner] of the last cell deeper than
-    ``threshold`` [m] along x (as the summary's front), None if none is."""
-    wet = np.nonzero(np.any(np.asarray(depth) > threshold, axis=1))[0]
-    return None if wet.size == 0 else float((wet[-1] + 1) * dx)
 
 
 def section_figure(x_range: Range1d) -> tuple[figure, ColumnDataSource, ColumnDataSource]:

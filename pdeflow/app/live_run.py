@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import metrics_2d
 from ..cases import Case
 from ..checks import WARNING_PREFIX, cost_warning, slope_warning, solver_warning
 from ..numerics.warmup import prepare
@@ -60,8 +61,9 @@ class Frame:
 
 
 def total_depth(data: np.ndarray) -> np.ndarray:
-    """The depth [m] of all layers of a 2D state (3 rows per layer: h, h u, h v)."""
-    return data[0::3].sum(axis=0).astype(np.float32)
+    """A frame's depth [m] of all layers of a 2D state
+    (:func:`pdeflow.metrics_2d.total_depth`), in single precision: enough to draw."""
+    return metrics_2d.total_depth(data).astype(np.float32)
 
 
 class LiveRun:
