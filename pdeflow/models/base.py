@@ -303,19 +303,22 @@ class GranularPDE(PDEBase):
         if state.data.shape[0] != len(names):
             raise ValueError(f"state must have {len(names)} fields "
                              f"{names}, got {state.data.shape[0]}")
-        q = state.data.reshape(len(names), -1)  # cells flattened (1D: the data itself)
+        # each field as py-pde holds it (a view: flattening a 2D state would copy it);
+        # np.flatnonzero numbers its cells as the kernels do
         for k, name in enumerate(names):
-            bad = np.nonzero(~np.isfinite(q[k]))[0]
-            if bad.size:
-                raise ValueError(f"{name} must be finite (no NaN or inf), got "
-                                 f"{q[k, bad[0]]} in {cell_name(state.grid, bad[0])} "
-                                 f"and {bad.size - 1} more")
+            if np.isfinite(state.data[k]).all():
+                continue
+            bad = np.flatnonzero(~np.isfinite(state.data[k]))
+            raise ValueError(f"{name} must be finite (no NaN or inf), got "
+                             f"{state.data[k].flat[bad[0]]} in "
+                             f"{cell_name(state.grid, bad[0])} and {bad.size - 1} more")
         for k in range(0, len(names), len(names) // len(self.system.layers)):
-            bad = np.nonzero(q[k] < 0)[0]
-            if bad.size:
-                raise ValueError(f"{names[k]} must be >= 0 m, got "
-                                 f"{q[k, bad[0]]:g} in {cell_name(state.grid, bad[0])} "
-                                 f"and {bad.size - 1} more")
+            if state.data[k].min() >= 0:
+                continue
+            bad = np.flatnonzero(state.data[k] < 0)
+            raise ValueError(f"{names[k]} must be >= 0 m, got "
+                             f"{state.data[k].flat[bad[0]]:g} in "
+                             f"{cell_name(state.grid, bad[0])} and {bad.size - 1} more")
         return metric
 
     # --- rates ----------------------------------------------------------------------------

@@ -54,20 +54,32 @@ __all__ = ["FVSplitSolver", "SimulationBlowUp", "diagnose_blowup", "split_steppe
 
 
 def on_cells(step: Any, shape: tuple[int, int]) -> Any:
-    """``step(state, data, t_start, t_end)`` as a stepper of py-pde's states: ``data`` is
-    the kernels' ``q[field, cell]``, a 1D grid's ``state.data`` itself; on a grid of
-    several axes a flattened copy of py-pde's ``data[field, n0, n1]`` (a view without
-    the ghost cells, not contiguous), written back after every call."""
-    flat = np.empty(shape)
+    """``step(state, data, t_start, t_end, changed)`` as a stepper of py-pde's states:
+    ``data`` is the kernels' ``q[field, cell]``, a 1D grid's ``state.data`` itself; on a
+    grid of several axes a flattened copy of py-pde's ``data[field, n0, n1]`` (a view
+    without the ghost cells, not contiguous), written back after every call.
+    ``changed``: the state is not the one the last call left (the first call, or
+    someone wrote to it in between).
+
+    What the last call left is kept once: on a grid of several axes it is the flattened
+    copy itself (no second copy of the state, and none made to flatten it)."""
+    kept = np.full(shape, np.nan)  # the state the last call left
 
     def stepper(state: Any, t_start: float, t_end: float) -> float:
         if state.data.shape == shape:
-            return step(state, state.data, t_start, t_end)
-        flat[...] = state.data.reshape(shape)
+            changed = not np.array_equal(state.data, kept)
+            try:
+                return step(state, state.data, t_start, t_end, changed)
+            finally:
+                np.copyto(kept, state.data)
+        on_grid = kept.reshape(state.data.shape)  # a view of the flat copy
+        changed = not np.array_equal(state.data, on_grid)
+        if changed:
+            on_grid[...] = state.data
         try:
-            return step(state, flat, t_start, t_end)
+            return step(state, kept, t_start, t_end, changed)
         finally:
-            state.data[...] = flat.reshape(state.data.shape)
+            state.data[...] = on_grid
 
     return stepper
 
@@ -216,15 +228,21 @@ class FVSplitSolver(SolverBase):
                        np.empty_like(q), np.empty_like(q), np.empty_like(work), 1)
 
         ahead: list[StepAhead] = []  # the state past the last output time, if any
+        entry = prev if self.backend_name == "numba" else np.empty(shape)
 
-        def step(state: Any, data: np.ndarray, t_start: float, t_end: float) -> float:
+        def step(state: Any, data: np.ndarray, t_start: float, t_end: float,
+                 changed: bool) -> float:
             t_pause = float(t_end)
             t_run = t_pause if self.t_end is None else max(self.t_end, t_pause)
+            if changed:  # someone changed the state: go on from it, not from a step ahead
+                ahead.clear()
             done, t_start = self._resume(ahead, data, float(t_start), t_pause)
             if done:
                 return t_start
-            entry = data.copy()
-            t, steps, status = advance(data, float(t_start), t_pause, t_run)
+            # the state at the call's start, kept for a blow-up: in prev, which the
+            # compiled loop writes only in a step that reaches t_pause (its last)
+            np.copyto(entry, data)
+            t, steps, status = advance(data, float(t_start), t_pause, t_run, changed)
             self.info["steps"] += int(steps)
             # not "dt": py-pde's controller would then fire every tracker due within half
             # a step *after* the time it stopped at, early (a snapshot at 0.0957 s
@@ -347,19 +365,16 @@ class FVSplitSolver(SolverBase):
 
     def _compiled_loop(self, kernel: Any, run_kernel: Any, diag: np.ndarray,
                        rate: np.ndarray, backup: np.ndarray, work: np.ndarray) -> Any:
-        """``advance(q, t0, t_pause, t1)`` with the compiled ``kernel`` (compiled or
-        loaded at its first call): it goes on from the live cells of the state its last
-        call left only if nobody changed that state in between
-        (:mod:`pdeflow.numerics.resting`)."""
-        left = np.full_like(rate, np.nan)  # the state the last call left
+        """``advance(q, t0, t_pause, t1, changed)`` with the compiled ``kernel`` (compiled
+        or loaded at its first call): it goes on from the live cells of the state its
+        last call left unless ``changed`` (someone changed that state in between, see
+        :func:`on_cells`; :mod:`pdeflow.numerics.resting`)."""
 
-        def advance(q: np.ndarray, t0: float, t_pause: float, t1: float):
-            if not np.array_equal(q, left):
+        def advance(q: np.ndarray, t0: float, t_pause: float, t1: float, changed: bool):
+            if changed:
                 diag[L.D_RESUME] = 0.0
-            out = run_kernel(kernel, q, t0, t1, diag, rate, backup, work, self.max_steps,
-                             t_pause)
-            np.copyto(left, q)
-            return out
+            return run_kernel(kernel, q, t0, t1, diag, rate, backup, work, self.max_steps,
+                              t_pause)
 
         return advance
 
@@ -372,7 +387,7 @@ class FVSplitSolver(SolverBase):
         pde._require_numpy_variant(state.grid)
         if self.scheme.strang:
             raise NotImplementedError("the numpy loop implements Lie splitting only")
-        def advance(q: np.ndarray, t: float, t_pause: float, t_end: float):
+        def advance(q: np.ndarray, t: float, t_pause: float, t_end: float, changed: bool):
             steps = 0
             while t < t_pause and steps < self.max_steps:
                 prev[...] = q  # the state before the step, as the compiled loop keeps
