@@ -172,7 +172,8 @@ def live_box(q: np.ndarray, before: np.ndarray, lo: int, hi: int, width: int,
     """The bounding box of the cells of the box (lo, hi) that move (a discharge row of
     ``q``, any but 0, ``width``, ..., is not zero) or changed in the last step (``q``
     differs from ``before``); ``(1, 0)`` if none. On a 1D grid: the first and the last
-    such cell."""
+    such cell. ``before`` is then set to ``q`` in the box: the state the next step
+    starts from, which it keeps to undo itself (one pass over the box for both)."""
     x0, x1, y0, y1 = rows_of(lo, hi, line)
     a0 = x1 + 1
     a1 = x0 - 1
@@ -180,11 +181,15 @@ def live_box(q: np.ndarray, before: np.ndarray, lo: int, hi: int, width: int,
     b1 = y0 - 1
     for x in range(x0, x1 + 1):
         for i in range(x * line + y0, x * line + y1 + 1):
+            live = False
             for k in range(q.shape[0]):
-                if q[k, i] != before[k, i] or (k % width != 0 and q[k, i] != 0.0):
-                    a0 = min(a0, x)
-                    a1 = max(a1, x)
-                    b0 = min(b0, i - x * line)
-                    b1 = max(b1, i - x * line)
-                    break
+                v = q[k, i]
+                if v != before[k, i] or (k % width != 0 and v != 0.0):
+                    live = True
+                before[k, i] = v
+            if live:
+                a0 = min(a0, x)
+                a1 = max(a1, x)
+                b0 = min(b0, i - x * line)
+                b1 = max(b1, i - x * line)
     return box_of(a0, a1, b0, b1, line)

@@ -100,13 +100,17 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
         s_hi = n - 1
         # running maxima of the wave speed of the cells at rest outside the box visited
         speeds, valid = rest_maxima(n, line)
+        # backup holds the state a step starts from wherever the step can change it:
+        # copied here for a call that starts afresh, else kept by the last step's
+        # live pass (live_box), which sets it to the state it leaves on its box
+        if first:
+            copy_box(backup, q, 0, n - 1, line)
         while t < t_pause and steps < max_steps:
             b_lo, b_hi = (0, n - 1) if first else box_grow(v_lo, v_hi, reach, line, n)
             e_lo, e_hi = box_grow(b_lo, b_hi, 1, line, n)
             s_rest = rest_outside(speeds, valid, q, e_lo, e_hi, g, dry, width, line)
             if two_d:
                 s_rest *= scale
-            copy_box(backup, q, b_lo, b_hi, line)
             if strang or ifcp:
                 _copy_range(diag_keep, diag, 0, L.N_DIAG - 1)
                 copy_box1(fex_keep, fex, b_lo, b_hi, line)
@@ -159,18 +163,18 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
             changed = max(changed, diag[L.D_CHANGED])
             s_lo = a_lo
             s_hi = a_hi
-            if b_lo <= b_hi:
+            if t_new >= t_pause:
+                # the state before this step, for output at t_pause (interpolated by the
+                # caller): the step changed the cells of box b only, kept in backup
+                copy_box(prev, q, 0, n - 1, line)
+                copy_box(prev, backup, b_lo, b_hi, line)
+            if b_lo <= b_hi:  # (and backup becomes the state this step leaves)
                 v_lo, v_hi = live_box(q, backup, b_lo, b_hi, width, line)
                 rest_changed(valid, b_lo, b_hi, line)
             diag[L.D_LIVE_LO] = v_lo
             diag[L.D_LIVE_HI] = v_hi
             diag[L.D_RESUME] = 1.0
             first = False
-            if t_new >= t_pause:
-                # the state before this step, for output at t_pause (interpolated by the
-                # caller): the step changed the cells of box b only, kept in backup
-                copy_box(prev, q, 0, n - 1, line)
-                copy_box(prev, backup, b_lo, b_hi, line)
             t = t_new
             steps += 1
             if stop_at_rest and mass_rate == 0.0 and changed == 0.0:
@@ -223,7 +227,8 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool, width: int = 2,
 
     ``diag[D_RESUME]`` = 1 lets a call go on from the live cells the last call recorded
     in ``diag`` (:mod:`pdeflow.numerics.resting`); the caller must clear it (0) unless
-    ``q`` is the state that call left.
+    ``q`` is the state that call left and ``backup`` the array it left (a step keeps
+    in it the state it starts from, and sets it to the state it leaves on its box).
 
     Returns ``(t, steps, status)``: status :data:`STATUS_END`; :data:`STATUS_REST`
     (everything at rest and unchanged: stationary from ``t`` on); or
