@@ -143,8 +143,10 @@ def _wait_done(page, timeout: float = WAIT_S, samples: list | None = None) -> No
         assert time.monotonic() - t0 < timeout, f"no end within {timeout:g} s: {status}"
         assert "cannot run" not in status and "the run " not in status, status
         if samples is not None and status.startswith("t = "):
-            fronts = page.locator("span.pdeflow-fronts").first
-            samples.append((status, fronts.inner_text() if fronts.count() else ""))
+            # read at once, without waiting: the run may end (and the span go) between
+            # the status read above and this one
+            fronts = page.locator("span.pdeflow-fronts").all_inner_texts()
+            samples.append((status, fronts[0] if fronts else ""))
         time.sleep(0.1)
 
 
