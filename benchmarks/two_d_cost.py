@@ -16,8 +16,9 @@ Rows (each the median over ``--repeats`` interleaved rounds, one process):
   of the same dx, so that the arrays are as large);
 - pdeflow's 2D two layers against its 2D single layer, and the 1D two layers on the
   section (the same ratio in 1D, for comparison).
-``--memory N`` runs an N x N single-layer step in a fresh process and prints its peak
-resident memory.
+``--memory N`` runs an N x N single-layer run in a fresh process and prints its peak
+resident memory: 5 steps in one call of the stepper (the state between outputs), and
+6 calls 0.5 ms apart (3 outputs, each between the states before and after a step).
 
 Run: ``python benchmarks/two_d_cost.py [--cells 256] [--repeats 5] [--memory 1000]``
 (``--memory 1000 --memory-only``: the peak memory alone, which the machine's load does
@@ -158,21 +159,36 @@ eq = pdeflow.SingleLayerGranular(theta_deg=45.0, phi_b_deg=20.0, scheme="hll/fir
                                  bc=(("wall", "wall"), ("wall", "wall")))
 state = eq.make_state(grid, h=h)
 del x, y, h
-solver = FVSplitSolver(eq, cfl=0.9, max_steps=5)
-stepper = solver.make_stepper(state)
-try:
-    stepper(state, 0.0, 1.0)
-except Exception as err:  # max_steps ends the run
-    print("ended:", type(err).__name__, file=sys.stderr)
+if sys.argv[2] == "outputs":  # interpolated outputs: a step ahead of each is kept
+    solver = FVSplitSolver(eq, cfl=0.9, t_end=1.0)
+    stepper = solver.make_stepper(state)
+    t = 0.0
+    for k in range(6):
+        t = stepper(state, t, t + 0.0005)
+else:
+    solver = FVSplitSolver(eq, cfl=0.9, max_steps=5)
+    stepper = solver.make_stepper(state)
+    try:
+        stepper(state, 0.0, 1.0)
+    except Exception as err:  # max_steps ends the run
+        print("ended:", type(err).__name__, file=sys.stderr)
 print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
 """
 
 
-def peak_memory_mb(n: int) -> float:
-    """Peak resident memory [MB] of a fresh process running 5 steps on n x n cells."""
-    out = subprocess.run([sys.executable, "-c", MEMORY_SCRIPT, str(n)], check=True,
+def peak_memory_mb(n: int, outputs: bool = False) -> float:
+    """Peak resident memory [MB] of a fresh process running 5 steps on n x n cells
+    (``outputs``: 6 calls 0.5 ms apart, about 10 steps, with interpolated outputs)."""
+    out = subprocess.run([sys.executable, "-c", MEMORY_SCRIPT, str(n),
+                          "outputs" if outputs else "steps"], check=True,
                          capture_output=True, text=True)
     return float(out.stdout.strip().splitlines()[-1])
+
+
+def print_memory(n: int) -> None:
+    """Print both peak memories of an n x n run."""
+    print(f"peak memory, {n} x {n} single layer: {peak_memory_mb(n):.0f} MB "
+          f"(target < 300); with interpolated outputs {peak_memory_mb(n, True):.0f} MB")
 
 
 def main() -> None:
@@ -185,8 +201,7 @@ def main() -> None:
                     help="the peak memory alone (--memory N), no timings")
     args = ap.parse_args()
     if args.memory_only:
-        print(f"peak memory, {args.memory} x {args.memory} single layer: "
-              f"{peak_memory_mb(args.memory):.0f} MB (target < 300)")
+        print_memory(args.memory)
         return
     rows = measure(args.cells, args.repeats)
     print(f"{args.cells} x {args.cells} cells, t = {T_END} s, {SCHEME}, "
@@ -203,8 +218,7 @@ def main() -> None:
     print(f"two layers / single 2D:  {ns['two layers 2D'] / ns['single 2D']:.2f} "
           f"(target <= 3.5; in 1D {ns['two layers 1D'] / ns['single 1D']:.2f})")
     if args.memory:
-        print(f"peak memory, {args.memory} x {args.memory} single layer: "
-              f"{peak_memory_mb(args.memory):.0f} MB (target < 300)")
+        print_memory(args.memory)
 
 
 if __name__ == "__main__":

@@ -262,3 +262,56 @@ def test_a_tracker_used_again_takes_its_own_times_again():
         assert tracker.interrupt.next(0.015) == pytest.approx(0.02)  # asked again
         tracker.final_state_next()
         assert not tracker.handed_early(0.015)  # the run's end: taken
+
+
+def _frames(eq, state, t_end: float, outputs: str) -> tuple[list, list, int]:
+    """Times and states of a run asked for its state every 0.1 ms (fv-split with
+    ``outputs``), and its steps."""
+    solver = FVSplitSolver(eq, t_end=t_end, outputs=outputs)
+    steps = solver.make_stepper(state)
+    t, times, frames = 0.0, [], []
+    while t < t_end - 1e-12:
+        t = steps(state, t, min(t + 1e-4, t_end))
+        times.append(t)
+        frames.append(state.data.copy())
+    return times, frames, solver.info["steps"]
+
+
+@pytest.mark.parametrize("dims", [1, 2])
+def test_outputs_within_one_step_lie_on_the_line_between_its_two_states(dims):
+    """Frames 20 times closer than the steps (several outputs inside each step): each
+    is the linear interpolation between the states before and after the step around
+    it, which the same run with outputs "step" gives (the solver's state before the
+    step is not copied for each output, nor rewritten between them), and the run ends
+    on the untracked run's state, on a 1D and a 2D grid."""
+    from pde import CartesianGrid
+
+    import pdeflow
+
+    if dims == 1:
+        grid = CartesianGrid([[0, 2.0]], [40])
+        h = np.where(grid.axes_coords[0] < 0.6, 0.3, 0.0)
+        bc = ("wall", "open")
+    else:
+        grid = CartesianGrid([[0, 2.0], [0, 1.0]], [40, 20])
+        x, y = np.meshgrid(*grid.axes_coords, indexing="ij")
+        h = np.where(np.hypot(x - 0.6, y - 0.5) < 0.3, 0.3, 0.0)
+        bc = (("wall", "open"), ("open", "wall"))
+    eq = pdeflow.SingleLayerGranular(theta_deg=25, phi_b_deg=20, bc=bc)
+    t_end = 0.05
+    alone = eq.solve(eq.make_state(grid, h=h), t_range=t_end, solver="fv-split",
+                     tracker=None)
+    state = eq.make_state(grid, h=h)
+    times, frames, n_steps = _frames(eq, state, t_end, "interpolate")
+    assert n_steps < len(frames) / 5
+    np.testing.assert_array_equal(state.data, alone.data)
+    t_steps, at_steps, _ = _frames(eq, eq.make_state(grid, h=h), t_end, "step")
+    t_steps = [0.0, *t_steps]
+    at_steps = [eq.make_state(grid, h=h).data, *at_steps]
+    scale = np.abs(h).max()
+    for t, frame in zip(times, frames, strict=True):
+        b = int(np.searchsorted(t_steps, t))  # the step from t_steps[b - 1] to t_steps[b]
+        w = (t - t_steps[b - 1]) / (t_steps[b] - t_steps[b - 1])
+        expected = w * at_steps[b] + (1.0 - w) * at_steps[b - 1]
+        # (the weights differ from the solver's by round-off in the times)
+        np.testing.assert_allclose(frame, expected, rtol=0, atol=1e-12 * scale)

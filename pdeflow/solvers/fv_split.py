@@ -236,12 +236,15 @@ class FVSplitSolver(SolverBase):
             t_run = t_pause if self.t_end is None else max(self.t_end, t_pause)
             if changed:  # someone changed the state: go on from it, not from a step ahead
                 ahead.clear()
-            done, t_start = self._resume(ahead, data, float(t_start), t_pause)
+            done, t_start, start = self._resume(ahead, data, float(t_start), t_pause)
             if done:
                 return t_start
-            # the state at the call's start, kept for a blow-up: in prev, which the
-            # compiled loop writes only in a step that reaches t_pause (its last)
-            np.copyto(entry, data)
+            # the call's start for a blow-up: the step ahead's, py-pde's state (several
+            # axes: not the kernels' array), or a copy in prev (the compiled loop writes
+            # it only in a step that reaches t_pause, its last)
+            if start is None and data is state.data:
+                start = entry
+                np.copyto(entry, data)
             t, steps, status = advance(data, float(t_start), t_pause, t_run, changed)
             self.info["steps"] += int(steps)
             # not "dt": py-pde's controller would then fire every tracker due within half
@@ -250,14 +253,11 @@ class FVSplitSolver(SolverBase):
             # the steps land on the output times (interpolated), no tolerance is needed
             self.info["last_dt"] = float(diag[L.D_DT]) or None
             if status == STATUS_FAIL:
-                self._blowup(state, data, entry, t_start, t, t_run, replay)
+                self._blowup(state, data, start, t_start, t, t_run, replay)
             if t_pause < t < t_run and self.outputs == "interpolate":
-                # the step went past the output time: output the state at that time,
-                # continue from the step's end at the next call
-                dt = float(diag[L.D_DT]) * (2.0 if self.scheme.strang else 1.0)
-                ahead.append(pending_output(data, prev, t, dt, status == STATUS_REST))
-                ahead[0].interpolate(data, t_pause)
-                return t_pause
+                return self._output_inside(ahead, data, prev, diag, t, t_pause,
+                                           status == STATUS_REST,
+                                           None if start is entry else start)
             if status == STATUS_REST:
                 self._at_rest(t)
             return float(t)
@@ -295,23 +295,35 @@ class FVSplitSolver(SolverBase):
 
         return stepper
 
+    def _output_inside(self, ahead: list[StepAhead], data: np.ndarray, prev: np.ndarray,
+                       diag: np.ndarray, t: float, t_pause: float, at_rest: bool,
+                       spare: np.ndarray | None) -> float:
+        """The step from ``prev`` to ``data`` (at ``t`` [s]; its dt in ``diag``) went
+        past the output time ``t_pause`` [s]: keep its end in ``ahead`` (in ``spare``,
+        if given, see :func:`pending_output`) for the next call to go on from, write
+        the state at ``t_pause`` into ``data`` and return ``t_pause``."""
+        dt = float(diag[L.D_DT]) * (2.0 if self.scheme.strang else 1.0)
+        ahead.append(pending_output(data, prev, t, dt, at_rest, spare=spare))
+        ahead[0].interpolate(data, t_pause)
+        return t_pause
+
     def _resume(self, ahead: list[StepAhead], data: np.ndarray, t_start: float,
-                t_pause: float) -> tuple[bool, float]:
+                t_pause: float) -> tuple[bool, float, np.ndarray | None]:
         """After an interpolated output (``ahead`` holds the step past it): ``(True,
-        t)`` if the call to ``t_pause`` [s] is answered from it (another output time
-        within the same step, or its end), else ``(False, t)`` with the step's end
-        restored as the state ``data`` (cells flattened) at ``t``; ``(False, t_start)``
-        if nothing is ahead."""
+        t, None)`` if the call to ``t_pause`` [s] is answered from it (another output
+        time within the same step, or its end), else ``(False, t, q)`` with the step's
+        end ``q`` restored as the state ``data`` (cells flattened) at ``t``; ``(False,
+        t_start, None)`` if nothing is ahead."""
         if not ahead:
-            return False, t_start
+            return False, t_start, None
         if t_pause < ahead[0].t:  # another output time within the same step
             ahead[0].interpolate(data, t_pause)
-            return True, t_pause
+            return True, t_pause, None
         step = ahead.pop()
         data[...] = step.q
         if step.at_rest:
             self._at_rest(step.t)
-        return step.t >= t_pause, step.t
+        return step.t >= t_pause, step.t, step.q
 
     def _at_rest(self, t: float) -> None:
         """End the run: everything is at rest from ``t`` [s] on."""
@@ -319,20 +331,21 @@ class FVSplitSolver(SolverBase):
         _RestProfilerFilter.ended_at_rest = True
         raise FinishedSimulation(f"everything at rest at t={t:.6g} s")
 
-    def _blowup(self, state: Any, data: np.ndarray, entry: np.ndarray, t_start: float,
-                t: float, t_end: float, replay: Any) -> None:
+    def _blowup(self, state: Any, data: np.ndarray, entry: np.ndarray | None,
+                t_start: float, t: float, t_end: float, replay: Any) -> None:
         """Raise :class:`SimulationBlowUp` with the diagnostic of the failed step.
 
         ``data`` (the kernels' ``q[field, cell]``, see :func:`on_cells`) holds the state
         before the failed step (time ``t``); if a source stage had already spoiled it,
-        the state at the start of this stepper call (``entry``, time ``t_start``) is
+        the state at the start of this stepper call (``entry``, time ``t_start``; None:
+        py-pde's ``state``, which :func:`on_cells` writes only after the call) is
         restored instead.
         """
         pde: GranularPDE = self.pde
         report = diagnose_blowup(pde, data, t, t_end, replay)
         t_kept = t
         if report.get("stage") == 0:
-            data[...] = entry
+            data[...] = state.data.reshape(data.shape) if entry is None else entry
             t_kept = t_start
         step = int(self.info["steps"]) + 1
         mode = getattr(getattr(pde, "parameters", None), "hyperbolicity", None)

@@ -43,11 +43,19 @@ class StepAhead:
         span = self.t - self.t_prev
         w = 1.0 if span <= 0 else min(max((t - self.t_prev) / span, 0.0), 1.0)
         np.multiply(self.q, w, out=out)
-        out += (1.0 - w) * self.prev
+        for row, before in zip(out, self.prev, strict=True):  # a temporary of one row
+            row += (1.0 - w) * before
 
 
 def pending_output(q: np.ndarray, prev: np.ndarray, t: float, dt: float,
-                   at_rest: bool) -> StepAhead:
+                   at_rest: bool, spare: np.ndarray | None = None) -> StepAhead:
     """A :class:`StepAhead` from the state ``q`` at ``t`` [s] after a step of ``dt``
-    [s] from ``prev`` (both copied)."""
-    return StepAhead(t=t, q=q.copy(), t_prev=t - dt, prev=prev.copy(), at_rest=at_rest)
+    [s] from ``prev``. ``q`` is copied (the output overwrites it), into ``spare`` if
+    given (the last step ahead's array, taken up: no second copy alive at once);
+    ``prev`` is not: the solver writes its array again only after the step ahead was
+    taken up or dropped."""
+    if spare is None:
+        spare = q.copy()
+    else:
+        np.copyto(spare, q)
+    return StepAhead(t=t, q=spare, t_prev=t - dt, prev=prev, at_rest=at_rest)
