@@ -79,6 +79,32 @@ for two, scheme, strang in ((True, {}, False), (True, {"reconstruction": "muscl"
         steps = step(eq, st, t_end, strang=strang)[2]
         counts.append((steps, rtsys.get_allocation_stats().alloc - a0.alloc))
     out.append(counts)
+# 2D: both models, first order and MUSCL + Strang, one and two threads
+from pde import CartesianGrid
+g2 = CartesianGrid([[0, 3.0], [0, 3.0]], [40, 40])
+x, y = np.meshgrid(*g2.axes_coords, indexing="ij")
+disc = np.where(np.hypot(x - 1.0, y - 1.5) < 0.5, 0.5, 0.0)
+walls = (("wall", "wall"), ("wall", "wall"))
+for two in (True, False):
+    for scheme in ("hll/first-order", "hll/muscl/mc+strang"):
+        for threads in (1, 2):
+            if two:
+                eq = pdeflow.TwoLayerGranular(theta_deg=30, scheme=scheme, bc=walls)
+                make = lambda: eq.make_state(g2, h1=0.4 * disc, h2=0.6 * disc)
+            else:
+                eq = pdeflow.SingleLayerGranular(theta_deg=30, phi_b_deg=20, scheme=scheme,
+                                                 bc=walls)
+                make = lambda: eq.make_state(g2, h=disc)
+            counts = []
+            for t_end in (0.001, 0.01, 0.1):  # (the first: compile or load)
+                st = make()
+                solver = pdeflow.FVSplitSolver(eq, threads=threads, t_end=t_end)
+                stepper = solver.make_stepper(st)
+                a0 = rtsys.get_allocation_stats()
+                stepper(st, 0.0, t_end)
+                counts.append((solver.info["steps"],
+                               rtsys.get_allocation_stats().alloc - a0.alloc))
+            out.append(counts[1:])
 print(json.dumps(out))
 """
 
@@ -86,7 +112,8 @@ print(json.dumps(out))
 def test_the_stepping_loop_allocates_nothing_per_step():
     """numba's runtime counts its allocations (NUMBA_NRT_STATS=1, set before numba is
     imported, hence a subprocess): a run of ten times as many steps allocates exactly as
-    often as a short one."""
+    often as a short one, on a 1D and a 2D grid (whose passes over rows put what the
+    rows share in one array a call, ``boxes.gather_rows``), with one and two threads."""
     import json
     import os
     import subprocess

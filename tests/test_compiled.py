@@ -139,8 +139,8 @@ for flux in sys.argv[1:]:
     k = ready(advection_kernel(SINGLE_LAYER, getattr(L, flux), 1, L.LIMITER_MINMOD,
                                L.GEOMETRY_PLANAR))
     rate = np.zeros_like(q)
-    k(q, rate, np.zeros((3, 2, 8)), 0.1, np.zeros((L.N_METRIC, 9)), 0, 0, 9.81, 0.0, 1e-6, 0,
-      7)
+    k(q, rate, np.zeros((3, 2, 8)), np.zeros((1, L.N_DIAG)), 0.1, np.zeros((L.N_METRIC, 9)),
+      0, 0, 9.81, 0.0, 1e-6, 0, 7)
     out.append([rate.tolist(), sum(k.stats.cache_hits.values())])
 print("STATS" + json.dumps(out))
 """

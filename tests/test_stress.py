@@ -513,8 +513,9 @@ def test_ifcp_steps_that_are_not_positive_are_redone_with_hll():
             *_, ok, _, _, _ = advect_step_function(1, False)(
                 kernels.advect, kernels.sources, None, q, 0.0, T_FAR, 1.0 / 3,
                 np.zeros((L.N_METRIC, n + 1)), *eq.bc_codes, P, *eq.kernels.constants(P), 0.5,
-                diag, np.zeros_like(q), q.copy(), np.zeros((2, *q.shape)), np.zeros_like(q),
-                np.zeros(L.N_DIAG), np.zeros(n), True, 0, n - 1, 0, n - 1, 0.0, n)
+                diag, np.zeros_like(q), q.copy(), np.zeros((2, *q.shape)),
+                np.zeros((1, L.N_DIAG)), np.zeros_like(q), np.zeros(L.N_DIAG), np.zeros(n),
+                True, 0, n - 1, 0, n - 1, 0.0, n)
             if not ok:
                 assert flux == "ifcp"  # only IFCP is not positive
             t = stepper(state, t, T_FAR)

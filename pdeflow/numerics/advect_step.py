@@ -84,8 +84,8 @@ def advect_step_function(order: int, strang: bool, update: Any = None, width: in
     the blow-up diagnosis runs it in Python with an instrumented ``update``):
 
     ``advect_step(advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
-    P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep, first, e_lo, e_hi,
-    b_lo, b_hi, s_rest, line)`` advances the cells of the box ``b_lo, b_hi``
+    P, g, r, dry, cfl, diag, rate, backup, rec, gather, q0, diag_keep, fex_keep, first,
+    e_lo, e_hi, b_lo, b_hi, s_rest, line)`` advances the cells of the box ``b_lo, b_hi``
     (:mod:`pdeflow.numerics.boxes`, ``line`` cells a row; on a 1D grid the range
     ``b_lo..b_hi``) with the model's kernels (see
     :func:`stepping_kernel`): the cells the step may change, saved in ``backup`` (and,
@@ -113,11 +113,11 @@ def advect_step_function(order: int, strang: bool, update: Any = None, width: in
     copy_box, copy_box1, clear_outside, _, _ = box_passes(compiled and two_d)
 
     def advect_step(advect, sources, predictor, q, t, t_end, dx, metric, bc_left, bc_right,
-                    P, g, r, dry, cfl, diag, rate, backup, rec, q0, diag_keep, fex_keep,
-                    first, e_lo, e_hi, b_lo, b_hi, s_rest, line):
+                    P, g, r, dry, cfl, diag, rate, backup, rec, gather, q0, diag_keep,
+                    fex_keep, first, e_lo, e_hi, b_lo, b_hi, s_rest, line):
         fex = diag[L.N_DIAG:]
-        smax, a_lo, a_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry,
-                                  e_lo, e_hi)
+        smax, a_lo, a_hi = advect(q, rate, rec, gather, dx, metric, bc_left, bc_right, g,
+                                  r, dry, e_lo, e_hi)
         smax = max(smax, s_rest)
         a_lo, a_hi = box_meet(a_lo, a_hi, b_lo, b_hi, line)
         dt = t_end - t
@@ -138,11 +138,11 @@ def advect_step_function(order: int, strang: bool, update: Any = None, width: in
             h_hi = b_hi if first else a_hi
             for attempt in range(40):
                 diag[L.D_DT] = 0.5 * dt
-                sources_box(sources, q, 0.5 * dt, t, P, diag, h_lo, h_hi, line)
+                sources_box(sources, q, 0.5 * dt, t, P, diag, gather, h_lo, h_hi, line)
                 changed = diag[L.D_CHANGED]
                 # (a deposit can lift a cell of sub-dry layers above dry: search wider)
-                smax2, a_lo, a_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry,
-                                           e_lo, e_hi)
+                smax2, a_lo, a_hi = advect(q, rate, rec, gather, dx, metric, bc_left,
+                                           bc_right, g, r, dry, e_lo, e_hi)
                 smax2 = max(smax2, s_rest)
                 a_lo, a_hi = box_meet(a_lo, a_hi, b_lo, b_hi, line)
                 if smax2 * dt <= cfl * dx * (1.0 + 1e-9) or attempt == 39:
@@ -154,20 +154,20 @@ def advect_step_function(order: int, strang: bool, update: Any = None, width: in
                 copy_box1(fex, fex_keep, b_lo, b_hi, line)
                 dt = min(0.5 * dt, cfl * dx / smax2)
         if not muscl:
-            mass_rate, ok = update_box(q, q, rate, dt, 0.0, a_lo, a_hi, line)
+            mass_rate, ok = update_box(q, q, rate, dt, 0.0, gather, a_lo, a_hi, line)
             return dt, mass_rate, ok, a_lo, a_hi, changed
         copy_box(q0, q, b_lo, b_hi, line)
-        mass_rate, ok = update_box(q, q0, rate, dt, 0.0, a_lo, a_hi, line)
+        mass_rate, ok = update_box(q, q0, rate, dt, 0.0, gather, a_lo, a_hi, line)
         if ok:
             predictor_box(predictor, q, dt, P, a_lo, a_hi, line)
-            _, c_lo, c_hi = advect(q, rate, rec, dx, metric, bc_left, bc_right, g, r, dry, e_lo,
-                                   e_hi)
+            _, c_lo, c_hi = advect(q, rate, rec, gather, dx, metric, bc_left, bc_right, g,
+                                   r, dry, e_lo, e_hi)
             c_lo, c_hi = box_meet(c_lo, c_hi, b_lo, b_hi, line)
             # cells of the first stage that the second does not reach get rate 0 (on a
             # 2D grid also those of the joined box in neither: their rate is stale)
             u_lo, u_hi = box_join(a_lo, a_hi, c_lo, c_hi, line)
             clear_outside(rate, u_lo, u_hi, c_lo, c_hi, line)
-            mass2, ok = update_box(q, q0, rate, dt, 0.5, u_lo, u_hi, line)
+            mass2, ok = update_box(q, q0, rate, dt, 0.5, gather, u_lo, u_hi, line)
             mass_rate = max(mass_rate, mass2)
             a_lo = u_lo
             a_hi = u_hi

@@ -43,7 +43,7 @@ from numba import njit, prange
 
 from . import layout as L
 from .bed_slope import bed_slope
-from .boxes import box_grow, box_of, rows_of, zero_box
+from .boxes import box_grow, box_of, gather_rows, rows_of, zero_box
 from .compiled import FIELDS, METRIC, STATE, WORK, cached, f8, i8, kernel, specialise
 from .geometry import area_change, area_change_muscl
 from .model_kernels import ModelKernels, check_flux
@@ -92,17 +92,20 @@ def line_wet(q: np.ndarray, dry: float, width: int, base: int, stride: int, k0: 
 
 
 @cached(inline="always")
-def wet_box(q: np.ndarray, dry: float, lo: int, hi: int, width: int,
-            line: int) -> tuple[int, int]:
+def wet_box(q: np.ndarray, dry: float, lo: int, hi: int, width: int, line: int,
+            gather: np.ndarray) -> tuple[int, int]:
     """The bounding box of the wet cells (:func:`wet_cells`) of the box (lo, hi) of a
-    grid of ``line`` cells a row (:mod:`pdeflow.numerics.boxes`); ``(1, 0)`` if none."""
+    grid of ``line`` cells a row (:mod:`pdeflow.numerics.boxes`); ``(1, 0)`` if none.
+    Each row's wet range goes through ``gather`` (one entry per row,
+    :func:`pdeflow.numerics.boxes.gather_rows`; cell indices, exact as floats)."""
     x0, x1, y0, y1 = rows_of(lo, hi, line)
     a0, a1, b0, b1 = x1 + 1, x0 - 1, y1 + 1, y0 - 1  # an empty box
-    wet = np.empty((max(x1 - x0 + 1, 0), 2), np.int64)
     for k in prange(x1 - x0 + 1):  # the rows on threads in a parallel kernel
-        wet[k, 0], wet[k, 1] = line_wet(q, dry, width, (x0 + k) * line, 1, y0, y1)
+        klo, khi = line_wet(q, dry, width, (x0 + k) * line, 1, y0, y1)
+        gather[k, 0] = klo
+        gather[k, 1] = khi
     for x in range(x0, x1 + 1):  # (min and max: the same box whatever the threads)
-        klo, khi = wet[x - x0, 0], wet[x - x0, 1]
+        klo, khi = int(gather[x - x0, 0]), int(gather[x - x0, 1])
         if klo <= khi:
             a0 = min(a0, x)
             a1 = x
@@ -130,14 +133,15 @@ def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, ax
                     axisymmetric: bool, lines: bool, terrain: bool = False) -> Any:
     """The faces of one axis as a Python closure (inlined into the advection stage):
 
-    ``faces(q, qm, qp, rate, metric, lo, hi, stride, count, inv_dx, s_lo, s_hi, g, r,
-    dry, per_row) -> smax`` subtracts the fluctuations of the axis' faces next to the wet
+    ``faces(q, qm, qp, rate, metric, gather, lo, hi, stride, count, inv_dx, s_lo, s_hi,
+    g, r, dry, per_row) -> smax`` subtracts the fluctuations of the axis' faces next to the wet
     cells of ``lo..hi`` (``qp``: the face values on the cells' high sides, ``qm`` on
     their low sides) from ``rate``, weighted ``inv_dx`` [1/m] (axisymmetric: the
     metric's rows), in the rows ``rows`` (``width`` rows per layer); line by line of the
     axis (``lines``: a 2D grid of ``per_row`` cells a row, and ``lo, hi`` a box,
-    :mod:`pdeflow.numerics.boxes`, whose cells on each line are all that line's visited;
-    else the one line of a 1D grid, whose wet cells are ``lo..hi``), in each the faces
+    :mod:`pdeflow.numerics.boxes`, whose cells on each line are all that line's visited,
+    each line's largest speed put in ``gather``'s first column; else the one line of a
+    1D grid, whose wet cells are ``lo..hi``), in each the faces
     between and beside its wet cells as on a 1D grid: interior faces first, then the
     low and the high boundary sides, whose ghost cells have their normal momenta times
     ``s_lo``, ``s_hi`` (-1: wall, 1: open). Returns the largest wave speed [m/s].
@@ -198,8 +202,8 @@ def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, ax
                 rate[j if identity else rows[j], i] -= dm[j] * w_l
         return smax
 
-    def faces(q, qm, qp, rate, metric, lo, hi, stride, count, inv_dx, s_lo, s_hi, g, r,
-              dry, per_row):
+    def faces(q, qm, qp, rate, metric, gather, lo, hi, stride, count, inv_dx, s_lo, s_hi,
+              g, r, dry, per_row):
         if not lines:
             return line(q, qm, qp, rate, metric, 0, 1, count, lo, hi, inv_dx, s_lo, s_hi, g,
                         r, dry)
@@ -209,14 +213,17 @@ def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, ax
             l0, l1, step, k0, k1 = x0, x1, per_row, y0, y1
         else:  # lines of the first axis: the box's columns
             l0, l1, step, k0, k1 = y0, y1, 1, x0, x1
-        speeds = np.zeros(l1 - l0 + 1)
         for m in prange(l0, l1 + 1):  # lines on threads: each writes its own cells
             base = m * step  # the line of cells base + k stride, k = 0..count - 1
             klo, khi = line_wet(q, dry, width, base, stride, k0, k1)
+            gather[m - l0, 0] = 0.0
             if klo <= khi:
-                speeds[m - l0] = line(q, qm, qp, rate, metric, base, stride, count, klo,
-                                      khi, inv_dx, s_lo, s_hi, g, r, dry)
-        return speeds.max()
+                gather[m - l0, 0] = line(q, qm, qp, rate, metric, base, stride, count, klo,
+                                         khi, inv_dx, s_lo, s_hi, g, r, dry)
+        smax = 0.0
+        for m in range(l1 - l0 + 1):  # (a maximum: the same whatever the threads)
+            smax = max(smax, gather[m, 0])
+        return smax
 
     return faces
 
@@ -224,8 +231,8 @@ def _faces_function(face: Any, fluct: Any, rows: tuple[int, ...], width: int, ax
 def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, axis: int,
                    axisymmetric: bool, lines: bool, terrain: bool = False) -> Any:
     """One axis' part of the advection stage as a Python closure (inlined):
-    ``along(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count, inv_dx, bc_lo,
-    bc_hi, g, r, dry, per_row) -> smax``: MUSCL's face values along the axis in cells
+    ``along(q, rate, work, gather, metric, lo, hi, r_lo, r_hi, stride, count, inv_dx,
+    bc_lo, bc_hi, g, r, dry, per_row) -> smax``: MUSCL's face values along the axis in cells
     ``r_lo..r_hi``, the axis' faces next to ``lo..hi`` (:func:`_faces_function`), the
     MUSCL cell jump along the axis; with ``lines`` (a 2D grid of ``per_row`` cells a
     row) ``lo, hi`` and ``r_lo, r_hi`` are boxes (:mod:`pdeflow.numerics.boxes`).
@@ -244,8 +251,8 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
     cell_jump = model.cell_jump if muscl or terrain else None
     bed_faces = model.terrain if terrain else None
 
-    def along(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count, inv_dx, bc_lo,
-              bc_hi, g, r, dry, per_row):
+    def along(q, rate, work, gather, metric, lo, hi, r_lo, r_hi, stride, count, inv_dx,
+              bc_lo, bc_hi, g, r, dry, per_row):
         x0, x1, y0, y1 = rows_of(r_lo, r_hi, per_row) if lines else (0, 0, r_lo, r_hi)
         if muscl:
             for x in prange(x0, x1 + 1):  # a 2D grid's box row by row, on threads
@@ -264,8 +271,8 @@ def _axis_function(model: ModelKernels, flux: int, muscl: bool, limiter: int, ax
         # a ghost cell: a wall mirrors the face value next to it, an open end copies it
         s_lo = -1.0 if bc_lo == L.BC_WALL else 1.0
         s_hi = -1.0 if bc_hi == L.BC_WALL else 1.0
-        smax = faces(q, qm, qp, rate, metric, lo, hi, stride, count, inv_dx, s_lo, s_hi, g,
-                     r, dry, per_row)
+        smax = faces(q, qm, qp, rate, metric, gather, lo, hi, stride, count, inv_dx, s_lo,
+                     s_hi, g, r, dry, per_row)
         if muscl:
             # axisymmetric too: the mean face area over the volume is 1/dr exactly
             for x in prange(x0, x1 + 1):
@@ -290,14 +297,15 @@ def _axis(metric: np.ndarray, a: int, dx: float) -> tuple[int, int, float, float
             dx / width * 2.0)
 
 
-ADVECT_SIGNATURE = (STATE, FIELDS, WORK, f8, METRIC, i8, i8, f8, f8, f8, i8, i8)
+ADVECT_SIGNATURE = (STATE, FIELDS, WORK, FIELDS, f8, METRIC, i8, i8, f8, f8, f8, i8, i8)
 
 
 @functools.cache
 def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
                      geometry: int) -> Any:
     r"""The advection stage of one model's scheme on one geometry: ``advect(q, rate,
-    work, dx, metric, bc_left, bc_right, g, r, dry, start, stop) -> (smax, r_lo, r_hi)``.
+    work, gather, dx, metric, bc_left, bc_right, g, r, dry, start, stop) -> (smax, r_lo,
+    r_hi)``.
 
     Writes the rate of the state ``q`` (fields x cells, flattened) into ``rate`` in the
     cells it can change, ``r_lo..r_hi``: the wet cells within ``start..stop``
@@ -310,7 +318,8 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
     the faces visited [m/s], on a grid of several axes each face's scaled by (dx / dx_a)
     times the number of axes, so that ``cfl dx / smax`` bounds the sum over axes of the
     Courant numbers by ``cfl``; and ``r_lo, r_hi`` (``0.0, 1, 0`` if nothing is wet).
-    ``work`` is scratch space of shape (2, fields, cells); ``g``, ``r``, ``dry``: the
+    ``work`` is scratch space of shape (2, fields, cells), ``gather`` that of a 2D
+    grid's lines (:func:`pdeflow.numerics.boxes.gather_rows`); ``g``, ``r``, ``dry``: the
     model's constants (:attr:`ModelKernels.constants`). ``model`` gives the face states,
     fluctuations and the MUSCL cell jump; ``flux`` (layout.FLUX_*), ``order`` (1: first
     order, 2: MUSCL) and ``limiter`` (layout.LIMITER_*) choose the scheme. ``bc_left``,
@@ -352,7 +361,8 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
                                                    True, terrain)) if two_d else None
     area = (area_change_muscl if muscl else area_change) if axisymmetric else None
 
-    def advect(q, rate, work, dx, metric, bc_left, bc_right, g, r, dry, start, stop):
+    def advect(q, rate, work, gather, dx, metric, bc_left, bc_right, g, r, dry, start,
+               stop):
         n = q.shape[1]
         if not two_d:
             lo, hi = wet_cells(q, dry, start, stop, width)
@@ -361,8 +371,8 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
             r_lo = max(lo - 1, 0)
             r_hi = min(hi + 1, n - 1)
             rate[:, r_lo:r_hi + 1] = 0.0
-            smax = along_x(q, rate, work, metric, lo, hi, r_lo, r_hi, 1, n, 1.0 / dx,
-                           bc_left, bc_right, g, r, dry, n)
+            smax = along_x(q, rate, work, gather, metric, lo, hi, r_lo, r_hi, 1, n,
+                           1.0 / dx, bc_left, bc_right, g, r, dry, n)
             if axisymmetric and muscl:
                 area(work[0], work[1], rate, r_lo, r_hi, metric, dry, width)
             elif axisymmetric:
@@ -371,18 +381,19 @@ def advection_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
         # a 2D grid: start, stop and what is returned are boxes, the wet cells' widened
         # by one cell along both axes: the cells their faces write to
         per_row = int(metric[L.M_AXES, 4])
-        lo, hi = wet_box(q, dry, start, stop, width, per_row)
+        lo, hi = wet_box(q, dry, start, stop, width, per_row, gather)
         if lo > hi:
             return 0.0, 1, 0
         r_lo, r_hi = box_grow(lo, hi, 1, per_row, n)
         zero_box(rate, r_lo, r_hi, per_row)
         stride, count, inv_width, scale = _axis(metric, 0, dx)
-        smax = scale * along_x(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count,
-                               inv_width, bc_left & 1, bc_right & 1, g, r, dry, per_row)
+        smax = scale * along_x(q, rate, work, gather, metric, lo, hi, r_lo, r_hi, stride,
+                               count, inv_width, bc_left & 1, bc_right & 1, g, r, dry,
+                               per_row)
         stride, count, inv_width, scale = _axis(metric, 1, dx)
-        s = scale * along_y(q, rate, work, metric, lo, hi, r_lo, r_hi, stride, count,
-                            inv_width, (bc_left >> 1) & 1, (bc_right >> 1) & 1, g, r, dry,
-                            per_row)
+        s = scale * along_y(q, rate, work, gather, metric, lo, hi, r_lo, r_hi, stride,
+                            count, inv_width, (bc_left >> 1) & 1, (bc_right >> 1) & 1, g,
+                            r, dry, per_row)
         return max(smax, s), r_lo, r_hi
 
     return specialise(advect, *ADVECT_SIGNATURE, parallel=two_d)
@@ -396,9 +407,13 @@ def rate_kernel(model: ModelKernels, flux: int, order: int, limiter: int,
     every cell of ``out``; arguments as :func:`advection_kernel`."""
     advect = advection_kernel(model, flux, order, limiter, geometry)
 
+    two_d = geometry in (L.GEOMETRY_PLANAR_2D, L.GEOMETRY_TERRAIN_2D)
+
     def advection_rate(q, out, work, dx, metric, bc_left, bc_right, g, r, dry):
         out[:, :] = 0.0
-        return advect(q, out, work, dx, metric, bc_left, bc_right, g, r, dry, 0,
-                      q.shape[1] - 1)[0]
+        n = q.shape[1]
+        gather = gather_rows(n, int(metric[L.M_AXES, 4]) if two_d else n, two_d)
+        return advect(q, out, work, gather, dx, metric, bc_left, bc_right, g, r, dry, 0,
+                      n - 1)[0]
 
-    return specialise(advection_rate, *ADVECT_SIGNATURE[:-2])
+    return specialise(advection_rate, *ADVECT_SIGNATURE[:3], *ADVECT_SIGNATURE[4:-2])

@@ -142,9 +142,22 @@ def clear_outside1(a: np.ndarray, lo: int, hi: int, lo2: int, hi2: int,
                 a[x * line + y] = 0.0
 
 
-def _sources_in_box(sources, q, dt, t, P, diag, lo, hi, line):
+@cached(inline="always")
+def gather_rows(n: int, line: int, two_d: bool) -> np.ndarray:
+    """Where the rows (or lines) of a pass over a box put what they share, one row of
+    ``L.N_DIAG`` floats each (the source stage's bookings,
+    :func:`pdeflow.numerics.threads.box_kernels`; the largest wave speed and mass rate,
+    the wet and live boxes): one array for every pass of a stepping loop's call, so that
+    no pass allocates per step. ``n`` cells in lines of ``line`` (a 2D
+    grid, ``two_d``: rows x columns, as many entries as the longer side; a 1D grid
+    shares nothing: one entry)."""
+    return np.empty((max(n // line, line) if two_d else 1, L.N_DIAG))
+
+
+def _sources_in_box(sources, q, dt, t, P, diag, gather, lo, hi, line):
     """The model's source stage on the cells of the box (lo, hi): one call on a box that
-    is a range of the flattened index (a 1D grid's always), else one call a row.
+    is a range of the flattened index (a 1D grid's always), else one call a row
+    (``gather``, what a 2D grid's rows share, is not used).
 
     A stage books what it saw in ``diag`` (``splitting.SOURCES``): a model's own slots
     must come out of calls on the rows as out of one call on their cells (times of last
@@ -175,12 +188,13 @@ def _predictor_in_box(predictor, q, dt, P, lo, hi, line):
 
 
 def update_in_box_function(update: Any) -> Any:
-    """``update_in_box(q, base, rate, dt, weight, lo, hi, line) -> (mass_rate, ok)``:
-    the state update ``update`` (:func:`pdeflow.numerics.advect_step.update_function`)
-    on the cells of the box (lo, hi), one call or one a row, as
-    :func:`_sources_in_box`; the largest mass rate and whether every row was ok."""
+    """``update_in_box(q, base, rate, dt, weight, gather, lo, hi, line) -> (mass_rate,
+    ok)``: the state update ``update``
+    (:func:`pdeflow.numerics.advect_step.update_function`) on the cells of the box
+    (lo, hi), one call or one a row, as :func:`_sources_in_box` (``gather`` not used);
+    the largest mass rate and whether every row was ok."""
 
-    def update_in_box(q, base, rate, dt, weight, lo, hi, line):
+    def update_in_box(q, base, rate, dt, weight, gather, lo, hi, line):
         if contiguous(lo, hi, line):
             return update(q, base, rate, dt, weight, lo, hi)
         x0, x1, y0, y1 = rows_of(lo, hi, line)
@@ -195,10 +209,10 @@ def update_in_box_function(update: Any) -> Any:
     return update_in_box
 
 
-def _sources_of_box(sources, q, dt, t, P, diag, lo, hi, line):
+def _sources_of_box(sources, q, dt, t, P, diag, gather, lo, hi, line):
     """A 2D grid's source stage, which takes the box itself
     (:func:`pdeflow.numerics.threads.box_kernels`: its rows on numba's threads)."""
-    sources(q, dt, t, P, diag, lo, hi, line)
+    sources(q, dt, t, P, diag, gather, lo, hi, line)
 
 
 def _predictor_of_box(predictor, q, dt, P, lo, hi, line):

@@ -31,7 +31,7 @@ from numba import njit, types
 from . import layout as L
 from .advect_step import _copy_range, advect_step_function, speed_scale
 from .advection import ADVECT_SIGNATURE, advection_kernel
-from .boxes import box_grow, row_calls
+from .boxes import box_grow, gather_rows, row_calls
 from .compiled import (
     FIELDS,
     METRIC,
@@ -100,6 +100,7 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
         s_hi = n - 1
         # running maxima of the wave speed of the cells at rest outside the box visited
         speeds, valid = rest_maxima(n, line)
+        gather = gather_rows(n, line, two_d)  # what rows share, for every step
         # backup holds the state a step starts from wherever the step can change it:
         # copied here for a call that starts afresh, else kept by the last step's
         # live pass (live_box), which sets it to the state it leaves on its box
@@ -123,8 +124,8 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
                 dt, mass_rate, ok, a_lo, a_hi, changed = advect_step(
                     fallback if fell_back else advect, sources, predictor, q, t, step_end,
                     dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag, rate, backup,
-                    rec, q0, diag_keep, fex_keep, first, e_lo, e_hi, b_lo, b_hi, s_rest,
-                    line)
+                    rec, gather, q0, diag_keep, fex_keep, first, e_lo, e_hi, b_lo, b_hi,
+                    s_rest, line)
                 if ok:
                     break
                 if ifcp and not fell_back:
@@ -158,8 +159,8 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
             # F_extra of cells that left the active region (if nothing is wet, the stage
             # only needs to clear the last F_extra)
             clear_outside1(fex, s_lo, s_hi, a_lo, a_hi, line)
-            sources_box(sources, q, 0.5 * dt if strang else dt, t_new, P, diag, a_lo, a_hi,
-                        line)
+            sources_box(sources, q, 0.5 * dt if strang else dt, t_new, P, diag, gather, a_lo,
+                        a_hi, line)
             changed = max(changed, diag[L.D_CHANGED])
             s_lo = a_lo
             s_hi = a_hi
@@ -169,7 +170,7 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
                 copy_box(prev, q, 0, n - 1, line)
                 copy_box(prev, backup, b_lo, b_hi, line)
             if b_lo <= b_hi:  # (and backup becomes the state this step leaves)
-                v_lo, v_hi = live_box(q, backup, b_lo, b_hi, width, line)
+                v_lo, v_hi = live_box(q, backup, gather, b_lo, b_hi, width, line)
                 rest_changed(valid, b_lo, b_hi, line)
             diag[L.D_LIVE_LO] = v_lo
             diag[L.D_LIVE_HI] = v_hi

@@ -29,7 +29,7 @@ from typing import Any
 
 import numba
 import numpy as np
-from numba import prange, types
+from numba import njit, prange, types
 
 from . import layout as L
 from .boxes import (
@@ -56,8 +56,9 @@ DEFAULT_THREADS = 1
 runs at once in processes (sweeps, studies, a test suite on every core) do not put two
 threads on each core (``numba``'s own default would be one per core)."""
 
-BOX_SOURCES = types.FunctionType(types.none(STATE, f8, f8, PARAMS, VECTOR, i8, i8, i8))
-"""type of a 2D source stage on a box ``(q, dt, t, P, diag, lo, hi, line)``
+BOX_SOURCES = types.FunctionType(types.none(STATE, f8, f8, PARAMS, VECTOR, FIELDS, i8, i8,
+                                            i8))
+"""type of a 2D source stage on a box ``(q, dt, t, P, diag, gather, lo, hi, line)``
 (:func:`box_kernels`)"""
 BOX_PREDICTOR = types.FunctionType(types.none(STATE, f8, PARAMS, i8, i8, i8))
 """type of a 2D MUSCL predictor on a box ``(q, dt, P, lo, hi, line)``"""
@@ -106,27 +107,30 @@ def on_threads(func: Callable[..., Any], threads: int) -> Callable[..., Any]:
 @functools.cache
 def box_kernels(model: ModelKernels) -> tuple[Any, Any]:
     """The 2D source stage and MUSCL predictor of ``model`` on a box, its rows on
-    numba's threads: ``sources(q, dt, t, P, diag, lo, hi, line)`` (:data:`BOX_SOURCES`)
+    numba's threads: ``sources(q, dt, t, P, diag, gather, lo, hi, line)``
+    (:data:`BOX_SOURCES`)
     and ``predictor(q, dt, P, lo, hi, line)`` (:data:`BOX_PREDICTOR`).
 
     The model's 2D stage books a row into a vector of its own, ``sources(q, dt, t, P,
-    book, fex, lo, hi)`` (``fex``: the per-cell diagnostic, ``diag[N_DIAG:]``), and
-    ``model.fold(diag, book)`` adds a row's booking to ``diag`` (its own slots; called
-    in row order on books that started at zero). Of the scheme's slots D_CHANGED is
-    the 'or' over the rows, D_T the stage's time and D_STEPS counts one stage."""
+    book, fex, lo, hi)`` (``fex``: the per-cell diagnostic, ``diag[N_DIAG:]``; the
+    books: rows of ``gather``, :func:`.boxes.gather_rows`), and ``model.fold(diag,
+    book)`` adds a row's booking to ``diag`` (its own slots; called in row order on
+    books that started at zero). Of the scheme's slots D_CHANGED is the 'or' over the
+    rows, D_T the stage's time and D_STEPS counts one stage."""
     sources = model.sources
     fold = model.fold
     predictor = model.predictor
 
-    def sources_on_rows(q, dt, t, P, diag, lo, hi, line):
+    def sources_on_rows(q, dt, t, P, diag, gather, lo, hi, line):
         fex = diag[L.N_DIAG:]
         x0, x1, y0, y1 = rows_of(lo, hi, line)
         if x0 > x1:  # nothing to visit: the stage books that it saw nothing
             sources(q, dt, t, P, diag, fex, 1, 0)
             return
-        books = np.zeros((x1 - x0 + 1, L.N_DIAG))
+        books = gather
         for k in prange(x1 - x0 + 1):
             x = x0 + k
+            books[k, :] = 0.0
             sources(q, dt, t, P, books[k], fex, x * line + y0, x * line + y1)
         steps = diag[L.D_STEPS]
         changed = 0.0
@@ -142,7 +146,7 @@ def box_kernels(model: ModelKernels) -> tuple[Any, Any]:
         for x in prange(x0, x1 + 1):
             predictor(q, dt, P, x * line + y0, x * line + y1)
 
-    return (specialise(sources_on_rows, STATE, f8, f8, PARAMS, VECTOR, i8, i8, i8,
+    return (specialise(sources_on_rows, STATE, f8, f8, PARAMS, VECTOR, FIELDS, i8, i8, i8,
                        parallel=True),
             specialise(predictor_on_rows, STATE, f8, PARAMS, i8, i8, i8, parallel=True))
 
@@ -151,27 +155,27 @@ def box_kernels(model: ModelKernels) -> tuple[Any, Any]:
 def update_on_rows(update: Any) -> Any:
     """The state update ``update`` (:func:`pdeflow.numerics.advect_step.update_function`,
     compiled) on the rows of a box on numba's threads: ``update_rows(q, base, rate, dt,
-    weight, lo, hi, line) -> (mass_rate, ok)``, the largest mass rate and whether every
-    row was ok (combined after the rows: exact whatever the threads)."""
+    weight, gather, lo, hi, line) -> (mass_rate, ok)``, the largest mass rate and
+    whether every row was ok (each row's in ``gather``, :func:`.boxes.gather_rows`;
+    combined after the rows: exact whatever the threads)."""
 
-    def update_rows(q, base, rate, dt, weight, lo, hi, line):
+    def update_rows(q, base, rate, dt, weight, gather, lo, hi, line):
         x0, x1, y0, y1 = rows_of(lo, hi, line)
         rows = max(x1 - x0 + 1, 0)
-        mass = np.empty(rows)
-        good = np.empty(rows, np.bool_)
         for k in prange(rows):
             x = x0 + k
-            mass[k], good[k] = update(q, base, rate, dt, weight, x * line + y0,
-                                      x * line + y1)
+            mass, good = update(q, base, rate, dt, weight, x * line + y0, x * line + y1)
+            gather[k, 0] = mass
+            gather[k, 1] = 1.0 if good else 0.0
         mass_rate = 0.0
         ok = True
         for k in range(rows):
-            mass_rate = max(mass_rate, mass[k])
-            ok = ok and good[k]
+            mass_rate = max(mass_rate, gather[k, 0])
+            ok = ok and gather[k, 1] == 1.0
         return mass_rate, ok
 
-    return specialise(update_rows, STATE, STATE, FIELDS, f8, f8, i8, i8, i8, helper=True,
-                      parallel=True)
+    return specialise(update_rows, STATE, STATE, FIELDS, f8, f8, FIELDS, i8, i8, i8,
+                      helper=True, parallel=True)
 
 
 def _copy_rows(dst, src, lo, hi, line):
@@ -202,20 +206,27 @@ def _clear_rows1(a, lo, hi, lo2, hi2, line):
         clear_outside1(a, x * line + y0, x * line + y1, lo2, hi2, line)
 
 
-def _live_rows(q, before, lo, hi, width, line):
-    """:func:`.resting.live_box` row by row on threads, the rows' boxes joined in row
-    order after them (minima and maxima: the same box whatever the threads)."""
+def _live_rows(q, before, gather, lo, hi, width, line):
+    """:func:`.resting.live_box` row by row on threads, each row's box in ``gather``
+    (:func:`.boxes.gather_rows`; cell indices, exact as floats), the rows' boxes joined
+    in row order after them (minima and maxima: the same box whatever the threads)."""
     x0, x1, y0, y1 = rows_of(lo, hi, line)
     rows = max(x1 - x0 + 1, 0)
-    found = np.empty((rows, 2), np.int64)
     for k in prange(rows):
         x = x0 + k
-        found[k, 0], found[k, 1] = live_box(q, before, x * line + y0, x * line + y1, width,
-                                            line)
+        r_lo, r_hi = live_box(q, before, x * line + y0, x * line + y1, width, line)
+        gather[k, 0] = r_lo
+        gather[k, 1] = r_hi
     a_lo, a_hi = 1, 0
     for k in range(rows):
-        a_lo, a_hi = box_join(a_lo, a_hi, found[k, 0], found[k, 1], line)
+        a_lo, a_hi = box_join(a_lo, a_hi, int(gather[k, 0]), int(gather[k, 1]), line)
     return a_lo, a_hi
+
+
+def _live_range(q, before, gather, lo, hi, width, line):
+    """:func:`.resting.live_box` with the arguments of :func:`_live_rows` (a 1D grid's
+    loop, or a loop run in Python: ``gather`` is not used)."""
+    return live_box(q, before, lo, hi, width, line)
 
 
 VECTOR_A = types.Array(f8, 1, "A")
@@ -226,10 +237,12 @@ def box_passes(threaded: bool) -> tuple[Any, Any, Any, Any, Any]:
     """The stepping loop's own passes over a box: ``(copy, copy1, clear, clear1,
     live)``, :func:`.boxes.copy_box`, :func:`.boxes.copy_box1`,
     :func:`.boxes.clear_outside`, :func:`.boxes.clear_outside1` and
-    :func:`.resting.live_box`; ``threaded`` (a compiled 2D loop): their rows on
-    numba's threads."""
+    :func:`.resting.live_box` (``live(q, before, gather, lo, hi, width, line)``, see
+    :func:`.boxes.gather_rows`); ``threaded`` (a compiled 2D loop): their rows on numba's
+    threads."""
     if not threaded:
-        return copy_box, copy_box1, clear_outside, clear_outside1, live_box
+        return copy_box, copy_box1, clear_outside, clear_outside1, \
+            njit(inline="always")(_live_range)
     return (specialise(_copy_rows, STATE, STATE, i8, i8, i8, helper=True, parallel=True),
             specialise(_copy_rows1, VECTOR_A, VECTOR_A, i8, i8, i8, helper=True,
                        parallel=True),
@@ -237,5 +250,5 @@ def box_passes(threaded: bool) -> tuple[Any, Any, Any, Any, Any]:
                        parallel=True),
             specialise(_clear_rows1, VECTOR_A, i8, i8, i8, i8, i8, helper=True,
                        parallel=True),
-            specialise(_live_rows, STATE, FIELDS, i8, i8, i8, i8, helper=True,
+            specialise(_live_rows, STATE, FIELDS, FIELDS, i8, i8, i8, i8, helper=True,
                        parallel=True))
