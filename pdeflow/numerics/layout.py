@@ -32,7 +32,8 @@ D_BAD_STEPS = 16  #: steps of a generic py-pde solver that left a non-finite val
 #: below -1e-12 m, before the post-step hook clipped it (models.base.make_post_step_hook)
 D_RETRIES = 17  #: steps rejected (a depth would turn negative) and retried with dt / 2
 D_RESUME = 18  #: 1 if D_LIVE_LO..D_LIVE_HI are the live cells of the state the fv-split
-#: loop left (the next call goes on from them; pdeflow.numerics.resting), else 0
+#: loop left (the next call goes on from them; pdeflow.numerics.resting), 2 the same after
+#: a call whose last step reached its pause (its backup holds the state before it), else 0
 D_LIVE_LO = 19  #: first live cell after the loop's last step
 D_LIVE_HI = 20  #: last live cell after the loop's last step
 MODEL_SLOTS = (2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 15)

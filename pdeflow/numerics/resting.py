@@ -168,12 +168,13 @@ def rest_changed(valid: np.ndarray, lo: int, hi: int, line: int) -> None:
 
 @cached(inline="always")
 def live_box(q: np.ndarray, before: np.ndarray, lo: int, hi: int, width: int,
-             line: int) -> tuple[int, int]:
+             line: int, sync: bool = True) -> tuple[int, int]:
     """The bounding box of the cells of the box (lo, hi) that move (a discharge row of
     ``q``, any but 0, ``width``, ..., is not zero) or changed in the last step (``q``
     differs from ``before``); ``(1, 0)`` if none. On a 1D grid: the first and the last
-    such cell. ``before`` is then set to ``q`` in the box: the state the next step
-    starts from, which it keeps to undo itself (one pass over the box for both)."""
+    such cell. With ``sync``, ``before`` is then set to ``q`` in the box: the state the
+    next step starts from, which it keeps to undo itself (one pass over the box for
+    both)."""
     x0, x1, y0, y1 = rows_of(lo, hi, line)
     a0 = x1 + 1
     a1 = x0 - 1
@@ -186,7 +187,8 @@ def live_box(q: np.ndarray, before: np.ndarray, lo: int, hi: int, width: int,
                 v = q[k, i]
                 if v != before[k, i] or (k % width != 0 and v != 0.0):
                     live = True
-                before[k, i] = v
+                if sync:
+                    before[k, i] = v
             if live:
                 a0 = min(a0, x)
                 a1 = max(a1, x)

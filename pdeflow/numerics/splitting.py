@@ -76,7 +76,7 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
     copy_box, copy_box1, _, clear_outside1, live_box = box_passes(compiled and two_d)
 
     def advance(q, t, t_pause, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl, diag,
-                rate, backup, diag_backup, work, prev, max_steps, stop_at_rest, advect, sources,
+                rate, backup, diag_backup, work, max_steps, stop_at_rest, advect, sources,
                 predictor, fallback):
         n = q.shape[1]
         line = int(metric[L.M_AXES, 4]) if two_d else n  # a line of the last axis
@@ -93,7 +93,8 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
         # A call going on from the state the last one left (diag[D_RESUME]) starts from
         # its live cells; else the first step visits all (the source stage cleans the
         # initial state).
-        first = diag[L.D_RESUME] != 1.0
+        resume = diag[L.D_RESUME]
+        first = resume != 1.0 and resume != 2.0
         v_lo = 0 if first else int(diag[L.D_LIVE_LO])
         v_hi = n - 1 if first else int(diag[L.D_LIVE_HI])
         s_lo = 0
@@ -102,9 +103,10 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
         speeds, valid = rest_maxima(n, line)
         gather = gather_rows(n, line, two_d)  # what rows share, for every step
         # backup holds the state a step starts from wherever the step can change it:
-        # copied here for a call that starts afresh, else kept by the last step's
-        # live pass (live_box), which sets it to the state it leaves on its box
-        if first:
+        # copied here for a call that starts afresh or after a call whose last step
+        # left in it the state before that step (D_RESUME 2), else kept by the last
+        # step's live pass (live_box), which sets it to the state it leaves on its box
+        if first or resume == 2.0:
             copy_box(backup, q, 0, n - 1, line)
         while t < t_pause and steps < max_steps:
             b_lo, b_hi = (0, n - 1) if first else box_grow(v_lo, v_hi, reach, line, n)
@@ -164,17 +166,16 @@ def stepping_function(ifcp: bool, strang: bool, advect_step: Any, reach: int,
             changed = max(changed, diag[L.D_CHANGED])
             s_lo = a_lo
             s_hi = a_hi
-            if t_new >= t_pause:
-                # the state before this step, for output at t_pause (interpolated by the
-                # caller): the step changed the cells of box b only, kept in backup
-                copy_box(prev, q, 0, n - 1, line)
-                copy_box(prev, backup, b_lo, b_hi, line)
-            if b_lo <= b_hi:  # (and backup becomes the state this step leaves)
-                v_lo, v_hi = live_box(q, backup, gather, b_lo, b_hi, width, line)
+            # the call's last step keeps in backup the state before it (the step
+            # changed the cells of box b only), for output at t_pause (interpolated by
+            # the caller); any other step's backup becomes the state it leaves
+            last = t_new >= t_pause
+            if b_lo <= b_hi:
+                v_lo, v_hi = live_box(q, backup, gather, b_lo, b_hi, width, line, not last)
                 rest_changed(valid, b_lo, b_hi, line)
             diag[L.D_LIVE_LO] = v_lo
             diag[L.D_LIVE_HI] = v_hi
-            diag[L.D_RESUME] = 1.0
+            diag[L.D_RESUME] = 2.0 if last else 1.0
             first = False
             t = t_new
             steps += 1
@@ -204,14 +205,14 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool, width: int = 2,
     from ``t`` to ``t_end`` with the CFL-limited splitting scheme,
 
     ``advance(q, t, t_pause, t_end, dx, metric, bc_left, bc_right, P, g, r, dry, cfl,
-    diag, rate, backup, diag_backup, work, prev, max_steps, stop_at_rest, advect, sources,
+    diag, rate, backup, diag_backup, work, max_steps, stop_at_rest, advect, sources,
     predictor, fallback) -> (t, steps, status)``; ``metric``: the grid's
     (:class:`~pdeflow.numerics.geometry.Metric`).
 
     Only ``t_end`` (the end of the run) shortens a step: the loop returns after the
     first step that reaches ``t_pause`` (<= ``t_end``; an output time), so that the
-    steps do not depend on when the caller looks at the state; ``prev`` then holds the
-    state before that step (dt earlier), for output at ``t_pause`` in between.
+    steps do not depend on when the caller looks at the state; ``backup`` then holds
+    the state before that step (dt earlier), for output at ``t_pause`` in between.
 
     ``rate`` and ``backup`` have the shape of ``q``, ``diag_backup`` that of ``diag``;
     ``work`` has shape (3, *q.shape); ``g`` = g_z [m/s^2], ``r`` = rho1/rho2 (0 for one
@@ -226,10 +227,12 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool, width: int = 2,
     half source step; if that half step makes the waves faster than dt allows (erosion
     deepens the upper layer), it is undone and the step retried with a shorter dt.
 
-    ``diag[D_RESUME]`` = 1 lets a call go on from the live cells the last call recorded
-    in ``diag`` (:mod:`pdeflow.numerics.resting`); the caller must clear it (0) unless
-    ``q`` is the state that call left and ``backup`` the array it left (a step keeps
-    in it the state it starts from, and sets it to the state it leaves on its box).
+    ``diag[D_RESUME]`` = 1 or 2 lets a call go on from the live cells the last call
+    recorded in ``diag`` (:mod:`pdeflow.numerics.resting`); the caller must clear it
+    (0) unless ``q`` is the state that call left and ``backup`` the array it left (a
+    step keeps in it the state it starts from, and sets it to the state it leaves on
+    its box, but the step that reached ``t_pause``: then D_RESUME is 2 and the next
+    call copies the state into ``backup`` first).
 
     Returns ``(t, steps, status)``: status :data:`STATUS_END`; :data:`STATUS_REST`
     (everything at rest and unchanged: stationary from ``t`` on); or
@@ -240,7 +243,7 @@ def stepping_kernel(order: int, strang: bool, ifcp: bool, width: int = 2,
     loop = stepping_function(ifcp, strang, step, reach_of(order), width, two_d)
     return specialise(loop, STATE, f8, f8, f8, f8,
                       METRIC, i8, i8, PARAMS, f8, f8, f8, f8, VECTOR, FIELDS, FIELDS, VECTOR,
-                      WORK, FIELDS, i8, flag,
+                      WORK, i8, flag,
                       ADVECT, BOX_SOURCES if two_d else SOURCES,
                       (BOX_PREDICTOR if two_d else PREDICTOR) if order == 2 else types.none,
                       ADVECT if ifcp else types.none, pointer=False)
@@ -284,25 +287,22 @@ class Stepper:
                  metric: np.ndarray, bc_left: int, bc_right: int, P: np.ndarray,
                  cfl: float, diag: np.ndarray, rate: np.ndarray, backup: np.ndarray,
                  work: np.ndarray, max_steps: int, stop_at_rest: bool,
-                 t_pause: float | None = None,
-                 prev: np.ndarray | None = None) -> tuple[float, int, int]:
+                 t_pause: float | None = None) -> tuple[float, int, int]:
         return self.run(self.ready().loop, q, t, t_end, dx, metric, bc_left, bc_right, P,
-                        cfl, diag, rate, backup, work, max_steps, stop_at_rest, t_pause,
-                        prev)
+                        cfl, diag, rate, backup, work, max_steps, stop_at_rest, t_pause)
 
     def run(self, loop: Any, q: np.ndarray, t: float, t_end: float, dx: float,
             metric: np.ndarray, bc_left: int, bc_right: int, P: np.ndarray, cfl: float,
             diag: np.ndarray, rate: np.ndarray, backup: np.ndarray, work: np.ndarray,
-            max_steps: int, stop_at_rest: bool, t_pause: float | None = None,
-            prev: np.ndarray | None = None) -> tuple[float, int, int]:
+            max_steps: int, stop_at_rest: bool,
+            t_pause: float | None = None) -> tuple[float, int, int]:
         """``loop`` (the compiled loop, or its Python code) with this scheme's kernels
         on the stepper's arguments; ``t_pause`` (default ``t_end``): return after the
-        first step that reaches it, with the state before that step in ``prev`` (see
+        first step that reaches it, with the state before that step in ``backup`` (see
         :func:`stepping_kernel`)."""
         return loop(q, t, t_end if t_pause is None else min(t_pause, t_end), t_end, dx,
                     metric, bc_left, bc_right, P, *self.model.constants(P), cfl, diag,
-                    rate, backup, np.empty_like(diag), work,
-                    np.empty_like(q) if prev is None else prev, max_steps, stop_at_rest,
+                    rate, backup, np.empty_like(diag), work, max_steps, stop_at_rest,
                     *self.ready().arguments)
 
 

@@ -206,7 +206,7 @@ def _clear_rows1(a, lo, hi, lo2, hi2, line):
         clear_outside1(a, x * line + y0, x * line + y1, lo2, hi2, line)
 
 
-def _live_rows(q, before, gather, lo, hi, width, line):
+def _live_rows(q, before, gather, lo, hi, width, line, sync):
     """:func:`.resting.live_box` row by row on threads, each row's box in ``gather``
     (:func:`.boxes.gather_rows`; cell indices, exact as floats), the rows' boxes joined
     in row order after them (minima and maxima: the same box whatever the threads)."""
@@ -214,7 +214,7 @@ def _live_rows(q, before, gather, lo, hi, width, line):
     rows = max(x1 - x0 + 1, 0)
     for k in prange(rows):
         x = x0 + k
-        r_lo, r_hi = live_box(q, before, x * line + y0, x * line + y1, width, line)
+        r_lo, r_hi = live_box(q, before, x * line + y0, x * line + y1, width, line, sync)
         gather[k, 0] = r_lo
         gather[k, 1] = r_hi
     a_lo, a_hi = 1, 0
@@ -223,10 +223,10 @@ def _live_rows(q, before, gather, lo, hi, width, line):
     return a_lo, a_hi
 
 
-def _live_range(q, before, gather, lo, hi, width, line):
+def _live_range(q, before, gather, lo, hi, width, line, sync):
     """:func:`.resting.live_box` with the arguments of :func:`_live_rows` (a 1D grid's
     loop, or a loop run in Python: ``gather`` is not used)."""
-    return live_box(q, before, lo, hi, width, line)
+    return live_box(q, before, lo, hi, width, line, sync)
 
 
 VECTOR_A = types.Array(f8, 1, "A")
@@ -237,7 +237,7 @@ def box_passes(threaded: bool) -> tuple[Any, Any, Any, Any, Any]:
     """The stepping loop's own passes over a box: ``(copy, copy1, clear, clear1,
     live)``, :func:`.boxes.copy_box`, :func:`.boxes.copy_box1`,
     :func:`.boxes.clear_outside`, :func:`.boxes.clear_outside1` and
-    :func:`.resting.live_box` (``live(q, before, gather, lo, hi, width, line)``, see
+    :func:`.resting.live_box` (``live(q, before, gather, lo, hi, width, line, sync)``, see
     :func:`.boxes.gather_rows`); ``threaded`` (a compiled 2D loop): their rows on numba's
     threads."""
     if not threaded:
@@ -250,5 +250,5 @@ def box_passes(threaded: bool) -> tuple[Any, Any, Any, Any, Any]:
                        parallel=True),
             specialise(_clear_rows1, VECTOR_A, i8, i8, i8, i8, i8, helper=True,
                        parallel=True),
-            specialise(_live_rows, STATE, FIELDS, FIELDS, i8, i8, i8, i8, helper=True,
-                       parallel=True))
+            specialise(_live_rows, STATE, FIELDS, FIELDS, i8, i8, i8, i8, types.boolean,
+                       helper=True, parallel=True))

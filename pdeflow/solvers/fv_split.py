@@ -201,7 +201,6 @@ class FVSplitSolver(SolverBase):
         rate = np.empty(shape)
         backup = np.empty(shape)
         work = np.empty((3, *shape))
-        prev = np.empty(shape)
         scheme = stepper_codes(pde, metric, self.scheme)
         cfl = self.cfl
         stop = self.stop_at_rest
@@ -210,15 +209,17 @@ class FVSplitSolver(SolverBase):
                        rate_: np.ndarray, backup_: np.ndarray, work_: np.ndarray,
                        max_steps: int, t_pause: float | None = None):
             return kernel(q, t0, t1, dx, M, bcl, bcr, P, cfl, diag_, rate_, backup_, work_,
-                          max_steps, stop, t_pause, prev)
+                          max_steps, stop, t_pause)
 
+        # the state before a call's last step: the compiled loop keeps it in backup
+        before = backup if self.backend_name == "numba" else np.empty(shape)
         if self.backend_name == "numba":
             advance = self._compiled_loop(scheme_stepper(*scheme), run_kernel, diag, rate,
                                           backup, work)
             if len(metric.axes) > 1:  # only a 2D run starts numba's threads
                 advance = on_threads(advance, self.threads)
         else:
-            advance = self._numpy_loop(state, dx, P, hook, diag, prev)
+            advance = self._numpy_loop(state, dx, P, hook, diag, before)
 
         def replay(q: np.ndarray, t0: float, t1: float, update: Any) -> None:
             # one step of the kernel's own Python code with an instrumented state update
@@ -228,7 +229,7 @@ class FVSplitSolver(SolverBase):
                        np.empty_like(q), np.empty_like(q), np.empty_like(work), 1)
 
         ahead: list[StepAhead] = []  # the state past the last output time, if any
-        entry = prev if self.backend_name == "numba" else np.empty(shape)
+        entry = np.empty(shape) if len(metric.axes) == 1 else None
 
         def step(state: Any, data: np.ndarray, t_start: float, t_end: float,
                  changed: bool) -> float:
@@ -240,8 +241,7 @@ class FVSplitSolver(SolverBase):
             if done:
                 return t_start
             # the call's start for a blow-up: the step ahead's, py-pde's state (several
-            # axes: not the kernels' array), or a copy in prev (the compiled loop writes
-            # it only in a step that reaches t_pause, its last)
+            # axes: not the kernels' array), or a copy
             if start is None and data is state.data:
                 start = entry
                 np.copyto(entry, data)
@@ -255,7 +255,7 @@ class FVSplitSolver(SolverBase):
             if status == STATUS_FAIL:
                 self._blowup(state, data, start, t_start, t, t_run, replay)
             if t_pause < t < t_run and self.outputs == "interpolate":
-                return self._output_inside(ahead, data, prev, diag, t, t_pause,
+                return self._output_inside(ahead, data, before, diag, t, t_pause,
                                            status == STATUS_REST,
                                            None if start is entry else start)
             if status == STATUS_REST:
