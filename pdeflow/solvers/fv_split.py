@@ -47,41 +47,25 @@ from .blowup import (
     fmt_position,
     fmt_values,
 )
-from .outputs import StepAhead, pending_output
+from .outputs import StepAhead, on_cells, pending_output
 
 __all__ = ["FVSplitSolver", "SimulationBlowUp", "diagnose_blowup", "split_stepper",
            "stepper_codes"]
 
 
-def on_cells(step: Any, shape: tuple[int, int]) -> Any:
-    """``step(state, data, t_start, t_end, changed)`` as a stepper of py-pde's states:
-    ``data`` is the kernels' ``q[field, cell]``, a 1D grid's ``state.data`` itself; on a
-    grid of several axes a flattened copy of py-pde's ``data[field, n0, n1]`` (a view
-    without the ghost cells, not contiguous), written back after every call.
-    ``changed``: the state is not the one the last call left (the first call, or
-    someone wrote to it in between).
-
-    What the last call left is kept once: on a grid of several axes it is the flattened
-    copy itself (no second copy of the state, and none made to flatten it)."""
-    kept = np.full(shape, np.nan)  # the state the last call left
-
-    def stepper(state: Any, t_start: float, t_end: float) -> float:
-        if state.data.shape == shape:
-            changed = not np.array_equal(state.data, kept)
-            try:
-                return step(state, state.data, t_start, t_end, changed)
-            finally:
-                np.copyto(kept, state.data)
-        on_grid = kept.reshape(state.data.shape)  # a view of the flat copy
-        changed = not np.array_equal(state.data, on_grid)
-        if changed:
-            on_grid[...] = state.data
-        try:
-            return step(state, kept, t_start, t_end, changed)
-        finally:
-            state.data[...] = on_grid
-
-    return stepper
+def _kept_for_blowup(start: np.ndarray | None, data: np.ndarray, given: np.ndarray,
+                     entry: np.ndarray | None) -> np.ndarray | None:
+    """The state a stepper call keeps for a blow-up in a source stage: the step ahead's
+    end ``start`` it went on from, if that is not the kernels' array ``data``; else a
+    copy in ``entry`` where ``data`` is py-pde's state ``given`` (a 1D grid); else None:
+    py-pde's state itself (several axes, where it is not the kernels' array; after an
+    output inside a step it holds that output)."""
+    if start is not None and start is not data:
+        return start
+    if data is given:
+        np.copyto(entry, data)
+        return entry
+    return None
 
 
 class _RestProfilerFilter(logging.Filter):
@@ -231,20 +215,17 @@ class FVSplitSolver(SolverBase):
         ahead: list[StepAhead] = []  # the state past the last output time, if any
         entry = np.empty(shape) if len(metric.axes) == 1 else None
 
-        def step(state: Any, data: np.ndarray, t_start: float, t_end: float,
-                 changed: bool) -> float:
+        def step(state: Any, data: np.ndarray, out: np.ndarray, t_start: float,
+                 t_end: float, changed: bool) -> tuple[float, StepAhead | None]:
             t_pause = float(t_end)
             t_run = t_pause if self.t_end is None else max(self.t_end, t_pause)
             if changed:  # someone changed the state: go on from it, not from a step ahead
                 ahead.clear()
-            done, t_start, start = self._resume(ahead, data, float(t_start), t_pause)
+            t_given = float(t_start)  # the time of py-pde's state
+            done, t_start, start, shown = self._resume(ahead, data, out, t_given, t_pause)
             if done:
-                return t_start
-            # the call's start for a blow-up: the step ahead's, py-pde's state (several
-            # axes: not the kernels' array), or a copy
-            if start is None and data is state.data:
-                start = entry
-                np.copyto(entry, data)
+                return t_start, shown
+            start = _kept_for_blowup(start, data, state.data, entry)
             t, steps, status = advance(data, float(t_start), t_pause, t_run, changed)
             self.info["steps"] += int(steps)
             # not "dt": py-pde's controller would then fire every tracker due within half
@@ -253,14 +234,15 @@ class FVSplitSolver(SolverBase):
             # the steps land on the output times (interpolated), no tolerance is needed
             self.info["last_dt"] = float(diag[L.D_DT]) or None
             if status == STATUS_FAIL:
-                self._blowup(state, data, start, t_start, t, t_run, replay)
+                self._blowup(state, data, start, t_given if start is None else t_start, t,
+                             t_run, replay)
             if t_pause < t < t_run and self.outputs == "interpolate":
-                return self._output_inside(ahead, data, before, diag, t, t_pause,
+                return self._output_inside(ahead, data, out, before, diag, t, t_pause,
                                            status == STATUS_REST,
                                            None if start is entry else start)
             if status == STATUS_REST:
                 self._at_rest(t)
-            return float(t)
+            return float(t), None
 
         return self._timed(on_cells(step, shape))
 
@@ -295,35 +277,42 @@ class FVSplitSolver(SolverBase):
 
         return stepper
 
-    def _output_inside(self, ahead: list[StepAhead], data: np.ndarray, prev: np.ndarray,
-                       diag: np.ndarray, t: float, t_pause: float, at_rest: bool,
-                       spare: np.ndarray | None) -> float:
+    def _output_inside(self, ahead: list[StepAhead], data: np.ndarray, out: np.ndarray,
+                       prev: np.ndarray, diag: np.ndarray, t: float, t_pause: float,
+                       at_rest: bool, spare: np.ndarray | None
+                       ) -> tuple[float, StepAhead | None]:
         """The step from ``prev`` to ``data`` (at ``t`` [s]; its dt in ``diag``) went
-        past the output time ``t_pause`` [s]: keep its end in ``ahead`` (in ``spare``,
-        if given, see :func:`pending_output`) for the next call to go on from, write
-        the state at ``t_pause`` into ``data`` and return ``t_pause``."""
+        past the output time ``t_pause`` [s]: keep its end in ``ahead`` for the next
+        call to go on from (a copy, in ``spare`` if given, see :func:`pending_output`,
+        where ``out`` is ``data``; else ``data`` itself), write the state at ``t_pause``
+        into ``out`` and return ``t_pause`` and the step ahead if ``out`` is not
+        ``data`` (:func:`on_cells`)."""
         dt = float(diag[L.D_DT]) * (2.0 if self.scheme.strang else 1.0)
-        ahead.append(pending_output(data, prev, t, dt, at_rest, spare=spare))
-        ahead[0].interpolate(data, t_pause)
-        return t_pause
+        ahead.append(pending_output(data, prev, t, dt, at_rest, spare=spare,
+                                    copy=out is data))
+        ahead[0].interpolate(out, t_pause)
+        return t_pause, None if out is data else ahead[0]
 
-    def _resume(self, ahead: list[StepAhead], data: np.ndarray, t_start: float,
-                t_pause: float) -> tuple[bool, float, np.ndarray | None]:
+    def _resume(self, ahead: list[StepAhead], data: np.ndarray, out: np.ndarray,
+                t_start: float, t_pause: float
+                ) -> tuple[bool, float, np.ndarray | None, StepAhead | None]:
         """After an interpolated output (``ahead`` holds the step past it): ``(True,
-        t, None)`` if the call to ``t_pause`` [s] is answered from it (another output
-        time within the same step, or its end), else ``(False, t, q)`` with the step's
-        end ``q`` restored as the state ``data`` (cells flattened) at ``t``; ``(False,
-        t_start, None)`` if nothing is ahead."""
+        t_pause, None, shown)`` if the call to ``t_pause`` [s] is answered from it by
+        another output time within the same step (written into ``out``; ``shown`` as
+        :meth:`_output_inside`'s), ``(done, t, q, None)`` with the step's end ``q``
+        restored as the state ``data`` (cells flattened) at ``t`` (``done``: t reaches
+        ``t_pause``); ``(False, t_start, None, None)`` if nothing is ahead."""
         if not ahead:
-            return False, t_start, None
+            return False, t_start, None, None
         if t_pause < ahead[0].t:  # another output time within the same step
-            ahead[0].interpolate(data, t_pause)
-            return True, t_pause, None
+            ahead[0].interpolate(out, t_pause)
+            return True, t_pause, None, None if out is data else ahead[0]
         step = ahead.pop()
-        data[...] = step.q
+        if step.q is not data:  # (else the kernels' copy holds it)
+            data[...] = step.q
         if step.at_rest:
             self._at_rest(step.t)
-        return step.t >= t_pause, step.t, step.q
+        return step.t >= t_pause, step.t, step.q, None
 
     def _at_rest(self, t: float) -> None:
         """End the run: everything is at rest from ``t`` [s] on."""
