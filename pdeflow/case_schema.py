@@ -38,8 +38,8 @@ SCHEMA: dict[str, dict[str, tuple[type, ...]]] = {
     # a 2D single-layer case over a bed (issue 37; pdeflow.case_terrain): a topography's
     # name or a DEM's path, where the grid's corner lies on it, the topography's
     # parameters (a sub-table, [terrain.topography], checked by case_terrain) and a
-    # shapefile of the release's outline
-    "terrain": {"bed": (str,), "x0": (float, int), "y0": (float, int),
+    # shapefile of the release's outline; or the bed as an expression in x and y
+    "terrain": {"bed": (str,), "expression": (str,), "x0": (float, int), "y0": (float, int),
                 "topography": (dict,), "release": (str,), "flow_density": (float, int)},
 }
 

@@ -4,7 +4,8 @@ Keys (docs/terrain.md, "Case files over terrain")::
 
     [terrain]
     bed = "parabola"     # a topography of pdeflow.terrain.topographies, or a DEM's path
-                         # (.asc, .tif, .tiff) relative to the case file
+                         # (.asc, .tif, .tiff) relative to the case file, or instead
+    # expression = "200 - 0.4 * x"   # the bed z(x, y) [m] (pdeflow.terrain.expression)
     x0 = 0.0             # [m] where the grid's corner (x_start, y_start) lies in the
     y0 = -500.0          # bed's coordinates (default: x_start, y_start)
     release = "rel.shp"  # optional: the release's outline from a shapefile (pyshp), in
@@ -46,6 +47,7 @@ from .terrain import (
     Raster,
     analytic_bed,
     bed_corners,
+    bed_expression,
     cell_centres,
     cell_corners,
     cos_slope_corners,
@@ -136,12 +138,24 @@ def _check_models(case: Any) -> None:
 
 
 def _check_bed(case: Any, terrain: dict[str, Any]) -> None:
-    """``terrain.bed`` a topography's name or an existing DEM file;
-    ``terrain.topography`` the topography's parameters, numbers in range."""
+    """``terrain.bed`` a topography's name or an existing DEM file, or
+    ``terrain.expression`` a bed expression (not both); ``terrain.topography`` the
+    topography's parameters, numbers in range."""
     names = list(TOPOGRAPHIES)
+    if "expression" in terrain:
+        for key in ("bed", "topography"):
+            if key in terrain:
+                raise _err(case, f"terrain.{key} and terrain.expression both give the "
+                                 f"bed: keep one")
+        try:
+            bed_expression(terrain["expression"])
+        except ValueError as err:
+            raise _err(case, f"terrain.expression: {err}") from None
+        return
     if "bed" not in terrain:
         raise _err(case, f"terrain.bed is required: one of {names} or a DEM file "
-                         f"({', '.join(DEM_SUFFIXES)}) relative to the case file")
+                         f"({', '.join(DEM_SUFFIXES)}) relative to the case file (or "
+                         f"terrain.expression, the bed z(x, y) [m] in x and y)")
     bed = terrain["bed"]
     parameters = terrain.get("topography", {})
     if is_dem(bed):
@@ -223,6 +237,8 @@ def _origin(case: Any) -> tuple[float, float]:
 def _bed(case: Any, terrain: dict[str, Any]) -> Any:
     """The DEM (a :class:`~pdeflow.terrain.Raster`) or the analytic bed z(x, y) of a
     checked ``[terrain]`` table."""
+    if "expression" in terrain:
+        return bed_expression(terrain["expression"])
     bed = terrain["bed"]
     if not is_dem(bed):
         return analytic_bed(bed, terrain.get("topography", {}))
@@ -294,7 +310,7 @@ def check_bed(case: Any) -> None:
     on cells with data (one-line CaseErrors naming ``terrain.release``)."""
     terrain_corners(case)
     terrain = case.data.get("terrain") or {}
-    if "release" not in terrain or not is_dem(terrain["bed"]):
+    if "release" not in terrain or not is_dem(terrain.get("bed", "")):
         return
     name = f"terrain.release {terrain['release']!r}"
     try:
@@ -318,6 +334,14 @@ def terrain_corners(case: Any) -> np.ndarray | None:
     x0, y0 = _origin(case)
     x = cell_corners(x0, case.length, case.dx)
     y = cell_corners(y0, case.width, case.dy, axis="y")
+    if "expression" in terrain:
+        corners = bed_corners(_bed(case, terrain), x, y)
+        bad = ~np.isfinite(corners)
+        if bad.any():
+            i, j = np.argwhere(bad)[0]
+            raise _err(case, f"terrain.expression is not finite at {bad.sum()} of the "
+                             f"grid's cell corners, e.g. x = {x[i]:g}, y = {y[j]:g} m")
+        return corners
     name = f"terrain.bed {terrain['bed']!r}"
     try:
         return bed_corners(_bed(case, terrain), x, y, name=name)

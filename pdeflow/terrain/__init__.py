@@ -12,6 +12,7 @@ any work.
   shapefile (pyshp, the same extra); :mod:`.thickness`: the release thickness, given
   vertically or normal to the slope, as a vertical depth;
 * :mod:`.topographies`: AvaFrame's idealised topographies z(x, y) from their equations;
+  :mod:`.expression`: a bed written as an expression in x and y;
 * :mod:`.corners`: the bed at a grid's cell corners (a topography evaluated, a raster
   resampled), what the flow over a bed takes (``GranularPDE(bed=...)``,
   docs/terrain.md);
@@ -22,6 +23,7 @@ A case file's ``[terrain]`` table (:mod:`pdeflow.case_terrain`) reads them.
 
 from .asc import read_asc, write_asc
 from .corners import analytic_bed, bed_corners, topography_parameters
+from .expression import bed_expression
 from .peaks import peak_rasters
 from .raster import Raster
 from .rasters import read_raster, write_raster
@@ -34,4 +36,4 @@ __all__ = ["Raster", "read_asc", "write_asc", "read_raster", "write_raster",
            "bed_on_grid", "cell_centres", "cell_corners", "case_polygon", "release_mask",
            "same_crs", "shapefile_crs", "shapefile_polygons", "vertical_thickness",
            "vertical_depth", "cos_slope_corners", "analytic_bed", "bed_corners",
-           "topography_parameters", "peak_rasters"]
+           "topography_parameters", "peak_rasters", "bed_expression"]
