@@ -3,8 +3,9 @@
 and cell size, in one table.
 
 The path is AvaFrame's parabola (PF: fall height 1000 m, mean slope 34 deg, flat beyond
-its foot at x = 1483 m) or hockey stick (HS: the 34 deg plane from 2200 m, bent into the
-flat by a circle of radius 200 m), from ``pdeflow.terrain.topographies``. This script
+its foot at x = 1483 m), hockey stick (HS: the 34 deg plane from 2200 m, bent into the
+flat by a circle of radius 200 m) or bowl (BL: a spherical bowl of radius 500 m, its
+centre at x = 500 m, the release on its side), from ``pdeflow.terrain.topographies``. This script
 writes it as one ESRI ASCII DEM (5 m cells, x down the slope from the top, y across)
 and **both codes read that file**: com1DFA as its DEM, pdeflow through ``read_raster``
 and ``bed_on_grid`` at its grid's cell corners (the bed bilinear between the DEM's
@@ -30,7 +31,7 @@ between the start and the end; the largest peak thickness, speed (pdeflow's hori
 speed, com1DFA's along the surface) and pressure (200 kg/m^3 times speed^2, kPa); the
 area (horizontal) where the peak thickness exceeds ``THRESHOLD``.
 
-Run: ``python benchmarks/terrain_vs_com1dfa.py [--path parabola|hockey]
+Run: ``python benchmarks/terrain_vs_com1dfa.py [--path parabola|hockey|bowl]
 [--dx 20 10 5 2.5] [--avaframe-python /tmp/ava_venv/bin/python] [--stop-crit 0.01 0]
 [--voellmy 0.155 4000]``.
 Units: lengths [m], angles [deg], speeds [m/s], pressures [kPa], times [s].
@@ -71,7 +72,7 @@ from pdeflow.terrain import (  # noqa: E402
     write_raster,
 )
 from pdeflow.terrain.thickness import cos_slope  # noqa: E402
-from pdeflow.terrain.topographies import hockey_stick, parabola  # noqa: E402
+from pdeflow.terrain.topographies import bowl, hockey_stick, parabola  # noqa: E402
 from pdeflow.trackers.peaks import PeakTracker  # noqa: E402
 
 DEM_CELL = 5.0  #: [m]
@@ -103,10 +104,17 @@ class AvalanchePath:
     t_end: float
 
 
+def side_of_bowl(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """AvaFrame's bowl (BL, radius 500 m) with its centre at x = 500 m: the release
+    (x = 100-300 m) lies on its side, 37-53 deg steep, the rim at x = 0 [m]."""
+    return bowl(np.asarray(x, float) - 500.0, y)
+
+
 PATHS = {"parabola": AvalanchePath("parabola", parabola, 3000.0, 500.0, 2600.0, 300.0,
                                    120.0),
          "hockey": AvalanchePath("hockey", hockey_stick, 5500.0, 500.0, 5200.0, 300.0,
-                                 200.0)}
+                                 200.0),
+         "bowl": AvalanchePath("bowl", side_of_bowl, 1000.0, 500.0, 1000.0, 400.0, 120.0)}
 
 
 def write_dem(path: AvalanchePath, file: str | Path, cellsize: float = DEM_CELL) -> Raster:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from pathlib import Path
 from typing import Any
 
 from .cli_options import positive
@@ -69,10 +70,17 @@ def _stored_axes(args: argparse.Namespace) -> int:
 
 
 def _stored_case(run: Any) -> Any:
-    """The case a stored run was run from (its metadata)."""
+    """The case a stored run was run from (its metadata), its files (a DEM, a
+    shapefile) read from the case file's folder as the run read them (``case_dir``;
+    runs stored before it was recorded: the working directory)."""
+    import copy
+
     from .cases import Case
 
-    return Case.from_dict(run.metadata["case"], source=str(run.path))
+    folder = Path(run.metadata.get("case_dir", Path.cwd()))
+    case = Case(copy.deepcopy(run.metadata["case"]), str(run.path), folder)
+    case.validate()
+    return case
 
 
 def _frames(runs: list[Any]) -> list[tuple[float, list[Any], list[Any]]]:

@@ -121,6 +121,8 @@ def run_metadata(case: Any, model: str, *, overrides: Sequence[str] = (),
         "case_name": case.name,
         "case_file": case_file if case_file is not None else case.source,
         "case": case.data,
+        # the folder its files (a DEM, a shapefile, profiles) are relative to
+        "case_dir": str(Path(case.base_dir).resolve()),
         "overrides": list(overrides),
         "model": model,
         "variant": variant,

@@ -272,3 +272,30 @@ def test_a_1d_store_keeps_its_metadata_keys():
     assert not {"dimensions", "dy", "width", "y_start", "cells_y"} & set(one)
     two = run_metadata(load_case(CYLINDER), "single_layer")
     assert two["dimensions"] == 2 and two["cells_y"] == 80
+
+
+def test_plot_of_a_run_over_a_dem_reads_the_dem_next_to_its_case_file(tmp_path,
+                                                                       monkeypatch):
+    """A case's DEM is relative to the case file: a run stored from another folder is
+    drawn from a third one (the store records the case file's folder)."""
+    from pdeflow.terrain import Raster, write_raster
+
+    cases, run_dir, elsewhere = (tmp_path / d for d in ("cases", "run", "elsewhere"))
+    for d in (cases, run_dir, elsewhere):
+        d.mkdir()
+    xc = 10.0 * np.arange(32) - 5.0
+    yc = 10.0 * np.arange(22)[::-1] - 105.0
+    X, _ = np.meshgrid(xc, yc)  # noqa: N806
+    write_raster(Raster(300.0 - 0.6 * X, -10.0, -110.0, 10.0, np.zeros(X.shape, bool)),
+                 cases / "dem.asc")
+    (cases / "case.toml").write_text(
+        '[case]\nmodels = ["single_layer"]\nt_end = 2.0\n'
+        "[grid]\nlength = 200.0\nwidth = 100.0\ndx = 20.0\ny_start = -50.0\n"
+        '[terrain]\nbed = "dem.asc"\n'
+        '[initial]\nshape = "box"\nx0 = 60.0\ny0 = 50.0\nsemi_x = 30.0\nsemi_y = 30.0\n'
+        "H0 = 1.0\n")
+    monkeypatch.chdir(run_dir)
+    assert main(["run", str(cases / "case.toml"), "--store", "a.h5", "-q"]) == 0
+    monkeypatch.chdir(elsewhere)
+    assert main(["plot", str(run_dir / "a.h5"), "--out", "a.png", "-q"]) == 0
+    assert (elsewhere / "a.png").stat().st_size > 0
