@@ -108,6 +108,16 @@ def _movie_2d(args: argparse.Namespace, runs: list[Any]) -> Any:
                   progress=not args.quiet, threshold=case.front_threshold)
 
 
+def _stored_bed(case: Any) -> Any:
+    """The bed [m] at the cell centres of a stored run's case over one, else None."""
+    corners = case.terrain_corners()
+    if corners is None:
+        return None
+    from .numerics.geometry import centre_values
+
+    return centre_values(corners)
+
+
 def _plot_2d(args: argparse.Namespace, runs: list[Any]) -> Any:
     """The 2D figure (:func:`pdeflow.figures_2d.final_figure_2d`) of the stored 2D runs
     at the stored time nearest to ``--time`` (default: the last), saved; its path."""
@@ -127,7 +137,8 @@ def _plot_2d(args: argparse.Namespace, runs: list[Any]) -> Any:
                           [float(r.times[i]) for r, i in zip(runs, idx, strict=True)],
                           case.front_threshold, total_depth(first.data[0]),
                           case.release_centre[1], title,
-                          state="last stored state" if last else "stored state")
+                          state="last stored state" if last else "stored state",
+                          bed=_stored_bed(case))
     return save(fig, args.out or first.path.with_suffix(".png"))
 
 

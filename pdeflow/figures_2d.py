@@ -26,7 +26,9 @@ import numpy as np
 
 from . import metrics_2d as m2
 from . import systems
+from .numerics.geometry import centre_values
 from .plotting import DRY, LAYER_STYLES, _symbol, _velocity, display_name, new_figure
+from .terrain_figures import terrain_underlay
 
 Run2D = tuple[str, np.ndarray]
 """a run drawn: (its model's registered name, its final state data (rows, nx, ny))"""
@@ -83,16 +85,18 @@ def layer_speed(data: np.ndarray, k: int) -> np.ndarray:
 
 
 def depth_map(ax: Any, cax: Any, fig: Any, x: np.ndarray, y: np.ndarray, h: np.ndarray,
-              total: np.ndarray, threshold: float) -> Any:
-    """A layer's depth ``h`` [m] (nx, ny) on ``ax``: colours (blank where dry; their
-    scale in ``cax``), the :data:`CONTOURS` (white) and the deposit outline, the
-    contour of the total depth ``total`` [m] at ``threshold`` [m] (black, labelled
-    'deposit'). Returns the outline's ContourSet (None if no cell is deeper than the
-    threshold, or the grid is one cell wide)."""
-    shown = np.where(h > DRY, h, np.nan)
+              total: np.ndarray, threshold: float, alpha: float = 1.0,
+              floor: float = DRY) -> Any:
+    """A layer's depth ``h`` [m] (nx, ny) on ``ax``: colours (blank where not deeper
+    than ``floor`` [m], by default dry; their scale in ``cax``; opacity ``alpha``), the
+    :data:`CONTOURS` (white) and the deposit
+    outline, the contour of the total depth ``total`` [m] at ``threshold`` [m] (black,
+    labelled 'deposit'). Returns the outline's ContourSet (None if no cell is deeper
+    than the threshold, or the grid is one cell wide)."""
+    shown = np.where(h > floor, h, np.nan)
     top = float(np.max(h)) if np.max(h) > 0 else 1.0
     mesh = ax.pcolormesh(cell_edges(x), cell_edges(y), shown.T, cmap="viridis",
-                         vmin=0.0, vmax=top, shading="flat")
+                         vmin=0.0, vmax=top, shading="flat", alpha=alpha)
     fig.colorbar(mesh, cax=cax)
     if np.max(h) > DRY and x.size > 1 and y.size > 1:  # contours need a 2 x 2 grid
         ax.contour(x, y, h.T, levels=[f * top for f in CONTOURS], colors="w",
@@ -117,14 +121,15 @@ def deposit_outline(ax: Any, x: np.ndarray, y: np.ndarray, total: np.ndarray,
 
 
 def speed_map(ax: Any, cax: Any, fig: Any, x: np.ndarray, y: np.ndarray,
-              speed: np.ndarray) -> None:
+              speed: np.ndarray, alpha: float = 1.0) -> None:
     """A layer's speed ``speed`` [m/s] (nx, ny; NaN where dry) on ``ax``, its colour
-    scale in ``cax``; a layer at rest shows 0 wherever it is wet (the scale then runs
-    to 1 m/s, and the map says 'at rest')."""
+    scale in ``cax`` (opacity ``alpha``); a layer at rest shows 0 wherever it is wet
+    (the scale then runs to 1 m/s, and the map says 'at rest')."""
     wet = bool(np.any(np.isfinite(speed)))
     top = float(np.nanmax(speed)) if wet else 0.0
     mesh = ax.pcolormesh(cell_edges(x), cell_edges(y), speed.T, cmap="magma",
-                         vmin=0.0, vmax=top if top > 0 else 1.0, shading="flat")
+                         vmin=0.0, vmax=top if top > 0 else 1.0, shading="flat",
+                         alpha=alpha)
     fig.colorbar(mesh, cax=cax)
     if top == 0:  # an all-black or empty map: say why
         ax.text(0.5, 0.5, "at rest" if wet else "dry", transform=ax.transAxes,
@@ -133,19 +138,28 @@ def speed_map(ax: Any, cax: Any, fig: Any, x: np.ndarray, y: np.ndarray,
 
 def model_row(fig: Any, axes: Sequence[Any], x: np.ndarray, y: np.ndarray,
               run: Run2D, t: float, threshold: float,
-              box: tuple[tuple[float, float], tuple[float, float]]) -> list[Any]:
+              box: tuple[tuple[float, float], tuple[float, float]],
+              bed: np.ndarray | None = None) -> list[Any]:
     """The maps of one run (model name, state data) at time ``t`` [s] on ``axes``
     ((map, colour bar) pairs, two per layer: depth, speed); the deposit outlines drawn
-    (see :func:`depth_map`)."""
+    (see :func:`depth_map`); over a ``bed`` (nx, ny) [m, at the cell centres] each map
+    on its hillshade and contour lines, the fields slightly transparent."""
     model, data = run
     system = systems.get(model)
     total = m2.total_depth(data)
     outlines = []
+    # over a bed the terrain shows where the flow is thinner than the deposit outline
+    alpha, floor = (1.0, DRY) if bed is None else (0.85, threshold)
     for k, layer in enumerate(system.layers):
         (ax_h, cax_h), (ax_u, cax_u) = axes[2 * k], axes[2 * k + 1]
+        if bed is not None:
+            xe, ye = cell_edges(x), cell_edges(y)
+            for ax in (ax_h, ax_u):
+                terrain_underlay(ax, bed, (xe[0], xe[-1], ye[0], ye[-1]))
         outlines.append(depth_map(ax_h, cax_h, fig, x, y, data[3 * k], total,
-                                  threshold))
-        speed_map(ax_u, cax_u, fig, x, y, layer_speed(data, k))
+                                  threshold, alpha, floor))
+        speed = np.where(data[3 * k] > floor, layer_speed(data, k), np.nan)
+        speed_map(ax_u, cax_u, fig, x, y, speed, alpha)
         head = f"{system.label}, t = {t:.3g} s"
         ax_h.set_title(f"{head}\n{_layer_name(layer)} depth {_symbol(layer.depth)} [m]",
                        fontsize=9)
@@ -200,14 +214,16 @@ def cross_sections(ax_x: Any, ax_y: Any, x: np.ndarray, y: np.ndarray,
 def final_figure_2d(x: np.ndarray, y: np.ndarray, runs: Sequence[Run2D],
                     times: Sequence[float], threshold: float, initial: np.ndarray,
                     y0: float, title: str = "", stops: str = "",
-                    state: str = "final state", also: Sequence[np.ndarray] = ()) -> Any:
+                    state: str = "final state", also: Sequence[np.ndarray] = (),
+                    bed: np.ndarray | None = None) -> Any:
     """The final state of a 2D case's runs (model name, state data) at ``times`` [s]:
     per run a row of maps (:func:`model_row`), then the cross-sections
     (:func:`cross_sections`); ``x``, ``y`` the cell centres [m], ``threshold`` the
     deposit outline's depth [m], ``initial`` the released total depth [m], ``y0`` the
     release centre's y [m]; the title: the case's ``title``, ``state`` (what is drawn)
     and ``stops``; the maps cover the material of the runs, the release and ``also``
-    (other total depths [m]: a case's snapshots share one extent)."""
+    (other total depths [m]: a case's snapshots share one extent); over a ``bed`` (nx,
+    ny) [m at the cell centres] on its hillshade and contour lines."""
     maps = [2 * len(systems.get(model).layers) for model, _ in runs]
     ncols = max(maps)
     box = plan_box(x, y, [*(m2.total_depth(d) for _, d in runs), initial, *also])
@@ -222,7 +238,7 @@ def final_figure_2d(x: np.ndarray, y: np.ndarray, runs: Sequence[Run2D],
     for run, t, n, row in zip(runs, times, maps, rows[:-1], strict=True):
         bottom = top - row + LABEL
         axes = [_map_axes(fig, size, c * MAP_SIZE, bottom, height) for c in range(n)]
-        model_row(fig, axes, x, y, run, t, threshold, box)
+        model_row(fig, axes, x, y, run, t, threshold, box, bed)
         top -= row
     half = ncols * MAP_SIZE / 2
     ax_x, ax_y = (fig.add_axes([(left + MARGIN) / size[0], LABEL / size[1],
@@ -263,8 +279,13 @@ def final_figure_job(results: dict[str, Any], path: str | Path, stops: str) -> t
     y0 = case.release_centre[1]
     args = (x, y, [(r.model, r.state.data) for r in runs], [r.t_final for r in runs],
             case.front_threshold, _initial_total(first), y0, display_name(case.name),
-            stops)
+            stops, "final state", (), _bed(first))
     return (final_figure_2d, args, Path(path))
+
+
+def _bed(res: Any) -> np.ndarray | None:
+    """The bed [m] at the cell centres (nx, ny) of a 2D run over one, else None."""
+    return None if res.metric.bed is None else centre_values(res.metric.bed)
 
 
 def snapshot_figure_jobs(results: dict[str, Any], outdir: Path) -> list[tuple]:
@@ -285,6 +306,6 @@ def snapshot_figure_jobs(results: dict[str, Any], outdir: Path) -> list[tuple]:
         shown = [(r.model, r.snapshots[t][0]) for r in runs if t in r.snapshots]
         args = (x, y, shown, [t] * len(shown), case.front_threshold, initial,
                 case.release_centre[1], display_name(case.name), "", f"t = {t:g} s",
-                reached)
+                reached, _bed(first))
         jobs.append((final_figure_2d, args, outdir / f"snapshot_t{t:g}.png"))
     return jobs

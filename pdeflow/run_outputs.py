@@ -202,7 +202,7 @@ class RunOutputs:
         """A run over a bed: its peak rasters and figure in the results folder."""
         if result.peak_fields is None:
             return
-        from .terrain.corners import centre_values
+        from .numerics.geometry import centre_values
         from .terrain_run import write_peak_outputs
 
         bed = centre_values(result.metric.bed)

@@ -22,7 +22,7 @@ import numpy as np
 
 from .case_terrain import flow_density, map_corner
 from .metrics_2d import peak_fields, total_depth
-from .terrain.corners import centre_values
+from .numerics.geometry import centre_values
 from .trackers.peaks import PeakTracker
 
 TERRAIN_KEYS = ("travel_angle", "affected_area", "max_pressure")

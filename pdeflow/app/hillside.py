@@ -27,7 +27,7 @@ from bokeh.models import ColumnDataSource, DataRange1d, Div, Range1d
 
 from ..cases import CaseError, load_case
 from ..metrics_2d import front_x
-from ..terrain.corners import centre_values
+from ..numerics.geometry import centre_values
 from .controls import served
 from .dam_break import LABELS, WARNING_STYLE, warnings_html
 from .hillside_figures import (

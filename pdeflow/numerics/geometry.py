@@ -192,6 +192,13 @@ def bed_at_corners(grid: Any, bed: Any) -> np.ndarray | None:
     return np.ascontiguousarray(z)
 
 
+def centre_values(corners: np.ndarray) -> np.ndarray:
+    """The mean [m] of each cell's four corner values ``corners`` (nx + 1, ny + 1):
+    the bed at the cell centres (nx, ny)."""
+    c = np.asarray(corners, dtype=float)
+    return 0.25 * (c[:-1, :-1] + c[1:, :-1] + c[:-1, 1:] + c[1:, 1:])
+
+
 def face_beds(corners: np.ndarray) -> np.ndarray:
     r"""The rows layout.M_BED of a 2D grid over a bed, (4, nx ny) [m]: per cell (C
     order) the bed at the middle of its faces x-low, x-high, y-low, y-high, each the mean

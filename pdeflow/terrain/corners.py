@@ -75,9 +75,3 @@ def bed_corners(bed: Raster | Bed, x: np.ndarray, y: np.ndarray,
     X, Y = np.meshgrid(x, y, indexing="ij")  # noqa: N806  (nx + 1, ny + 1)
     return np.asarray(bed(X, Y), dtype=float)
 
-
-def centre_values(corners: np.ndarray) -> np.ndarray:
-    """The mean [m] of each cell's four corner values ``corners`` (nx + 1, ny + 1):
-    the bed at the cell centres (nx, ny)."""
-    c = np.asarray(corners, dtype=float)
-    return 0.25 * (c[:-1, :-1] + c[1:, :-1] + c[:-1, 1:] + c[1:, 1:])
