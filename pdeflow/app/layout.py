@@ -22,8 +22,8 @@ POLL_MS = 500
 """How often the waiting page updates its elapsed time [ms]."""
 
 HEADER = """<h2 style="margin:0; font-size:1.3em">pdeflow: dry granular avalanches, one
-layer and two layers</h2><p style="margin:0">Move a slider: the case runs again in the
-server, and every number shown is what <code>pdeflow run</code> prints for it.</p>"""
+layer and two layers</h2><p style="margin:0">Move a slider, or draw a release and press
+run on the hillside: every number shown is what <code>pdeflow run</code> prints.</p>"""
 """Two lines on a projector's 1024 px: the figures start high enough to fit below."""
 
 
