@@ -34,6 +34,7 @@ from .hillside_figures import (
     MODEL_COLOURS,
     PLAN_HEIGHT_PX,
     SECTION_HEIGHT_PX,
+    TABLE_WIDTH_PX,
     PlanView,
     contour_lines,
     hillshade_rgba,
@@ -85,7 +86,7 @@ class HillsidePage:
                                    sizing_mode="stretch_width")
         self.warnings = pn.pane.HTML("", css_classes=["pdeflow-warnings"], visible=False,
                                      sizing_mode="stretch_width", styles=WARNING_STYLE)
-        self.table = Div(text="", css_classes=["pdeflow-summary"], sizing_mode="stretch_width")
+        self.table = Div(text="", css_classes=["pdeflow-summary"], width=TABLE_WIDTH_PX)
         self.run: LiveRun | None = None
         self._shown = 0  # frames of the current run drawn so far
         self._ticker: Any = None
@@ -348,9 +349,12 @@ class HillsidePage:
                             self.command, sizing_mode="stretch_width")
         plans = pn.Row(*(pn.pane.Bokeh(p.figure, sizing_mode="stretch_width")
                          for p in self.plans.values()), sizing_mode="stretch_width")
-        figures = pn.Column(self.status, self.warnings, plans, self.player,
-                            pn.pane.Bokeh(self.section, sizing_mode="stretch_width"),
-                            pn.pane.Bokeh(self.table, sizing_mode="stretch_width"),
+        # the section and the table side by side: on a projector's 768 px the table
+        # stays above the fold
+        below = pn.Row(pn.pane.Bokeh(self.section, sizing_mode="stretch_width"),
+                       pn.pane.Bokeh(self.table),
+                       sizing_mode="stretch_width")
+        figures = pn.Column(self.status, self.warnings, plans, self.player, below,
                             sizing_mode="stretch_width")
         self.layout = PageLayout(sidebar, figures, top=self.run_button)
         if self.present:

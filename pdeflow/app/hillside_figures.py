@@ -39,6 +39,10 @@ PLAN_HEIGHT_PX = (260, 300)
 """Height of a plan view's plot area [px], normal and presentation mode."""
 SECTION_HEIGHT_PX = (170, 200)
 """Height of the long section [px], normal and presentation mode."""
+TABLE_WIDTH_PX = 300
+"""Width of the results table beside the long section [px]: two models' columns and
+their labels, so that the section keeps the rest (at 1024 px with the side bar shown,
+its plot area above the page's 300 px least)."""
 
 
 def hillshade_rgba(bed: np.ndarray, dx: float, dy: float) -> np.ndarray:
