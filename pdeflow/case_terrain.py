@@ -327,26 +327,25 @@ def terrain_corners(case: Any) -> np.ndarray | None:
     (``terrain.x0``, ``terrain.y0``, by default the grid's x_start, y_start); None
     without ``[terrain]``. A DEM that does not cover the corners, or has no data next to
     one, is a one-line CaseError naming ``terrain.bed``, and so is a GeoTIFF without
-    rasterio."""
+    rasterio or a bed that is not finite at a corner."""
     terrain = case.data.get("terrain")
     if terrain is None:
         return None
     x0, y0 = _origin(case)
     x = cell_corners(x0, case.length, case.dx)
     y = cell_corners(y0, case.width, case.dy, axis="y")
-    if "expression" in terrain:
-        corners = bed_corners(_bed(case, terrain), x, y)
-        bad = ~np.isfinite(corners)
-        if bad.any():
-            i, j = np.argwhere(bad)[0]
-            raise _err(case, f"terrain.expression is not finite at {bad.sum()} of the "
-                             f"grid's cell corners, e.g. x = {x[i]:g}, y = {y[j]:g} m")
-        return corners
-    name = f"terrain.bed {terrain['bed']!r}"
+    name = ("terrain.expression" if "expression" in terrain
+            else f"terrain.bed {terrain['bed']!r}")
     try:
-        return bed_corners(_bed(case, terrain), x, y, name=name)
+        corners = bed_corners(_bed(case, terrain), x, y, name=name)
     except (ValueError, ImportError) as err:
         raise _named(case, name, err) from None
+    bad = ~np.isfinite(corners)  # (an expression's log(0); a DEM's are refused above)
+    if bad.any():
+        i, j = np.argwhere(bad)[0]
+        raise _err(case, f"{name} is not finite at {bad.sum()} of the grid's cell "
+                         f"corners, e.g. x = {x[i]:g}, y = {y[j]:g} m")
+    return corners
 
 
 def release_depth(case: Any, h: np.ndarray, corners: np.ndarray) -> np.ndarray:
